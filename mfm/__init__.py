@@ -1,7 +1,23 @@
 """mfm: floating multi-body systems by the Moving Frame Method (MFM) in jax.
 
 Importing mfm switches jax to float64: every physical quantity here is float64.
+
+Data flows one way: config (TOML) → float tree → :class:`Model` → :func:`simulate` →
+:class:`xarray.Dataset` → plots.
 """
 import jax
 
 jax.config.update("jax_enable_x64", True)
+
+from . import integrators, loads, se3  # noqa: E402
+from .dynamics import (coriolis_matrix, energies, evaluate, forward_dynamics,  # noqa: E402
+                       mass_matrix, reaction_loads)
+from .kinematics import b_matrix, b_matrix_dot, body_poses, kinematics  # noqa: E402
+from .model import Model, compile_tree, load  # noqa: E402
+from .simulate import SimulationError, rollout, simulate  # noqa: E402
+from .tree import ConfigError  # noqa: E402
+
+__all__ = ["ConfigError", "Model", "SimulationError", "b_matrix", "b_matrix_dot", "body_poses",
+           "compile_tree", "coriolis_matrix", "energies", "evaluate", "forward_dynamics",
+           "integrators", "kinematics", "load", "loads", "mass_matrix", "reaction_loads",
+           "rollout", "se3", "simulate"]

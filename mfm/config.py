@@ -1,0 +1,221 @@
+"""TOML float-tree configs → validated :class:`~mfm.tree.BodySpec` lists.
+
+Format (every key is checked; an unknown key is an error)::
+
+    [model]
+    name = "double pendulum"     # optional
+    gravity = 9.81               # m/s², acts along −z (default 9.81)
+
+    [[bodies]]
+    name = "link1"
+    mass = 1.0                                  # kg, > 0
+    com = [0.0, 0.0, -0.5]                      # m, inertial axes at q = 0
+    inertia = [[0.1, 0, 0], [0, 0.1, 0], [0, 0, 0.01]]   # kg m² about the CoM, or instead:
+    # principal_inertia = [Ixx, Iyy, Izz]       #   body axes = inertial axes at q = 0
+    # radii_of_gyration = [rx, ry, rz]          #   m, I = m r²
+    # parent = "..."                            # omitted for the one root body
+    [bodies.joint]
+    type = "revolute"        # free | planar | revolute | prismatic | fixed
+    axis = [0.0, 1.0, 0.0]   # revolute / prismatic: unit direction, inertial axes at q = 0
+    point = [0.0, 0.0, 0.0]  # revolute: a point on the axis, m
+    damping = 0.0            # optional linear damper on the joint coordinate (N m s/rad, N s/m)
+    stiffness = 0.0          # optional linear spring (N m/rad, N/m) about `rest`
+    rest = 0.0
+
+The root may use ``free`` (6 coordinates: surge, sway, heave, roll, pitch, yaw), ``planar`` (surge,
+heave, pitch) or ``free`` with ``dofs = [...]`` (any subset), or a revolute/prismatic/fixed joint to
+the inertial frame. For a root with several coordinates, ``damping``/``stiffness``/``rest`` take
+one value per coordinate.
+"""
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .tree import (JOINT_KINDS, PLANAR_DOFS, ROOT_DOFS, BodySpec, ConfigError, JointSpec,
+                   check_inertia, tree_order)
+
+TOP_KEYS = {"model", "bodies"}
+MODEL_KEYS = {"name", "gravity", "description"}
+BODY_KEYS = {"name", "mass", "com", "inertia", "principal_inertia", "radii_of_gyration", "parent",
+             "joint", "geometry", "notes"}
+JOINT_KEYS = {"type", "axis", "point", "dofs", "damping", "stiffness", "rest", "notes"}
+
+
+def _unknown(keys, allowed, where):
+    bad = sorted(set(keys) - set(allowed))
+    if bad:
+        raise ConfigError(f"{where}: unknown key(s) {bad}; accepted keys: {sorted(allowed)}")
+
+
+def _vector(value, n, where, what="numbers"):
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{where}: {value!r} is not a list of {n} {what}") from None
+    if arr.shape != (n,) or not np.all(np.isfinite(arr)):
+        raise ConfigError(f"{where}: {value!r} is not a list of {n} finite {what}")
+    return arr
+
+
+def _number(value, where):
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+        raise ConfigError(f"{where}: {value!r} is not a finite number")
+    return float(value)
+
+
+def _per_coordinate(value, n, where):
+    if n == 0:
+        raise ConfigError(f"{where}: a fixed joint has no coordinate to carry a spring or damper")
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return np.full(n, _number(value, where))
+    return _vector(value, n, where)
+
+
+def _parse_joint(raw: Any, where: str, is_root: bool) -> JointSpec:
+    if not isinstance(raw, dict):
+        raise ConfigError(f"{where}: expected a table such as {{ type = \"revolute\", axis = [0, 1, "
+                          f"0], point = [0, 0, 0] }}, got {raw!r}")
+    _unknown(raw, JOINT_KEYS, where)
+    if "type" not in raw:
+        raise ConfigError(f"{where}.type: missing; accepted: {list(JOINT_KINDS)}")
+    kind = raw["type"]
+    if kind not in JOINT_KINDS:
+        raise ConfigError(f"{where}.type: {kind!r} is not a joint type; accepted: {list(JOINT_KINDS)}")
+    axis = point = None
+    dofs: tuple[str, ...] = ()
+    if kind in ("revolute", "prismatic"):
+        if "axis" not in raw:
+            raise ConfigError(f"{where}.axis: missing; a {kind} joint needs a unit axis, e.g. [0, 1, 0]")
+        axis = _vector(raw["axis"], 3, f"{where}.axis")
+        norm = np.linalg.norm(axis)
+        if norm < 1e-12:
+            raise ConfigError(f"{where}.axis: {raw['axis']!r} is a zero vector; give the direction "
+                              "of the joint axis, e.g. [0, 1, 0]")
+        axis = axis / norm
+    elif "axis" in raw:
+        raise ConfigError(f"{where}.axis: a {kind} joint has no axis; remove the key")
+    if kind == "revolute":
+        if "point" not in raw:
+            raise ConfigError(f"{where}.point: missing; a revolute joint needs a point on its axis (m)")
+        point = _vector(raw["point"], 3, f"{where}.point")
+    elif "point" in raw:
+        raise ConfigError(f"{where}.point: only a revolute joint takes a point; remove the key")
+    if kind in ("free", "planar"):
+        if kind == "planar":
+            if "dofs" in raw:
+                raise ConfigError(f"{where}.dofs: a planar joint is {list(PLANAR_DOFS)}; use "
+                                  "type = \"free\" with dofs = [...] for another subset")
+            dofs = PLANAR_DOFS
+        else:
+            req = raw.get("dofs", list(ROOT_DOFS))
+            if not isinstance(req, list) or not req:
+                raise ConfigError(f"{where}.dofs: {req!r} is not a non-empty list of {list(ROOT_DOFS)}")
+            for d in req:
+                if d not in ROOT_DOFS:
+                    raise ConfigError(f"{where}.dofs: {d!r} is not a root dof; accepted: {list(ROOT_DOFS)}")
+            if len(set(req)) != len(req):
+                raise ConfigError(f"{where}.dofs: {req!r} repeats a dof")
+            dofs = tuple(d for d in ROOT_DOFS if d in req)
+    elif "dofs" in raw:
+        raise ConfigError(f"{where}.dofs: only a free root takes dofs; remove the key")
+    spec = JointSpec(kind=kind, axis=axis, point=point, dofs=dofs)
+    n = spec.n_coordinates
+    loads = {}
+    for key in ("stiffness", "damping", "rest"):
+        loads[key] = (_per_coordinate(raw[key], n, f"{where}.{key}") if key in raw else np.zeros(n))
+    for key in ("stiffness", "damping"):
+        if np.any(loads[key] < 0):
+            raise ConfigError(f"{where}.{key}: {raw[key]!r} is negative; a passive spring or damper "
+                              "needs a value ≥ 0")
+    return JointSpec(kind=kind, axis=axis, point=point, dofs=dofs, **loads)
+
+
+def _parse_inertia(raw: dict, mass: float, where: str) -> np.ndarray:
+    given = [k for k in ("inertia", "principal_inertia", "radii_of_gyration") if k in raw]
+    if len(given) != 1:
+        raise ConfigError(f"{where}: give exactly one of inertia (3×3), principal_inertia (3) or "
+                          f"radii_of_gyration (3); found {given or 'none'}")
+    key = given[0]
+    if key == "inertia":
+        try:
+            J = np.asarray(raw[key], dtype=float)
+        except (TypeError, ValueError):
+            raise ConfigError(f"{where}.inertia: {raw[key]!r} is not a 3×3 matrix of numbers") from None
+    elif key == "principal_inertia":
+        J = np.diag(_vector(raw[key], 3, f"{where}.{key}"))
+    else:
+        r = _vector(raw[key], 3, f"{where}.{key}")
+        if np.any(r <= 0):
+            raise ConfigError(f"{where}.{key}: {raw[key]!r} must be positive lengths (m)")
+        J = np.diag(mass * r**2)
+    return check_inertia(J, f"{where}.{key}")
+
+
+def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodySpec]]:
+    """Validate a parsed TOML document. Returns (model options, bodies in tree order)."""
+    _unknown(data, TOP_KEYS, source)
+    model = data.get("model", {})
+    if not isinstance(model, dict):
+        raise ConfigError(f"{source}: [model] must be a table")
+    _unknown(model, MODEL_KEYS, "model")
+    options = {"name": str(model.get("name", Path(source).stem)),
+               "gravity": _number(model.get("gravity", 9.81), "model.gravity"),
+               "description": str(model.get("description", ""))}
+    if options["gravity"] < 0:
+        raise ConfigError(f"model.gravity: {options['gravity']} is negative; give the magnitude "
+                          "(m/s², gravity acts along −z)")
+    raw_bodies = data.get("bodies")
+    if not isinstance(raw_bodies, list) or not raw_bodies:
+        raise ConfigError(f"{source}: no [[bodies]]; a config needs at least one body")
+    bodies = []
+    for i, raw in enumerate(raw_bodies):
+        where = f"bodies[{i}]"
+        if not isinstance(raw, dict):
+            raise ConfigError(f"{where}: expected a table")
+        _unknown(raw, BODY_KEYS, where)
+        name = raw.get("name")
+        if not isinstance(name, str) or not name:
+            raise ConfigError(f"{where}.name: {name!r}; every body needs a non-empty string name")
+        where = f"bodies[{i}] ({name!r})"
+        if "__" in name or any(c.isspace() for c in name):
+            raise ConfigError(f"{where}.name: {name!r} contains '__' or white space; those are "
+                              "reserved for hydro dof labels such as 'float__Heave'")
+        if "mass" not in raw:
+            raise ConfigError(f"{where}.mass: missing (kg, > 0)")
+        mass = _number(raw["mass"], f"{where}.mass")
+        if mass <= 0:
+            raise ConfigError(f"{where}.mass: {raw['mass']!r} is not positive; give the mass in kg")
+        if "com" not in raw:
+            raise ConfigError(f"{where}.com: missing; the centre of mass [x, y, z] in m at q = 0")
+        com = _vector(raw["com"], 3, f"{where}.com")
+        inertia = _parse_inertia(raw, mass, where)
+        parent = raw.get("parent")
+        if parent is not None and not isinstance(parent, str):
+            raise ConfigError(f"{where}.parent: {parent!r} is not a body name")
+        if "joint" not in raw:
+            raise ConfigError(f"{where}.joint: missing; accepted types: {list(JOINT_KINDS)}")
+        joint = _parse_joint(raw["joint"], f"{where}.joint", parent is None)
+        extra = {k: raw[k] for k in ("geometry", "notes") if k in raw}
+        bodies.append(BodySpec(name=name, mass=mass, com=com, inertia=inertia, parent=parent,
+                               joint=joint, extra=extra))
+    return options, tree_order(bodies)
+
+
+def load_config(path: str | Path) -> tuple[dict, list[BodySpec]]:
+    """Read and validate a TOML config file."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except FileNotFoundError:
+        raise ConfigError(f"config file {str(path)!r} not found") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise ConfigError(f"{path}: not valid TOML: {e}") from None
+    options, bodies = parse_config(data, str(path))
+    options["source"] = str(path)
+    return options, bodies

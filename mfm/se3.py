@@ -1,0 +1,196 @@
+"""SE(3) frame connections as 4×4 matrices (seed 001 eqs. 4–12).
+
+A frame connection ``E = [[R, x], [0, 1]]`` places a child frame in a parent frame: ``R`` turns
+child axes into parent axes and ``x`` is the child origin in parent axes. Composition is the matrix
+product (eq. 7) and the inverse is analytic (eq. 8): ``E⁻¹ = [[Rᵀ, −Rᵀx], [0, 1]]``.
+
+Twists are ordered ``ξ = (v, ω)``: linear part first, angular part second, with
+``ξ̂ = [[ω̂, v], [0, 0]]``. A body twist ``(E⁻¹ Ė)^∨`` holds ``v = Rᵀ ẋ`` and ω in body axes (eq. 12).
+
+All functions are pure jax and work on float64 arrays; batch them with ``jax.vmap``.
+"""
+from __future__ import annotations
+
+import jax.numpy as jnp
+
+# Below this rotation angle the closed forms of exp/log switch to Taylor series (their relative
+# error there is below 1e-16 in float64).
+_SMALL_ANGLE = 1e-4
+
+
+def hat(w):
+    """Skew matrix ``ŵ`` of a 3-vector, so that ``ŵ u = w × u``. Shape (3,) → (3, 3)."""
+    w = jnp.asarray(w)
+    z = jnp.zeros_like(w[0])
+    return jnp.array([[z, -w[2], w[1]], [w[2], z, -w[0]], [-w[1], w[0], z]])
+
+
+def vee(W):
+    """Inverse of :func:`hat`: the 3-vector of a skew matrix (its skew part). (3, 3) → (3,)."""
+    return 0.5 * jnp.array([W[2, 1] - W[1, 2], W[0, 2] - W[2, 0], W[1, 0] - W[0, 1]])
+
+
+def _sinc_terms(theta):
+    """Return ``sin θ/θ``, ``(1 − cos θ)/θ²`` and ``(θ − sin θ)/θ³``, safe at θ → 0 (and for grad)."""
+    small = theta < _SMALL_ANGLE
+    t = jnp.where(small, 1.0, theta)  # keeps the unused branch finite for gradients
+    t2 = theta * theta
+    a = jnp.where(small, 1.0 - t2 / 6.0 + t2 * t2 / 120.0, jnp.sin(t) / t)
+    b = jnp.where(small, 0.5 - t2 / 24.0 + t2 * t2 / 720.0, (1.0 - jnp.cos(t)) / (t * t))
+    c = jnp.where(small, 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0, (t - jnp.sin(t)) / (t * t * t))
+    return a, b, c
+
+
+def _norm(w):
+    # sqrt of a sum of squares with a safe gradient at zero
+    n2 = jnp.sum(w * w)
+    safe = n2 > 0.0
+    return jnp.where(safe, jnp.sqrt(jnp.where(safe, n2, 1.0)), 0.0)
+
+
+def so3_exp(w):
+    """Rodrigues: ``Exp(ŵ) = I + (sin θ/θ) ŵ + ((1 − cos θ)/θ²) ŵ²``, θ = |w|. (3,) → (3, 3)."""
+    theta = _norm(w)
+    a, b, _ = _sinc_terms(theta)
+    W = hat(w)
+    return jnp.eye(3) + a * W + b * (W @ W)
+
+
+def so3_log(R):
+    """Rotation vector w with ``so3_exp(w) = R``, |w| ≤ π. (3, 3) → (3,).
+
+    Uses ``θ = atan2(|vee(R − Rᵀ)|/2, (tr R − 1)/2)``; near θ = π the axis comes from the symmetric
+    part ``(R + I)/2 = I + (1 − cos θ)/θ² ŵ²`` instead, where the skew part carries no information.
+    """
+    cos_t = jnp.clip((jnp.trace(R) - 1.0) * 0.5, -1.0, 1.0)
+    s = vee(R)  # = sin θ · axis
+    sin_t = _norm(s)
+    theta = jnp.arctan2(sin_t, cos_t)
+    small = theta < _SMALL_ANGLE
+    a, _, _ = _sinc_terms(theta)
+    w_generic = s / jnp.where(small, 1.0, a)
+    w_generic = jnp.where(small, s * (1.0 + theta * theta / 6.0), w_generic)
+    # near π the skew part vanishes; the symmetric part (R + Rᵀ)/2 = cos θ I + (1 − cos θ) n nᵀ
+    # gives n nᵀ exactly, and the skew part still fixes the sign of n.
+    nnT = (0.5 * (R + R.T) - cos_t * jnp.eye(3)) / jnp.maximum(1.0 - cos_t, 1e-300)
+    k = jnp.argmax(jnp.diagonal(nnT))
+    n = nnT[:, k] / jnp.sqrt(jnp.maximum(nnT[k, k], 1e-300))
+    n = jnp.where(jnp.dot(n, s) < 0.0, -n, n)
+    near_pi = cos_t < -0.99
+    return jnp.where(near_pi, theta * n, w_generic)
+
+
+def _left_jacobian(w):
+    """SO(3) left Jacobian ``J(w) = I + ((1 − cos θ)/θ²) ŵ + ((θ − sin θ)/θ³) ŵ²``."""
+    theta = _norm(w)
+    _, b, c = _sinc_terms(theta)
+    W = hat(w)
+    return jnp.eye(3) + b * W + c * (W @ W)
+
+
+def _left_jacobian_inv(w):
+    """Inverse of the SO(3) left Jacobian: ``I − ½ŵ + (1/θ² − (1 + cos θ)/(2θ sin θ)) ŵ²``."""
+    theta = _norm(w)
+    small = theta < _SMALL_ANGLE
+    t = jnp.where(small, 1.0, theta)
+    coef = jnp.where(small, 1.0 / 12.0 + theta * theta / 720.0,
+                     1.0 / (t * t) - (1.0 + jnp.cos(t)) / (2.0 * t * jnp.sin(t)))
+    W = hat(w)
+    return jnp.eye(3) - 0.5 * W + coef * (W @ W)
+
+
+def make(R, x):
+    """Frame connection ``[[R, x], [0, 1]]`` from a rotation (3, 3) and a translation (3,)."""
+    top = jnp.concatenate([jnp.asarray(R), jnp.asarray(x)[:, None]], axis=1)
+    return jnp.concatenate([top, jnp.array([[0.0, 0.0, 0.0, 1.0]], dtype=top.dtype)], axis=0)
+
+
+def rotation(E):
+    return E[:3, :3]
+
+
+def translation(E):
+    return E[:3, 3]
+
+
+def inverse(E):
+    """Analytic inverse (seed 001 eq. 8): ``[[Rᵀ, −Rᵀx], [0, 1]]``."""
+    R, x = E[:3, :3], E[:3, 3]
+    return make(R.T, -R.T @ x)
+
+
+def compose(*Es):
+    """Product ``E₁ E₂ ⋯`` of frame connections (closure of SE(3), eq. 7)."""
+    out = Es[0]
+    for E in Es[1:]:
+        out = out @ E
+    return out
+
+
+def twist_hat(xi):
+    """``ξ̂ = [[ω̂, v], [0, 0]]`` for ξ = (v, ω). (6,) → (4, 4)."""
+    xi = jnp.asarray(xi)
+    top = jnp.concatenate([hat(xi[3:]), xi[:3, None]], axis=1)
+    return jnp.concatenate([top, jnp.zeros((1, 4), dtype=top.dtype)], axis=0)
+
+
+def twist_vee(X):
+    """Inverse of :func:`twist_hat`. (4, 4) → (6,)."""
+    return jnp.concatenate([X[:3, 3], vee(X[:3, :3])])
+
+
+def se3_exp(xi):
+    """``Exp(ξ̂) = [[Exp(ω̂), J(ω) v], [0, 1]]`` with J the SO(3) left Jacobian. (6,) → (4, 4)."""
+    xi = jnp.asarray(xi)
+    v, w = xi[:3], xi[3:]
+    return make(so3_exp(w), _left_jacobian(w) @ v)
+
+
+def se3_log(E):
+    """Twist ξ = (v, ω) with ``se3_exp(ξ) = E``, |ω| ≤ π. (4, 4) → (6,)."""
+    w = so3_log(E[:3, :3])
+    v = _left_jacobian_inv(w) @ E[:3, 3]
+    return jnp.concatenate([v, w])
+
+
+def adjoint(E):
+    """Adjoint ``Ad_E = [[R, x̂R], [0, R]]`` acting on twists (v, ω): ``(E ξ̂ E⁻¹)^∨ = Ad_E ξ``."""
+    R, x = E[:3, :3], E[:3, 3]
+    top = jnp.concatenate([R, hat(x) @ R], axis=1)
+    bottom = jnp.concatenate([jnp.zeros((3, 3), dtype=R.dtype), R], axis=1)
+    return jnp.concatenate([top, bottom], axis=0)
+
+
+def adjoint_inverse(E):
+    """``Ad_{E⁻¹} = [[Rᵀ, −Rᵀx̂], [0, Rᵀ]]`` without forming E⁻¹."""
+    R, x = E[:3, :3], E[:3, 3]
+    Rt = R.T
+    top = jnp.concatenate([Rt, -Rt @ hat(x)], axis=1)
+    bottom = jnp.concatenate([jnp.zeros((3, 3), dtype=R.dtype), Rt], axis=1)
+    return jnp.concatenate([top, bottom], axis=0)
+
+
+def rot_x(a):
+    c, s = jnp.cos(a), jnp.sin(a)
+    o, z = jnp.ones_like(a), jnp.zeros_like(a)
+    return jnp.array([[o, z, z], [z, c, -s], [z, s, c]])
+
+
+def rot_y(a):
+    c, s = jnp.cos(a), jnp.sin(a)
+    o, z = jnp.ones_like(a), jnp.zeros_like(a)
+    return jnp.array([[c, z, s], [z, o, z], [-s, z, c]])
+
+
+def rot_z(a):
+    c, s = jnp.cos(a), jnp.sin(a)
+    o, z = jnp.ones_like(a), jnp.zeros_like(a)
+    return jnp.array([[c, -s, z], [s, c, z], [z, z, o]])
+
+
+def euler_zyx(R):
+    """Roll, pitch, yaw (φ, θ, ψ) with ``R = R_z(ψ) R_y(θ) R_x(φ)``; θ ∈ [−π/2, π/2]."""
+    pitch = jnp.arcsin(jnp.clip(-R[2, 0], -1.0, 1.0))
+    roll = jnp.arctan2(R[2, 1], R[2, 2])
+    yaw = jnp.arctan2(R[1, 0], R[0, 0])
+    return jnp.array([roll, pitch, yaw])

@@ -1,0 +1,318 @@
+"""Time-domain simulation: a pure jax rollout, compiled once, and its labelled dataset.
+
+``rollout`` is the pure core (``lax.scan`` over steps; vmap- and grad-friendly); ``simulate`` is the
+front door: it checks the inputs, runs the compiled rollout, stops with a clear error if the state
+went non-finite, and returns an :class:`xarray.Dataset`.
+"""
+from __future__ import annotations
+
+import collections
+import datetime
+import math
+from typing import Sequence
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import xarray as xr
+
+from . import integrators as _integrators
+from . import se3
+from .dynamics import energies, evaluate, reaction_loads
+from .kinematics import kinematics
+from .loads import Load
+from .model import Model
+
+# How many times each compiled function was traced (a retrace means a recompilation); tests use it.
+TRACES: collections.Counter = collections.Counter()
+
+
+class SimulationError(RuntimeError):
+    """The simulation went non-finite; the message gives the time, the state and the likely cause."""
+
+
+def _as_loads(loads) -> tuple[Load, ...]:
+    if loads is None:
+        return ()
+    if isinstance(loads, Load):
+        return (loads,)
+    loads = tuple(loads)
+    for ld in loads:
+        if not isinstance(ld, Load):
+            raise TypeError(f"loads: {ld!r} is not an mfm.loads.Load")
+    return loads
+
+
+def applied_loads(model: Model, loads: Sequence[Load], t, q, qd, z, kin):
+    """Sum the external loads at one state: (body (n, 6) | None, tau (n_q,) | None,
+    mass (n_q, n_q) | None, zd (n_states,)). Load states are concatenated in z in ``loads`` order."""
+    sizes = [ld.n_states for ld in loads]
+    offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
+    body = tau = mass = None
+    zds = []
+    for k, ld in enumerate(loads):
+        out = ld(model, t, q, qd, z[offsets[k]:offsets[k + 1]], kin)
+        if out.body is not None:
+            body = out.body if body is None else body + out.body
+        if out.tau is not None:
+            tau = out.tau if tau is None else tau + out.tau
+        if out.mass is not None:
+            mass = out.mass if mass is None else mass + out.mass
+        zds.append(jnp.zeros(sizes[k]) if out.zd is None else out.zd)
+    zd = jnp.concatenate(zds) if zds else jnp.zeros(0)
+    return body, tau, mass, zd
+
+
+def dynamics_function(model: Model, loads: Sequence[Load] = ()):
+    """The system ``f(t, q, q̇, z) -> (q̈, ż)`` of the integrators: MFM equations of motion plus the
+    external loads."""
+
+    def f(t, q, qd, z):
+        kin = kinematics(model, q)
+        body, tau, mass, zd = applied_loads(model, loads, t, q, qd, z, kin)
+        return evaluate(model, q, qd, tau=tau, body_loads=body, extra_mass=mass, kin=kin).qdd, zd
+
+    return f
+
+
+def _rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_every):
+    TRACES["rollout"] += 1
+    f = dynamics_function(model, loads)
+    state = integrator.init(f, t0, q0, qd0, z0)
+
+    def block(s, _):
+        s, _ = jax.lax.scan(lambda s, _: (integrator.step(f, s, dt), None), s, None,
+                            length=save_every)
+        return s, (s.t, s.q, s.qd, s.qdd, s.z, s.iterations)
+
+    _, traj = jax.lax.scan(block, state, None, length=n_steps // save_every)
+    first = (state.t, state.q, state.qd, state.qdd, state.z, state.iterations)
+    return tuple(jnp.concatenate([a[None], b]) for a, b in zip(first, traj))
+
+
+_rollout_jit = jax.jit(_rollout_impl, static_argnames=("n_steps", "integrator", "save_every"))
+
+
+def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=None,
+            save_every: int = 1, t0=0.0, z0=None):
+    """Pure, jit-compiled rollout: returns ``(t, q, qd, qdd, z, iterations)`` arrays with a leading
+    time axis of length ``n_steps // save_every + 1`` (the initial state first).
+
+    Compiled once per (topology, n_steps, integrator, save_every, loads structure): changing any
+    array parameter of ``model`` or ``loads``, ``dt``, ``q0``, ``qd0`` reuses the compiled code, and
+    the function can be ``jax.vmap``-ed over a batched model or ``jax.grad``-ed (RK4, semi-implicit
+    and Newmark; Beeman's while loop is forward-mode only).
+    """
+    loads = _as_loads(loads)
+    integ = _integrators.get(integrator)
+    q0 = jnp.asarray(q0, jnp.float64)
+    qd0 = jnp.asarray(qd0, jnp.float64)
+    if z0 is None:
+        parts = [ld.initial_state(model) for ld in loads]
+        z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
+    return _rollout_jit(model, loads, q0, qd0, jnp.asarray(z0, jnp.float64),
+                        jnp.asarray(t0, jnp.float64), jnp.asarray(dt, jnp.float64),
+                        n_steps=int(n_steps), integrator=integ, save_every=int(save_every))
+
+
+def _initial_vector(model: Model, value, what: str) -> np.ndarray:
+    n = model.n_coordinates
+    if value is None:
+        return np.zeros(n)
+    if isinstance(value, dict):
+        out = np.zeros(n)
+        for k, v in value.items():
+            try:
+                out[model.coordinate_index(k)] = float(v)
+            except KeyError:
+                raise ValueError(f"{what}: {k!r} is not a coordinate of {model.name!r}; "
+                                 f"coordinates: {list(model.coordinates)}") from None
+        return out
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (n,):
+        raise ValueError(f"{what}: shape {arr.shape} does not match the {n} coordinates "
+                         f"{list(model.coordinates)}; give an array of shape ({n},) or a dict")
+    return arr
+
+
+def shortest_natural_period(model: Model, q, loads=()) -> float:
+    """Estimate of the shortest natural period (s) at configuration q (q̇ = 0): from the
+    generalised eigenproblem K v = ω² M* v with K = −∂q̈/∂q · M* linearised numerically by jax.
+    Returns inf when nothing is restoring."""
+    f = dynamics_function(model, _as_loads(loads))
+    z0 = jnp.zeros(sum(ld.n_states for ld in _as_loads(loads)))
+    qd0 = jnp.zeros(model.n_coordinates)
+    Jq = jax.jacfwd(lambda x: f(0.0, x, qd0, z0)[0])(jnp.asarray(q, jnp.float64))
+    lam = np.linalg.eigvals(-np.asarray(Jq)).real
+    lam_max = lam.max() if lam.size else 0.0
+    return math.inf if lam_max <= 0 else 2.0 * math.pi / math.sqrt(lam_max)
+
+
+def _raise_nonfinite(model, integ, t, q, qd, dt, loads):
+    bad = ~(np.isfinite(q).all(axis=1) & np.isfinite(qd).all(axis=1))
+    k = int(np.argmax(bad))
+    coords = [model.coordinates[j] for j in range(model.n_coordinates)
+              if not (np.isfinite(q[k, j]) and np.isfinite(qd[k, j]))]
+    k_ok = max(k - 1, 0)
+    T_min = shortest_natural_period(model, q[k_ok], loads)
+    lines = [f"the state went non-finite at t = {t[k]:.6g} s (first saved sample; last finite at "
+             f"t = {t[k_ok]:.6g} s) in coordinate(s) {coords}."]
+    if math.isfinite(T_min):
+        ratio = 2 * math.pi * dt / T_min
+        lines.append(f"Likely cause: dt = {dt:.4g} s against the shortest natural period "
+                     f"{T_min:.4g} s (ω dt = {ratio:.3g}; {integ.name} is stable for ω dt < "
+                     f"{integ.stability_limit:.3g}).")
+        if ratio >= 0.5 * integ.stability_limit:
+            lines.append(f"Reduce dt below {T_min * integ.stability_limit / (4 * math.pi):.3g} s or "
+                         "use integrator='newmark'.")
+        else:
+            lines.append("dt is inside the stability limit, so look at the loads or the model: "
+                         "large rotations of a free root near pitch = ±90° (Euler angle "
+                         "singularity), a load that grows without bound, or a bad parameter.")
+    else:
+        lines.append("No restoring stiffness at the last finite state: look at the loads, a "
+                     "parameter, or a free root near pitch = ±90° (Euler angle singularity).")
+    raise SimulationError(" ".join(lines))
+
+
+def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="rk4",
+             q0=None, qd0=None, loads=None, save_every: int = 1, t0: float = 0.0) -> xr.Dataset:
+    """Simulate a model in the time domain.
+
+    Parameters
+    ----------
+    model: a compiled :class:`~mfm.model.Model`.
+    sea: the sea state; must be None for a mechanics-only model.
+    duration, dt: s. The run has ``round(duration / dt)`` steps.
+    integrator: ``"rk4"`` (default), ``"beeman"`` (seed 001 eq. 52), ``"semi_implicit"``,
+        ``"newmark"``, or an instance from :mod:`mfm.integrators`.
+    q0, qd0: initial coordinates and rates, arrays (n_q,) or dicts by coordinate name (others 0).
+    loads: an :class:`mfm.loads.Load` or a sequence of them (external loads).
+    save_every: keep every k-th step in the output.
+
+    Returns an :class:`xarray.Dataset` with ``q``, ``qd``, ``qdd`` (time, coordinate),
+    ``body_position`` (time, body, axis) CoM in inertial axes, ``body_rotation`` (time, body, angle)
+    roll/pitch/yaw (R = R_z(yaw) R_y(pitch) R_x(roll)), ``joint_force`` and ``joint_moment``
+    (time, body, axis): the load each body's joint transmits from the parent (inertial axes, moment
+    about the joint point), ``kinetic_energy`` and ``potential_energy`` (time), and
+    ``iterations`` (corrector iterations of the step), with units and provenance in attributes.
+
+    Raises :class:`SimulationError` when the state goes non-finite.
+    """
+    if sea is not None:
+        raise ValueError("sea: this model has no hydrodynamics (mfm.load(..., hydro=False)); pass "
+                         "sea=None")
+    if not (dt > 0 and math.isfinite(dt)):
+        raise ValueError(f"dt: {dt!r} must be a positive number of seconds")
+    if not (duration > 0 and math.isfinite(duration)):
+        raise ValueError(f"duration: {duration!r} must be a positive number of seconds")
+    n_steps = int(round(duration / dt))
+    if n_steps < 1:
+        raise ValueError(f"duration = {duration} s is shorter than one step dt = {dt} s")
+    if save_every < 1 or n_steps % save_every:
+        raise ValueError(f"save_every: {save_every} must be a positive divisor of the {n_steps} "
+                         "steps")
+    loads = _as_loads(loads)
+    integ = _integrators.get(integrator)
+    q0 = _initial_vector(model, q0, "q0")
+    qd0 = _initial_vector(model, qd0, "qd0")
+    t, q, qd, qdd, z, iters = (np.asarray(a) for a in rollout(
+        model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
+        save_every=save_every, t0=t0))
+    if not (np.isfinite(q).all() and np.isfinite(qd).all()):
+        _raise_nonfinite(model, integ, t, q, qd, dt, loads)
+    post = _postprocess(model, loads, t, q, qd, z)
+    return _dataset(model, integ, dt, t, q, qd, qdd, iters, post)
+
+
+def _postprocess_impl(model, loads, t, q, qd, z):
+    TRACES["postprocess"] += 1
+
+    def one(t, q, qd, z):
+        kin = kinematics(model, q)
+        body, tau, mass, _ = applied_loads(model, loads, t, q, qd, z, kin)
+        ev = evaluate(model, q, qd, tau=tau, body_loads=body, extra_mass=mass, kin=kin)
+        # Note: acceleration-proportional load terms (``mass``) act through q̈ only; a load that
+        # has them must also report its Cartesian part in ``body`` for the reactions to hold it.
+        f_j, m_j = reaction_loads(model, ev)
+        T, V = energies(model, q, qd)
+        angles = jax.vmap(se3.euler_zyx)(kin.E[:, :3, :3])
+        return kin.E[:, :3, 3], angles, f_j, m_j, T, V, ev.qdd
+
+    return jax.vmap(one)(t, q, qd, z)
+
+
+_postprocess_jit = jax.jit(_postprocess_impl)
+
+
+def _postprocess(model, loads, t, q, qd, z):
+    return tuple(np.asarray(a) for a in _postprocess_jit(model, loads, jnp.asarray(t),
+                                                         jnp.asarray(q), jnp.asarray(qd),
+                                                         jnp.asarray(z)))
+
+
+def _dataset(model, integ, dt, t, q, qd, qdd, iters, post) -> xr.Dataset:
+    pos, ang, f_j, m_j, T, V, _ = post
+    coords = {"time": ("time", t, {"units": "s"}),
+              "coordinate": list(model.coordinates),
+              "body": list(model.body_names),
+              "axis": ["x", "y", "z"],
+              "angle": ["roll", "pitch", "yaw"]}
+    units = [_coordinate_unit(model, c) for c in model.coordinates]
+    ds = xr.Dataset(
+        {
+            "q": (("time", "coordinate"), q, {"long_name": "generalised coordinates",
+                                              "units": "m or rad (see coordinate_unit)"}),
+            "qd": (("time", "coordinate"), qd, {"long_name": "generalised velocities",
+                                                "units": "m/s or rad/s"}),
+            "qdd": (("time", "coordinate"), qdd, {"long_name": "generalised accelerations",
+                                                  "units": "m/s2 or rad/s2"}),
+            "coordinate_unit": (("coordinate",), units),
+            "body_position": (("time", "body", "axis"), pos,
+                              {"long_name": "centre of mass position, inertial axes", "units": "m"}),
+            "body_rotation": (("time", "body", "angle"), ang,
+                              {"long_name": "body orientation as roll, pitch, yaw with "
+                               "R = Rz(yaw) Ry(pitch) Rx(roll)", "units": "rad"}),
+            "joint_force": (("time", "body", "axis"), f_j,
+                            {"long_name": "force the joint of each body transmits from its parent "
+                             "(or the inertial frame) to the body, inertial axes", "units": "N"}),
+            "joint_moment": (("time", "body", "axis"), m_j,
+                             {"long_name": "moment the joint of each body transmits, about the joint "
+                              "point, inertial axes", "units": "N m"}),
+            "kinetic_energy": (("time",), T, {"units": "J"}),
+            "potential_energy": (("time",), V, {"long_name": "gravity and joint springs",
+                                                "units": "J"}),
+            "iterations": (("time",), iters, {"long_name": "corrector iterations of the step"}),
+        },
+        coords=coords,
+        attrs={
+            "title": f"mfm simulation of {model.name}",
+            "model": model.name,
+            "integrator": integ.name,
+            "integrator_settings": repr(integ),
+            "dt": float(dt),
+            "dt_units": "s",
+            "mfm_version": _version(),
+            "jax_version": jax.__version__,
+            "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+            "conventions": "inertial frame: origin on the still-water line, z up; body frames at "
+                           "the CoM, parallel to inertial at q = 0",
+        },
+    )
+    return ds
+
+
+def _coordinate_unit(model: Model, name: str) -> str:
+    for i, motions in enumerate(model.motions):
+        for kind, k in motions:
+            if model.coordinates[k] == name:
+                return "rad" if kind == "R" else "m"
+    return ""
+
+
+def _version() -> str:
+    try:
+        from importlib.metadata import version
+        return version("mfm")
+    except Exception:  # not installed (running from a source tree)
+        return "unknown"
