@@ -41,7 +41,7 @@ from .tree import (JOINT_KINDS, PLANAR_DOFS, ROOT_DOFS, BodySpec, ConfigError, J
 TOP_KEYS = {"model", "bodies"}
 MODEL_KEYS = {"name", "gravity", "description"}
 BODY_KEYS = {"name", "mass", "com", "inertia", "principal_inertia", "radii_of_gyration", "parent",
-             "joint", "geometry", "notes"}
+             "joint", "notes"}
 JOINT_KEYS = {"type", "axis", "point", "dofs", "damping", "stiffness", "rest", "notes"}
 
 
@@ -199,7 +199,7 @@ def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodyS
         if "joint" not in raw:
             raise ConfigError(f"{where}.joint: missing; accepted types: {list(JOINT_KINDS)}")
         joint = _parse_joint(raw["joint"], f"{where}.joint", parent is None)
-        extra = {k: raw[k] for k in ("geometry", "notes") if k in raw}
+        extra = {k: raw[k] for k in ("notes",) if k in raw}
         bodies.append(BodySpec(name=name, mass=mass, com=com, inertia=inertia, parent=parent,
                                joint=joint, extra=extra))
     return options, tree_order(bodies)

@@ -72,11 +72,12 @@ def so3_log(R):
     w_generic = jnp.where(small, s * (1.0 + theta * theta / 6.0), w_generic)
     # near π the skew part vanishes; the symmetric part (R + Rᵀ)/2 = cos θ I + (1 − cos θ) n nᵀ
     # gives n nᵀ exactly, and the skew part still fixes the sign of n.
-    nnT = (0.5 * (R + R.T) - cos_t * jnp.eye(3)) / jnp.maximum(1.0 - cos_t, 1e-300)
-    k = jnp.argmax(jnp.diagonal(nnT))
-    n = nnT[:, k] / jnp.sqrt(jnp.maximum(nnT[k, k], 1e-300))
-    n = jnp.where(jnp.dot(n, s) < 0.0, -n, n)
+    # (the unused branch is kept finite so that gradients through jnp.where stay finite)
     near_pi = cos_t < -0.99
+    nnT = (0.5 * (R + R.T) - cos_t * jnp.eye(3)) / jnp.where(near_pi, 1.0 - cos_t, 1.0)
+    k = jnp.argmax(jnp.diagonal(nnT))
+    n = nnT[:, k] / jnp.sqrt(jnp.where(near_pi, nnT[k, k], 1.0))
+    n = jnp.where(jnp.dot(n, s) < 0.0, -n, n)
     return jnp.where(near_pi, theta * n, w_generic)
 
 
