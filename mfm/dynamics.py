@@ -31,18 +31,13 @@ def body_mass_blocks(model: Model) -> jnp.ndarray:
 def mass_matrix(model: Model, q) -> jnp.ndarray:
     """M*(q) = Bᵀ M B, shape (n_q, n_q), symmetric positive-definite."""
     B = kinematics(model, q).B
-    return jnp.einsum("nai,nab,nbj->ij", B, body_mass_blocks(model), B)
-
-
-def _xdot_bias(model: Model, q, qd):
-    """Ḃ q̇ per body, (n, 6): the jvp of q ↦ B(q) q̇ along q̇ (one forward pass)."""
-    return jax.jvp(lambda x: jnp.einsum("nai,i->na", kinematics(model, x).B, qd), (q,), (qd,))[1]
+    return jnp.einsum("nai,naj->ij", B, _apply_mass(model, B))
 
 
 def gyroscopic(model: Model, X) -> jnp.ndarray:
     """D M X per body, (n, 6): zero force, ω × (J ω) moment in body axes."""
     w = X[:, 3:]
-    Jw = jnp.einsum("nab,nb->na", model.inertia, w)
+    Jw = jnp.sum(model.inertia * w[:, None, :], axis=2)
     return jnp.concatenate([jnp.zeros_like(w), jnp.cross(w, Jw)], axis=1)
 
 
@@ -90,26 +85,32 @@ def evaluate(model: Model, q, qd, tau=None, body_loads=None, extra_mass=None,
     """
     q = jnp.asarray(q, jnp.float64)
     qd = jnp.asarray(qd, jnp.float64)
-    if kin is None:
-        kin = kinematics(model, q)
-    B = kin.B
-    Mb = body_mass_blocks(model)
-    X = jnp.einsum("nai,i->na", B, qd)
-    bias = _xdot_bias(model, q, qd)
+    if kin is None or kin.bias is None:
+        kin = kinematics(model, q, qd)
+    B, X, bias = kin.B, kin.X, kin.bias
     F = gravity_loads(model)
     if body_loads is not None:
         F = F + body_loads
     Q = joint_loads(model, q, qd)
     if tau is not None:
         Q = Q + tau
-    Mstar = jnp.einsum("nai,nab,nbj->ij", B, Mb, B)
+    MB = _apply_mass(model, B)                                    # M B, (n, 6, n_q)
+    Mstar = jnp.einsum("nai,naj->ij", B, MB)
     if extra_mass is not None:
         Mstar = Mstar + extra_mass
-    rhs = (jnp.einsum("nai,na->i", B, F - jnp.einsum("nab,nb->na", Mb, bias) - gyroscopic(model, X))
-           + Q)
-    qdd = jnp.linalg.solve(Mstar, rhs)
+    rhs = jnp.einsum("nai,na->i", B, F - _apply_mass(model, bias) - gyroscopic(model, X)) + Q
+    qdd = jax.scipy.linalg.cho_solve(jax.scipy.linalg.cho_factor(Mstar), rhs)
     Xdot = jnp.einsum("nai,i->na", B, qdd) + bias
     return Evaluation(qdd=qdd, kin=kin, X=X, Xdot=Xdot, F=F, Q=Q)
+
+
+def _apply_mass(model: Model, Y):
+    """M Y per body without forming M: (m Y_lin, J Y_ang), Y of shape (n, 6, ...) ."""
+    extra = (None,) * (Y.ndim - 2)
+    lin = model.mass[(slice(None), None) + extra] * Y[:, :3]
+    J = model.inertia[(slice(None), slice(None), slice(None)) + extra]
+    ang = jnp.sum(J * Y[:, None, 3:], axis=2)
+    return jnp.concatenate([lin, ang], axis=1)
 
 
 def forward_dynamics(model: Model, q, qd, tau=None) -> jnp.ndarray:
@@ -126,8 +127,7 @@ def reaction_loads(model: Model, ev: Evaluation):
     point (n, 3) N m, both in inertial axes. Along a joint's free directions these equal the joint's
     generalised loads (zero for an unloaded free root); across them they are the constraint loads.
     """
-    Mb = body_mass_blocks(model)
-    r = jnp.einsum("nab,nb->na", Mb, ev.Xdot) + gyroscopic(model, ev.X) - ev.F
+    r = _apply_mass(model, ev.Xdot) + gyroscopic(model, ev.X) - ev.F
     R = ev.kin.E[:, :3, :3]
     x = ev.kin.E[:, :3, 3]
     pJ = ev.kin.joint_frame[:, :3, 3]
@@ -143,9 +143,8 @@ def reaction_loads(model: Model, ev: Evaluation):
 
 def energies(model: Model, q, qd):
     """Kinetic ½ q̇ᵀM*q̇ and potential (gravity Σ m g z_i + joint springs) energy, J."""
-    kin = kinematics(model, q)
-    X = jnp.einsum("nai,i->na", kin.B, qd)
-    T = 0.5 * jnp.einsum("na,nab,nb->", X, body_mass_blocks(model), X)
+    kin = kinematics(model, q, qd)
+    T = 0.5 * jnp.sum(kin.X * _apply_mass(model, kin.X))
     V = jnp.sum(model.mass * model.gravity * kin.E[:, 2, 3])
     V = V + 0.5 * jnp.sum(model.stiffness * (q - model.rest) ** 2)
     return T, V

@@ -68,7 +68,7 @@ def dynamics_function(model: Model, loads: Sequence[Load] = ()):
     external loads."""
 
     def f(t, q, qd, z):
-        kin = kinematics(model, q)
+        kin = kinematics(model, q, qd)
         body, tau, mass, zd = applied_loads(model, loads, t, q, qd, z, kin)
         return evaluate(model, q, qd, tau=tau, body_loads=body, extra_mass=mass, kin=kin).qdd, zd
 
@@ -229,7 +229,7 @@ def _postprocess_impl(model, loads, t, q, qd, z):
     TRACES["postprocess"] += 1
 
     def one(t, q, qd, z):
-        kin = kinematics(model, q)
+        kin = kinematics(model, q, qd)
         body, tau, mass, _ = applied_loads(model, loads, t, q, qd, z, kin)
         ev = evaluate(model, q, qd, tau=tau, body_loads=body, extra_mass=mass, kin=kin)
         # Note: acceleration-proportional load terms (``mass``) act through q̈ only; a load that

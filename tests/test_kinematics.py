@@ -84,6 +84,18 @@ def test_b_dot_is_time_derivative(name):
     np.testing.assert_allclose(mfm.b_matrix_dot(m, q, qd), fd, atol=1e-7)
 
 
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_walk_velocities_and_bias_equal_jvp(name):
+    # the walk's X and Ḃ q̇ (from ȧ = ω × a) against jax's jvp of B along q̇
+    m = MODELS[name]
+    q, qd = random_state(m)
+    kin = mfm.kinematics(m, q, qd)
+    X = np.asarray(mfm.b_matrix(m, q) @ qd).reshape(m.n_bodies, 6)
+    np.testing.assert_allclose(kin.X, X, atol=TOL)
+    bias = np.asarray(mfm.b_matrix_dot(m, q, qd) @ qd).reshape(m.n_bodies, 6)
+    np.testing.assert_allclose(kin.bias, bias, atol=TOL * max(1, np.abs(bias).max()))
+
+
 # --- seed 001 eqs. 29–40, written out by hand in numpy ------------------------------------------
 
 def Ry(a):

@@ -1,0 +1,186 @@
+"""hydro.radiation and hydro.statespace: K(t), Ogilvie's relations, memory, grid, state space.
+
+Independent references: the analytic pair B(ω) = 2aω²/(a² + ω²)² ↔ K(t) = (1 − at)e^{−at}; the database's own
+A(ω), B(ω) (WAMIT RM3, capytaine sphere); the realisation C(iωI − A)⁻¹B by a dense solve.
+"""
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from hydro import database as D
+from hydro import radiation as R
+from hydro import statespace as S
+from hydro.wamit import read_wamit
+
+DATA = Path(__file__).resolve().parents[1] / "hydro" / "data"
+BAND = (0.2, 2.0)
+
+
+@pytest.fixture(scope="module")
+def rm3():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", D.HydroDatabaseWarning)
+        return read_wamit(DATA / "rm3" / "rm3", body_names=["float", "spar"])
+
+
+@pytest.fixture(scope="module")
+def rm3_K(rm3):
+    return R.impulse_response(rm3, np.arange(0.0, 80.0, 0.02))
+
+
+@pytest.fixture(scope="module")
+def rm3_ss(rm3):
+    return S.fit_state_space(rm3, omega_fit=BAND)
+
+
+def _one_dof(omega, B):
+    lab = ["b__Heave"]
+    return xr.Dataset({"radiation_damping": (("omega", "influenced_dof", "radiating_dof"), B[:, None, None])},
+                      coords={"omega": omega, "influenced_dof": lab, "radiating_dof": lab})
+
+
+def test_impulse_response_and_ogilvie_analytic():
+    """K(t) = (1 − at) e^{−at} ↔ B(ω) = 2aω²/(a² + ω²)², A(ω) − A∞ = (a² − ω²)/(a² + ω²)²
+    (from ∫K e^{−iωt} dt = iω/(a + iω)²; B(0) = 0 and B ~ ω⁻² like a floating body's)."""
+    from scipy.optimize import brentq
+    a = 1.0
+    om = np.arange(0.01, 10.0 + 1e-9, 0.01)
+    db = _one_dof(om, 2 * a * om ** 2 / (a ** 2 + om ** 2) ** 2)
+    t = np.arange(0.0, 30.0, 0.01)
+    K = R.impulse_response(db, t)
+    Kex = (1 - a * t) * np.exp(-a * t)
+    # the ω⁻² tail beyond 10 rad/s is 6 % of K(0): the exponent fitted on 7.5–10 rad/s is the
+    # local log-slope 2(a² − ω²)/(a² + ω²) + 2 − … ≈ 1.9 there, and the tail is extrapolated
+    assert 1.85 < K.tail_exponent.values[0, 0] < 2.0
+    # K(0) carries the whole tail: the fitted exponent (< 2, fitted before the asymptote) makes
+    # it 0.5 % high (measured); elsewhere 3e-3 covers piecewise-linear B and the tail
+    assert K.values[0, 0, 0] == pytest.approx(1.0, rel=0.01)
+    np.testing.assert_allclose(K.values[1:, 0, 0], Kex[1:], atol=3e-3)
+    w = np.array([0.2, 0.5, 1.0, 2.0, 4.0])
+    A = R.added_mass_from_irf(Kex[:, None, None], t, A_inf=np.zeros((1, 1)), omega=w)[:, 0, 0]
+    B = R.damping_from_irf(Kex[:, None, None], t, omega=w)[:, 0, 0]
+    # Filon integration of the piecewise-linear K: error ≈ dt²/12 · K'' = 8e-6 (measured), so 2e-5
+    np.testing.assert_allclose(A, (a ** 2 - w ** 2) / (a ** 2 + w ** 2) ** 2, atol=2e-5)
+    np.testing.assert_allclose(B, 2 * a * w ** 2 / (a ** 2 + w ** 2) ** 2, atol=2e-5)
+    # the sign of the sine relation matters: A(0) − A∞ = +1/a² here (A0 > A∞ for this K)
+    assert A[0] > 0
+    # memory length: |K| < 0.01 · max|K| = 0.01 after the root of (at − 1) e^{−at} = 0.01, t > 2/a
+    T_ref = brentq(lambda x: (a * x - 1) * np.exp(-a * x) - 0.01, 2 / a, 30.0)
+    assert R.memory_length(Kex[:, None, None], t, rtol=0.01) == pytest.approx(T_ref, abs=0.011)
+
+
+def _entry_err(model, db_var, band, i, j):
+    ref = db_var[:, i, j][band]
+    scale = np.sqrt(np.abs(db_var[band][:, i, i]).max() * np.abs(db_var[band][:, j, j]).max())
+    return np.abs(model[:, i, j][band] - ref).max() / scale, np.ptp(model[:, i, j][band] - ref) / scale
+
+
+def test_rm3_added_mass_and_damping_from_K(rm3, rm3_K):
+    om = rm3.omega.values
+    band = (om >= BAND[0]) & (om <= BAND[1])
+    A = R.added_mass_from_irf(rm3_K, A_inf=rm3.added_mass_inf.values, omega=om[band]).values
+    B = R.damping_from_irf(rm3_K, omega=om[band]).values
+    Adb, Bdb = rm3.added_mass.values[band], rm3.radiation_damping.values[band]
+    full = np.ones(band.sum(), bool)
+    # float heave (2), float pitch (4), spar heave (8), float–spar heave (2, 8): measured ≤ 0.17 %
+    # of sqrt(max A_ii max A_jj) over the band; 0.5 % allows the piecewise-linear B and its tail
+    for i, j in ((2, 2), (4, 4), (8, 8), (2, 8), (8, 2)):
+        err, _ = _entry_err(A, Adb, full, i, j)
+        assert err < 0.005, (i, j, err)
+        assert _entry_err(B, Bdb, full, i, j)[0] < 0.005, (i, j)      # measured ≤ 0.11 %
+    # spar pitch (10): A(ω) − A∞ is right (ω-dependent part within 0.5 %; measured 0.08 %) but
+    # WAMIT's A∞ of the spar's pitch/surge is off by a constant 1.03e7 kg m² (2.7 %): a constant
+    # offset over the whole band is the signature of an inconsistent A∞, not of a K(t) error
+    err, spread = _entry_err(A, Adb, full, 10, 10)
+    assert spread < 0.005 and 0.02 < err < 0.03
+    assert _entry_err(B, Bdb, full, 10, 10)[0] < 0.005
+
+
+def test_sphere_added_mass_from_K():
+    path = DATA / "sphere.nc"
+    if not path.exists():
+        pytest.skip("hydro/data/sphere.nc not generated")
+    sp = D.from_capytaine(xr.open_dataset(path))
+    om = sp.omega.values
+    K = R.impulse_response(sp, np.arange(0.0, 40.0, 0.01))
+    band = (om >= 0.2) & (om <= 5.0)
+    A = R.added_mass_from_irf(K, A_inf=sp.added_mass_inf.values, omega=om).values
+    Adb = sp.added_mass.values
+    # heave: measured 0.31 % of max A33 over 0.2–5 rad/s
+    assert _entry_err(A, Adb, band, 2, 2)[0] < 0.01
+    # surge: the damping decays slowly (fitted tail exponent 1.3, CAPYTAINE.md) and is cut at
+    # 6 rad/s, so its tail carries an uncertain near-constant share of A: measured 2.7 % absolute,
+    # 0.7 % in its variation over the band
+    err, spread = _entry_err(A, Adb, band, 0, 0)
+    assert err < 0.04 and spread < 0.01
+
+
+def test_ringing_check(rm3):
+    t = np.arange(0.0, 20.0, 0.02)
+    # plain truncation: float surge (and sway) damping is still 18 % of its peak at 5.2 rad/s → K rings
+    with pytest.warns(D.HydroDatabaseWarning, match=r"rings.*float__(Surge|Sway)"):
+        Kn = R.impulse_response(rm3, t, tail="none")
+    assert Kn.attrs["ringing_ratio"] > 0.05                    # measured 0.062
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", D.HydroDatabaseWarning)
+        Ke = R.impulse_response(rm3, t, tail="extrapolate")
+        Kt = R.impulse_response(rm3, t, tail="taper")
+    assert Ke.attrs["ringing_ratio"] < 0.01 and Kt.attrs["ringing_ratio"] == 0.0
+    # float surge extrapolated with a fitted power law (~ω^-2.3); heave (noise at 5 rad/s) tapered
+    assert 1.5 < float(Ke.tail_exponent[0, 0]) < 3.0 and np.isnan(float(Ke.tail_exponent[2, 2]))
+
+
+def test_memory_length_and_grid_check(rm3, rm3_K):
+    T_K = R.memory_length(rm3_K, rtol=0.01)
+    assert 5.0 < T_K < 40.0                                      # measured 15.1 s
+    assert R.check_grid(rm3, T_K) < 1.0                          # Δω = 0.02 ≪ π/T_K
+    coarse = rm3.isel(omega=slice(0, None, 20))                  # Δω = 0.4 rad/s > π/15 s
+    with pytest.raises(ValueError, match=r"too coarse.*d omega = 0\.4.*pi/T_K"):
+        R.check_grid(coarse, T_K)
+    with pytest.warns(D.HydroDatabaseWarning, match="too coarse"):
+        R.check_grid(coarse, T_K, on_fail="warn")
+
+
+def test_state_space_fit_rm3(rm3, rm3_ss):
+    ss, rep = rm3_ss, rm3_ss.report
+    # brief target: < 2 % over 0.2–2 rad/s against the (symmetrized) database impedance about the
+    # model's A∞ (measured 1.2 %, of which 1.1 % is the change that makes the BEM B passive)
+    assert rep["overall_error"] < 0.02
+    assert max(rep["entry_error"].values()) < 0.05               # measured 2.9 % (spar roll)
+    assert rep["stable"] and np.max(np.linalg.eigvals(ss.A).real) < 0
+    # passivity checked here independently on a denser grid than the fit's own check
+    w = np.concatenate([np.linspace(1e-3, 10.0, 1500), np.geomspace(10.0, 2000.0, 200)])
+    Z = ss.impedance(w)
+    keep = [i for i in range(12) if i % 6 != 5]                  # yaw has no radiation: dropped
+    d = np.sqrt(np.abs(np.diagonal(Z, axis1=1, axis2=2)).max(axis=0))[keep]
+    Zk = Z[:, keep][:, :, keep] / np.outer(d, d)
+    H = 0.5 * (Zk + np.conj(np.swapaxes(Zk, 1, 2)))
+    # ≥ 0 between the enforcement grid points up to 1e-5 of the diagonal scale
+    assert np.linalg.eigvalsh(H)[:, 0].min() > -1e-5
+    assert rep["passive"] and rep["passivity_min_eig_data"] < -0.02   # the BEM data themselves are not
+    # negligible entries dropped (yaw, and e.g. heave–surge below 1 % of the diagonals)
+    assert ("float__Heave", "float__Surge") in rep["dropped"] and len(ss.entries) == 36
+    # the matrices realise the pole–residue model: C (iωI − A)⁻¹ B by a dense solve
+    for om in (0.3, 1.1):
+        Zr = ss.C @ np.linalg.solve(1j * om * np.eye(ss.A.shape[0]) - ss.A, ss.B)
+        np.testing.assert_allclose(Zr, ss.impedance([om])[0], rtol=1e-8, atol=1e-8 * np.abs(Zr).max())
+    # immutable result
+    with pytest.raises(ValueError):
+        ss.A[0, 0] = 1.0
+    with pytest.raises(TypeError):
+        ss.report["overall_error"] = 0.0
+
+
+def test_state_space_impulse_response_matches_K(rm3, rm3_ss, rm3_K):
+    t = rm3_K.time.values
+    K, Kf = rm3_K.values, rm3_ss.impulse_response(t)
+    # relative L2 over 0–80 s; the fit sees K of the symmetrized, passive-projected B and is
+    # weighted on 0.2–2 rad/s, so K(t) near t = 0 (set by high ω) differs most: measured
+    # heave 2.2 %, pitch 4.4 %, float–spar heave 1.1 %
+    for i, j in ((2, 2), (8, 8), (4, 4), (10, 10), (2, 8)):
+        err = np.linalg.norm(Kf[:, i, j] - K[:, i, j]) / np.sqrt(
+            np.linalg.norm(K[:, i, i]) * np.linalg.norm(K[:, j, j]))
+        assert err < 0.08, (i, j, err)
