@@ -6,3 +6,22 @@ returns forces, databases and time series.
 import jax
 
 jax.config.update("jax_enable_x64", True)
+
+# helper B
+from hydro.waves import (  # noqa: E402
+    Jonswap, MeasuredElevation, PiersonMoskowitz, Regular, Spreading, UserSpectrum, WaveComponents,
+    elevation, ramp, wavenumber,
+)
+from hydro.excitation import excitation_coefficients, excitation_dataarray, excitation_time_series  # noqa: E402
+
+# helper C: BEM databases from capytaine (capytaine itself is imported lazily inside them).
+from hydro import bem, geometry  # noqa: E402,F401
+
+# helper A: database schema, WAMIT reader, radiation memory (K(t), Ogilvie), state space.
+from hydro import database, radiation, statespace, wamit  # noqa: E402,F401
+from hydro.database import from_capytaine, open_database, select_bodies, to_netcdf, validate  # noqa: E402,F401
+from hydro.wamit import read_wamit  # noqa: E402,F401
+from hydro.radiation import (  # noqa: E402,F401
+    added_mass_from_irf, check_grid, damping_from_irf, impulse_response, memory_length,
+)
+from hydro.statespace import StateSpaceRadiation, fit_state_space, fitted_impedance  # noqa: E402,F401

@@ -1,0 +1,369 @@
+"""The internal hydrodynamic database: schema, validation, NetCDF round trip, capytaine import.
+
+A database is an ``xarray.Dataset`` with one complex-amplitude convention, capytaine's
+time dependence ``exp(-i omega t)``: a wave of real amplitude a and heading beta has elevation
+``eta = Re[a exp(i(k(x cos beta + y sin beta) - omega t))]`` and causes the excitation force
+``F(t) = Re[a X(omega, beta) exp(-i omega t)]``.
+
+Coordinates
+    omega (omega) rad/s, finite, > 0, ascending; wave_direction (wave_direction) rad, 0 = waves
+    towards +x; body (body) names; influenced_dof / radiating_dof labels ``"<body>__<Mode>"``
+    (Mode in Surge, Sway, Heave, Roll, Pitch, Yaw; 6 per body, bodies in ``body`` order);
+    axis = ["x", "y", "z"].
+Data variables (dims in this order)
+    added_mass (omega, influenced_dof, radiating_dof)        A_ij(omega): force i per accel. of j
+    radiation_damping (omega, influenced_dof, radiating_dof) B_ij(omega)
+    added_mass_inf (influenced_dof, radiating_dof)           A_inf (required)
+    added_mass_zero (influenced_dof, radiating_dof)          A_0 (only where the source gives it)
+    excitation (omega, wave_direction, influenced_dof)       complex, N (N m) per m of amplitude
+    froude_krylov, diffraction (same dims, optional)
+    hydrostatic_stiffness (influenced_dof, radiating_dof)    as the source gives it (attrs say)
+    waterplane_stiffness (influenced_dof, radiating_dof)     only the linear water-plane terms
+    displaced_volume (body) m^3; center_of_buoyancy (body, axis) m; reference_point (body, axis) m
+Attributes
+    rho (kg/m^3), g (m/s^2), water_depth (m, inf = deep), convention = "exp(-i omega t)",
+    source, and provenance strings.
+
+Complex variables are stored in NetCDF with a trailing ``complex`` dimension ["re", "im"]
+(:func:`to_netcdf` / :func:`open_database`).
+"""
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+MODES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
+AXES = ("x", "y", "z")
+CONVENTION = "exp(-i omega t)"
+_SEP = "__"
+
+MATRIX_DIMS = ("influenced_dof", "radiating_dof")
+FREQ_MATRIX_DIMS = ("omega",) + MATRIX_DIMS
+EXCITATION_DIMS = ("omega", "wave_direction", "influenced_dof")
+
+#: variable -> dims; the variables every database must have
+REQUIRED = {
+    "added_mass": FREQ_MATRIX_DIMS,
+    "radiation_damping": FREQ_MATRIX_DIMS,
+    "added_mass_inf": MATRIX_DIMS,
+    "excitation": EXCITATION_DIMS,
+    "waterplane_stiffness": MATRIX_DIMS,
+    "displaced_volume": ("body",),
+    "center_of_buoyancy": ("body", "axis"),
+    "reference_point": ("body", "axis"),
+}
+#: variable -> dims; optional variables, checked when present
+OPTIONAL = {
+    "added_mass_zero": MATRIX_DIMS,
+    "froude_krylov": EXCITATION_DIMS,
+    "diffraction": EXCITATION_DIMS,
+    "hydrostatic_stiffness": MATRIX_DIMS,
+}
+REQUIRED_ATTRS = ("rho", "g", "water_depth")
+
+
+class HydroDatabaseWarning(UserWarning):
+    """A database is usable but suspicious (asymmetric matrices, negative damping, coarse grid)."""
+
+
+def dof_labels(bodies) -> list[str]:
+    """The dof labels ``"<body>__<Mode>"`` of `bodies` in schema order (6 per body)."""
+    return [f"{b}{_SEP}{m}" for b in bodies for m in MODES]
+
+
+def dof_index(db: xr.Dataset) -> dict[str, int]:
+    """Map each dof label of `db` to its position (0 … 6 n_body − 1) along influenced_dof."""
+    return {str(d): k for k, d in enumerate(db["influenced_dof"].values)}
+
+
+def select_bodies(db: xr.Dataset, names) -> xr.Dataset:
+    """The sub-database of the bodies `names` (in that order), cross-body terms among them kept.
+
+    Raises KeyError naming the missing bodies and the available ones.
+    """
+    names = [names] if isinstance(names, str) else list(names)
+    _check_bodies(db, names)
+    dofs = dof_labels(names)
+    out = db.sel(body=names, influenced_dof=dofs)
+    if "radiating_dof" in out.dims:
+        out = out.sel(radiating_dof=dofs)
+    return out
+
+
+def _check_bodies(db, names):
+    available = [str(b) for b in db["body"].values] if "body" in db.coords else []
+    missing = [n for n in names if n not in available]
+    if missing:
+        raise KeyError(f"bodies {missing} are not in the hydro database; available bodies: "
+                       f"{available}. Fix the body names or regenerate the database with them.")
+
+
+# ----------------------------------------------------------------------------------------- validate
+def validate(db: xr.Dataset, bodies=None, *, sym_rtol: float = 0.05,
+             damping_noise: float = 0.02) -> xr.Dataset:
+    """Check `db` against the schema; raise on errors, warn on suspicious data. Returns `db`.
+
+    Errors (ValueError / KeyError): a required variable, dimension, coordinate or attribute is
+    missing or has the wrong dims; omega not finite/positive/ascending; dof labels not
+    ``dof_labels(body)``; ``added_mass_inf`` absent; a body named in `bodies` absent.
+
+    Warnings (:class:`HydroDatabaseWarning`):
+    - asymmetry of A(ω), B(ω), A∞: the largest ``|M_ij − M_ji| / sqrt(d_i d_j)`` over ω, with
+      d_i = max_ω |M_ii(ω)| (a scale with the units of M_ij), above `sym_rtol`;
+    - negative damping: ``B_ii(ω) < −damping_noise · max_ω |B_ii|`` (BEM damping at high ω is
+      noise of about ±1 % of its peak, hence the default 2 %); the frequency and dof are named.
+      Dofs whose damping peak is below 1e-6 of the largest of their kind (translation or
+      rotation), e.g. yaw of an axisymmetric body, are noise and not checked.
+    """
+    if "added_mass_inf" not in db:
+        raise ValueError(
+            "the hydro database has no 'added_mass_inf' (A_inf, required for the Cummins equation). "
+            "Get it from capytaine by solving the radiation problems at omega=numpy.inf as well "
+            "(then hydro.database.from_capytaine), or from WAMIT by including period 0 in the run "
+            "(rows with period 0 in the .1 file).")
+    for name, dims in REQUIRED.items():
+        if name not in db:
+            raise ValueError(f"the hydro database has no variable {name!r} (dims {dims}); "
+                             f"required variables: {sorted(REQUIRED)}.")
+    for name, dims in {**REQUIRED, **OPTIONAL}.items():
+        if name in db and tuple(db[name].dims) != dims:
+            raise ValueError(f"variable {name!r} has dims {tuple(db[name].dims)}; expected {dims} "
+                             f"(transpose it, e.g. db[{name!r}].transpose(*{dims})).")
+    for a in REQUIRED_ATTRS:
+        if a not in db.attrs:
+            raise ValueError(f"the hydro database has no attribute {a!r}; required: {REQUIRED_ATTRS}.")
+    if db.attrs.get("convention", CONVENTION) != CONVENTION:
+        raise ValueError(f"attribute convention = {db.attrs['convention']!r}; the database must use "
+                         f"{CONVENTION!r} (conjugate the complex amplitudes at the reader).")
+    om = np.asarray(db["omega"].values, dtype=float)
+    if not (np.all(np.isfinite(om)) and np.all(om > 0) and np.all(np.diff(om) > 0)):
+        raise ValueError(f"coordinate omega must be finite, > 0 and ascending; got {om[:5]}… "
+                         "(move omega=0 / inf into added_mass_zero / added_mass_inf).")
+    body_names = [str(b) for b in db["body"].values]
+    expected = dof_labels(body_names)
+    for dim in MATRIX_DIMS:
+        got = [str(d) for d in db[dim].values]
+        if got != expected:
+            raise ValueError(f"coordinate {dim} = {got} does not match the bodies {body_names}: "
+                             f"expected {expected}.")
+    if list(db["axis"].values) != list(AXES):
+        raise ValueError(f"coordinate axis = {list(db['axis'].values)}; expected {list(AXES)}.")
+    if not np.iscomplexobj(db["excitation"].values):
+        raise ValueError("variable 'excitation' must be complex; if it was read from NetCDF with a "
+                         "'complex' dim, open it with hydro.database.open_database.")
+    if bodies is not None:
+        _check_bodies(db, [bodies] if isinstance(bodies, str) else list(bodies))
+
+    labels = expected
+    for name in ("added_mass", "radiation_damping", "added_mass_inf"):
+        _warn_asymmetry(name, np.asarray(db[name].values, dtype=float), labels, om, sym_rtol)
+    _warn_negative_damping(np.asarray(db["radiation_damping"].values, dtype=float), labels, om,
+                           damping_noise)
+    return db
+
+
+def _warn_asymmetry(name, M, labels, om, rtol):
+    M3 = M if M.ndim == 3 else M[None]
+    d = np.abs(np.diagonal(M3, axis1=1, axis2=2)).max(axis=0)
+    d = np.maximum(d, 1e-12 * max(d.max(), 1e-300))          # keeps zero diagonals (e.g. yaw) finite
+    asym = np.abs(M3 - np.swapaxes(M3, 1, 2)) / np.sqrt(np.outer(d, d))[None]
+    k, i, j = np.unravel_index(np.argmax(asym), asym.shape)
+    if asym[k, i, j] > rtol:
+        where = f" at omega = {om[k]:.4g} rad/s" if M.ndim == 3 else ""
+        warnings.warn(
+            f"{name} is not symmetric: largest |M_ij - M_ji|/sqrt(d_i d_j) = {asym[k, i, j]:.3g} > "
+            f"{rtol:g} for ({labels[i]}, {labels[j]}){where}: M_ij = {M3[k, i, j]:.6g}, "
+            f"M_ji = {M3[k, j, i]:.6g}. The BEM data may be unconverged there.",
+            HydroDatabaseWarning, stacklevel=3)
+
+
+def _warn_negative_damping(B, labels, om, noise):
+    diag = np.diagonal(B, axis1=1, axis2=2)                  # (omega, dof)
+    peak = np.abs(diag).max(axis=0)
+    # a dof whose damping is negligible beside the others of its kind (translation / rotation),
+    # e.g. yaw of an axisymmetric body (≈ 1e-10 of roll), is pure noise: not checked
+    rot = (np.arange(len(peak)) % 6) >= 3
+    kind_max = np.where(rot, peak[rot].max(initial=0.0), peak[~rot].max(initial=0.0))
+    peak = np.where(peak > 1e-6 * kind_max, peak, 0.0)
+    bad = diag < -noise * peak[None]
+    if np.any(bad & (peak[None] > 0)):
+        rel = np.where(peak > 0, diag / np.where(peak > 0, peak, 1.0), 0.0)
+        k, i = np.unravel_index(np.argmin(rel), rel.shape)
+        warnings.warn(
+            f"radiation_damping diagonal is negative beyond the noise tolerance {noise:g} of its "
+            f"peak: B[{labels[i]}] = {diag[k, i]:.4g} at omega = {om[k]:.4g} rad/s "
+            f"({rel[k, i]:.3g} of its peak {peak[i]:.4g}). Irregular frequency or unconverged "
+            "mesh? Use a lid / finer mesh, or taper the damping before the impulse response.",
+            HydroDatabaseWarning, stacklevel=3)
+
+
+# ------------------------------------------------------------------------------------ NetCDF I/O
+def split_complex(ds: xr.Dataset) -> xr.Dataset:
+    """Complex variables -> real with a trailing ``complex`` dim ["re", "im"]."""
+    out = ds.copy()
+    for name in list(out.data_vars):
+        da = out[name]
+        if np.iscomplexobj(da.values):
+            out[name] = xr.DataArray(np.stack([da.values.real, da.values.imag], axis=-1),
+                                     dims=da.dims + ("complex",), attrs=da.attrs)
+    if any("complex" in out[v].dims for v in out.data_vars):
+        out = out.assign_coords(complex=["re", "im"])
+    return out
+
+
+def merge_complex(ds: xr.Dataset) -> xr.Dataset:
+    """Inverse of :func:`split_complex`; also accepts capytaine's leading ``complex`` dim."""
+    if "complex" not in ds.dims:
+        return ds
+    out = ds.copy()
+    for name in list(out.data_vars):
+        da = out[name]
+        if "complex" in da.dims:
+            dims = tuple(d for d in da.dims if d != "complex")
+            val = da.sel(complex="re").transpose(*dims).values + 1j * da.sel(complex="im").transpose(*dims).values
+            out[name] = xr.DataArray(val, dims=dims, attrs=da.attrs)
+    return out.drop_vars("complex")
+
+
+def to_netcdf(db: xr.Dataset, path) -> Path:
+    """Write `db` to NetCDF at `path` (complex values split into a trailing ``complex`` dim)."""
+    path = Path(path)
+    ds = split_complex(db)
+    for c in ("body", "influenced_dof", "radiating_dof", "axis"):
+        if c in ds.coords:
+            ds = ds.assign_coords({c: np.asarray(ds[c].values).astype(str)})
+    ds.attrs = {k: (str(v) if isinstance(v, (bool, type(None))) else v) for k, v in ds.attrs.items()}
+    ds.to_netcdf(path)
+    return path
+
+
+def open_database(path) -> xr.Dataset:
+    """Read a database written by :func:`to_netcdf` (loaded into memory, complex rejoined)."""
+    with xr.open_dataset(path) as ds:
+        ds = ds.load()
+    ds = merge_complex(ds)
+    for c in ("body", "influenced_dof", "radiating_dof", "axis"):
+        if c in ds.coords:
+            ds = ds.assign_coords({c: np.asarray(ds[c].values).astype(str)})
+    return ds
+
+
+# ---------------------------------------------------------------------------------- capytaine
+def from_capytaine(ds: xr.Dataset, body_names=None) -> xr.Dataset:
+    """Convert a capytaine 3 dataset to the internal schema.
+
+    `ds` as produced by capytaine's ``BEMSolver.fill_dataset`` / ``cpt.assemble_dataset``, or read
+    from a ``cpt.export_dataset`` NetCDF (the split ``complex`` dim is rejoined here). Steps:
+    transpose to (omega, influenced_dof, radiating_dof); omega = inf → ``added_mass_inf``, omega = 0
+    → ``added_mass_zero``; ``excitation = Froude_Krylov_force + diffraction_force``; the rotation
+    centres → ``reference_point``; ``displaced_volume``, ``center_of_buoyancy``,
+    ``waterplane_stiffness``, ``hydrostatic_stiffness`` are carried when present (the project's BEM
+    generator ``mfm hydro`` writes them with the schema names). A single body's bare dof names
+    ("Heave") get the body name (capytaine's ``body`` coordinate, else `body_names`, else "body0").
+    """
+    ds = merge_complex(ds)
+    freq_dim = next((d for d in ("omega", "freq", "period", "wavenumber", "wavelength")
+                     if d in ds.dims), None)
+    if freq_dim is None:
+        raise ValueError(f"the capytaine dataset has no frequency dimension; dims: {dict(ds.sizes)}")
+    if freq_dim != "omega":
+        ds = ds.swap_dims({freq_dim: "omega"})
+    for name in ("added_mass", "radiation_damping"):
+        if name not in ds:
+            raise ValueError(f"the capytaine dataset has no {name!r}: solve the radiation problems.")
+    if "waterplane_stiffness" not in ds:
+        raise ValueError("the capytaine dataset has no 'waterplane_stiffness' (the linear water-plane "
+                         "part of the hydrostatics, which mfm needs): regenerate the database with "
+                         "`mfm hydro`, which adds it.")
+
+    # body names and dof labels
+    dofs_in = [str(d) for d in ds["influenced_dof"].values]
+    if all(_SEP in d for d in dofs_in):
+        names = list(dict.fromkeys(d.split(_SEP)[0] for d in dofs_in))
+        if body_names is not None:
+            raise ValueError("body_names is only for single-body capytaine datasets whose dofs have "
+                             f"no body prefix; this one has bodies {names}.")
+        rename = {d: d for d in dofs_in}
+    else:
+        if body_names is not None:
+            names = [body_names] if isinstance(body_names, str) else list(body_names)
+        elif "body" in ds.coords and ds["body"].ndim == 0:
+            names = [str(ds["body"].values)]
+        else:
+            names = ["body0"]
+        if len(names) != 1:
+            raise ValueError(f"body_names={body_names!r}: a single-body dataset needs one name.")
+        rename = {d: f"{names[0]}{_SEP}{d}" for d in dofs_in}
+    labels = dof_labels(names)
+    have = set(rename.values())
+    missing = [d for d in labels if d not in have]
+    if missing:
+        raise ValueError(f"the capytaine dataset lacks the dofs {missing}; the schema needs all 6 rigid "
+                         "modes per body: build the bodies with cpt.rigid_body_dofs(rotation_center=…).")
+
+    def mat(da):
+        da = da.assign_coords(influenced_dof=[rename[str(d)] for d in da["influenced_dof"].values],
+                              radiating_dof=[rename[str(d)] for d in da["radiating_dof"].values])
+        dims = ("omega",) * ("omega" in da.dims) + MATRIX_DIMS
+        return da.sel(influenced_dof=labels, radiating_dof=labels).transpose(*dims)
+
+    def vec(da):
+        da = da.assign_coords(influenced_dof=[rename[str(d)] for d in da["influenced_dof"].values])
+        return da.sel(influenced_dof=labels).transpose("omega", "wave_direction", "influenced_dof")
+
+    om = np.asarray(ds["omega"].values, dtype=float)
+    finite = np.isfinite(om) & (om > 0)
+    if not np.any(np.isinf(om)):
+        raise ValueError("the capytaine dataset has no omega = inf: add numpy.inf to the omega values "
+                         "of the radiation problems to get added_mass_inf (required).")
+    order = np.argsort(om[finite])
+    ofin = om[finite][order]
+
+    def freq(da):
+        return da.isel(omega=np.flatnonzero(finite)[order]).assign_coords(omega=ofin)
+
+    out = xr.Dataset(coords={"omega": ofin, "body": names, "influenced_dof": labels,
+                             "radiating_dof": labels, "axis": list(AXES)})
+    drop = [c for c in ("freq", "period", "wavenumber", "wavelength", "g", "rho", "water_depth",
+                        "forward_speed", "body", "space_coordinate", "rotation_center")]
+    A = mat(ds["added_mass"]).drop_vars(drop, errors="ignore")
+    B = mat(ds["radiation_damping"]).drop_vars(drop, errors="ignore")
+    out["added_mass"] = freq(A).astype(float)
+    out["radiation_damping"] = freq(B).astype(float)
+    out["added_mass_inf"] = A.isel(omega=int(np.flatnonzero(np.isinf(om))[0])).drop_vars("omega").astype(float)
+    if np.any(om == 0):
+        out["added_mass_zero"] = A.isel(omega=int(np.flatnonzero(om == 0)[0])).drop_vars("omega").astype(float)
+    if "Froude_Krylov_force" in ds and "diffraction_force" in ds:
+        fk = freq(vec(ds["Froude_Krylov_force"]).drop_vars(drop, errors="ignore")).astype(complex)
+        df = freq(vec(ds["diffraction_force"]).drop_vars(drop, errors="ignore")).astype(complex)
+        out["froude_krylov"], out["diffraction"] = fk, df
+        out["excitation"] = fk + df
+    for name in ("waterplane_stiffness", "hydrostatic_stiffness"):
+        if name in ds:
+            out[name] = mat(ds[name]).drop_vars(drop, errors="ignore").astype(float)
+            out[name].attrs.update(ds[name].attrs)
+    for name in ("displaced_volume", "center_of_buoyancy", "reference_point"):
+        if name in ds:
+            da = ds[name]
+            if "body" not in da.dims:
+                if len(names) != 1:
+                    continue
+                da = da.drop_vars("body", errors="ignore").expand_dims(body=names)
+            if "space_coordinate" in da.dims:
+                da = da.rename(space_coordinate="axis")
+            out[name] = da.drop_vars([c for c in da.coords if c not in da.dims]).assign_coords(
+                body=names, **({"axis": list(AXES)} if "axis" in da.dims else {}))
+    if "reference_point" not in out and "rotation_center" in ds.coords:
+        rc = np.asarray(ds["rotation_center"].values, dtype=float).reshape(len(names), 3)
+        out["reference_point"] = (("body", "axis"), rc)
+
+    attrs = {k: v for k, v in ds.attrs.items() if isinstance(v, (str, int, float, np.number))}
+    for a in ("rho", "g", "water_depth"):
+        if a in ds.coords and ds[a].size == 1:
+            attrs[a] = float(ds[a].values)
+    attrs.update(convention=CONVENTION, source=attrs.get("source", "capytaine"))
+    out.attrs = attrs
+    return out

@@ -1,0 +1,282 @@
+"""Radiation memory: impulse response K(t), Ogilvie's relations, memory length, grid check.
+
+Cummins' radiation force is ``F_r(t) = −A_inf ξ̈(t) − ∫_0^t K(τ) ξ̇(t − τ) dτ`` with
+
+    K(t) = (2/π) ∫_0^∞ B(ω) cos(ωt) dω                                   (1)
+
+and Ogilvie's relations back to the frequency domain (checked: a convolution with ξ̇ = e^{iωt}
+gives K̂(ω) = ∫K e^{−iωt}dt, and −[iωA∞ + K̂] must equal −[iωA(ω) + B(ω)]):
+
+    A(ω) = A_inf − (1/ω) ∫_0^∞ K(t) sin(ωt) dt,   B(ω) = ∫_0^∞ K(t) cos(ωt) dt     (2)
+
+so that the radiation impedance (Laplace transform of K at s = iω) is
+``K(iω) = B(ω) + iω (A(ω) − A_inf)``. Example: K = e^{−at} gives B = a/(a² + ω²) ≥ 0 and
+A = A∞ − 1/(a² + ω²).
+
+All integrals treat the sampled function as piecewise linear and integrate it against the
+cosine/sine exactly (Filon-trapezoid), so no sampling of the oscillation is needed: K(t) at large
+t and A(ω) at large ω are as accurate as the linear interpolation of B(ω) or K(t) itself.
+Units: K in N/(m/s)/s = N s/m / s (translation), ω rad/s, t s; dims (time, influenced_dof,
+radiating_dof).
+"""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import xarray as xr
+
+from .database import HydroDatabaseWarning
+
+
+# ------------------------------------------------------------------------------ Filon weights
+def filon_weights(x, y) -> np.ndarray:
+    """Complex weights W (len(y), len(x)) with ``W @ f ≈ ∫_{x0}^{xN} f(x) e^{i y x} dx``.
+
+    Exact for f linear between the nodes x (ascending). Per segment [a, b] (h = b − a,
+    midpoint c): ``∫ f e^{iyx} = [f_b e^{iyb} − f_a e^{iya} − (f_b − f_a) e^{iyc} S(yh/2)]/(iy)``,
+    S(z) = sin z / z. Interior node weights telescope to ``(E_k − E_{k−1})/(iy)`` with
+    E_k = e^{iy c_k} S(y h_k/2). Points with |y| x_span < 1e-6 use the trapezoid rule (error
+    O((y x)²) there).
+    """
+    x = np.asarray(x, dtype=float)
+    y = np.atleast_1d(np.asarray(y, dtype=float))
+    h = np.diff(x)
+    c = 0.5 * (x[:-1] + x[1:])
+    trap = np.zeros(len(x))
+    trap[:-1] += h / 2
+    trap[1:] += h / 2
+    W = np.empty((len(y), len(x)), dtype=complex)
+    small = np.abs(y) * max(np.abs(x).max(), 1e-300) < 1e-6
+    W[small] = trap
+    ys = y[~small][:, None]
+    if ys.size:
+        E = np.exp(1j * ys * c) * np.sinc(ys * h / (2 * np.pi))
+        iy = 1j * ys
+        Wb = np.empty((ys.shape[0], len(x)), dtype=complex)
+        Wb[:, 0] = (E[:, 0] - np.exp(1j * ys[:, 0] * x[0])) / iy[:, 0]
+        Wb[:, 1:-1] = (E[:, 1:] - E[:, :-1]) / iy
+        Wb[:, -1] = (np.exp(1j * ys[:, 0] * x[-1]) - E[:, -1]) / iy[:, 0]
+        W[~small] = Wb
+    return W
+
+
+# ------------------------------------------------------------------------- impulse response
+def _tail_fit(omega, B, fit_fraction, noise):
+    """Per entry power law B ≈ c ω^(−n) on the top `fit_fraction` of the band.
+
+    Returns (c, n, ok): ok where the window has one sign, |B| > noise · peak everywhere in it
+    (below that BEM damping is noise) and 1 < n < 20 (an integrable tail).
+    """
+    nw, ne = B.shape
+    win = omega >= omega[-1] * (1.0 - fit_fraction)
+    Bw = B[win]
+    peak = np.abs(B).max(axis=0)
+    same_sign = np.all(Bw > 0, axis=0) | np.all(Bw < 0, axis=0)
+    above = np.all(np.abs(Bw) > noise * np.where(peak > 0, peak, np.inf), axis=0)
+    lx = np.log(omega[win])
+    ly = np.log(np.where(np.abs(Bw) > 0, np.abs(Bw), 1e-300))
+    X = np.stack([np.ones_like(lx), -lx], axis=1)
+    coef, *_ = np.linalg.lstsq(X, ly, rcond=None)
+    n = coef[1]
+    c = np.sign(Bw[-1]) * np.exp(coef[0])
+    resid = np.sqrt(np.mean((X @ coef - ly) ** 2, axis=0))
+    ok = same_sign & above & (n > 1.0) & (n < 20.0) & (resid < 0.2)
+    return c, n, ok
+
+
+def _taper(omega, fraction):
+    w0 = omega[-1] * (1.0 - fraction)
+    u = np.clip((omega - w0) / max(omega[-1] - w0, 1e-300), 0.0, 1.0)
+    return 0.5 * (1.0 + np.cos(np.pi * u))
+
+
+def impulse_response(db: xr.Dataset, t, *, tail: str = "extrapolate", fit_fraction: float = 0.25,
+                     taper_fraction: float = 0.1, noise: float = 0.005, extend: float = 1e3,
+                     n_extend: int = 300, ringing_tol: float = 0.01) -> xr.DataArray:
+    """Radiation impulse response K(t) (time, influenced_dof, radiating_dof) from eq. (1).
+
+    db: database with radiation_damping (omega, influenced_dof, radiating_dof) [N s/m …].
+    t: times (s), ≥ 0. Between 0 and the first ω, B is interpolated linearly to B(0) = 0.
+    tail — how B beyond ω_max (the last BEM frequency) is handled:
+      "extrapolate": per entry, fit B ≈ c ω^(−n) on the top `fit_fraction` of the band and
+          integrate it to `extend`·ω_max on `n_extend` geometric nodes (remainder
+          ∝ extend^{1−n}, < 0.1 % for n ≥ 2). Entries whose top band is noise (sign change, or
+          |B| < `noise`·peak: e.g. heave, which falls as ω^−7) or whose fit is not integrable
+          (n ≤ 1), and entries below 1e-3 of sqrt(peak_ii peak_jj), are tapered instead. The exponents are the coordinate ``tail_exponent``
+          (NaN = tapered).
+      "taper": B·w(ω), w a half-cosine from 1 at (1 − taper_fraction)·ω_max to 0 at ω_max.
+      "none": plain truncation at ω_max (for comparison; it rings).
+    Ringing check: with piecewise-linear B ending at value B_end, eq. (1) contains exactly the
+    truncation term (2/π) B_end sin(ω_end t)/t. attrs["ringing_ratio"] is its amplitude at one
+    cut-off period t = 2π/ω_end relative to max_t |K_ij|, the largest over the entries; a
+    warning is issued above `ringing_tol`.
+    """
+    if tail not in ("extrapolate", "taper", "none"):
+        raise ValueError(f"tail={tail!r}; accepted: 'extrapolate', 'taper', 'none'.")
+    t = np.asarray(t, dtype=float)
+    if t.ndim != 1 or np.any(t < 0):
+        raise ValueError("t must be a 1-D array of times ≥ 0 (s).")
+    Bda = db["radiation_damping"].transpose("omega", "influenced_dof", "radiating_dof")
+    om = np.asarray(Bda["omega"].values, dtype=float)
+    nd = Bda.shape[1]
+    B = np.asarray(Bda.values, dtype=float).reshape(len(om), -1)
+    peak = np.abs(B).max(axis=0)
+    n_exp = np.full(B.shape[1], np.nan)
+
+    nodes = np.concatenate([[0.0], om])
+    Bn = np.vstack([np.zeros((1, B.shape[1])), B])
+    if tail == "none":
+        B_end = B[-1]
+        w_end = om[-1]
+    elif tail == "taper":
+        Bn = Bn * _taper(nodes, taper_fraction)[:, None]
+        B_end = np.zeros(B.shape[1])
+        w_end = om[-1]
+    else:
+        c, n, ok = _tail_fit(om, B, fit_fraction, noise)
+        # entries negligible beside their diagonals (< 1e-3, e.g. yaw noise) are tapered
+        dpk = np.diagonal(peak.reshape(nd, nd))
+        ok &= peak > 1e-3 * np.sqrt(np.outer(dpk, dpk)).ravel()
+        taper = _taper(nodes, taper_fraction)[:, None]
+        Bn = np.where(ok[None], Bn, Bn * taper)
+        ext = om[-1] * np.geomspace(1.0, extend, n_extend + 1)[1:]
+        # the fitted exponent continues B from its last BEM value (continuous at ω_max)
+        Bext = np.where(ok[None], B[-1][None] * (ext[:, None] / om[-1]) ** (-np.where(ok, n, 2.0))[None],
+                        0.0)
+        nodes = np.concatenate([nodes, ext])
+        Bn = np.vstack([Bn, Bext])
+        n_exp = np.where(ok, n, np.nan)
+        B_end = Bext[-1]
+        w_end = ext[-1]
+    W = filon_weights(nodes, t).real
+    K = (2.0 / np.pi) * (W @ Bn)
+    Kpk = np.abs(K).max(axis=0)
+    ring = (2.0 / np.pi) * np.abs(B_end) / (2 * np.pi / w_end) / np.where(Kpk > 0, Kpk, np.inf)
+    relevant = peak > 1e-3 * peak.max()
+    ringing = float(np.max(ring[relevant], initial=0.0))
+    labels = [str(d) for d in Bda["influenced_dof"].values]
+    rlabels = [str(d) for d in Bda["radiating_dof"].values]
+    out = xr.DataArray(K.reshape(len(t), nd, nd), dims=("time", "influenced_dof", "radiating_dof"),
+                       coords={"time": t, "influenced_dof": labels, "radiating_dof": rlabels},
+                       name="impulse_response")
+    out.coords["tail_exponent"] = (("influenced_dof", "radiating_dof"), n_exp.reshape(nd, nd))
+    out.attrs.update(tail=tail, omega_max=float(om[-1]), ringing_ratio=ringing,
+                     units="N s/m per s (translation); N m s per s (rotation); per dof pair",
+                     equation="K(t) = (2/pi) int_0^inf B(omega) cos(omega t) d omega")
+    if ringing > ringing_tol:
+        k = int(np.argmax(np.where(relevant, ring, 0)))
+        warnings.warn(
+            f"K(t) rings from the truncation of B at omega = {w_end:.4g} rad/s: ringing amplitude "
+            f"{ringing:.3g} of max|K| at t = 2 pi/omega_max for ({labels[k // nd]}, {rlabels[k % nd]}) "
+            f"(B_end = {B_end[k]:.4g}). Use tail='extrapolate' or 'taper', or compute B to higher "
+            "omega.", HydroDatabaseWarning, stacklevel=2)
+    return out
+
+
+# --------------------------------------------------------------------------- Ogilvie's relations
+def _as_array(K, t):
+    if isinstance(K, xr.DataArray):
+        tt = np.asarray(K["time"].values if t is None else t, dtype=float)
+        return np.asarray(K.transpose("time", ...).values, dtype=float), tt, K
+    if t is None:
+        raise ValueError("t is required when K is a plain array (time first).")
+    return np.asarray(K, dtype=float), np.asarray(t, dtype=float), None
+
+
+def _wrap(val, omega, Kda):
+    if Kda is None:
+        return val
+    rest = [d for d in Kda.dims if d != "time"]
+    return xr.DataArray(val, dims=("omega", *rest),
+                        coords={"omega": omega, **{d: Kda[d].values for d in rest}})
+
+
+def added_mass_from_irf(K, t=None, A_inf=None, omega=None):
+    """A(ω) = A_inf − (1/ω) ∫_0^{t_end} K(t) sin(ωt) dt (eq. 2); ω > 0 (rad/s).
+
+    K: DataArray (time, …) or array (n_t, …); A_inf broadcastable to K's trailing shape.
+    Returns (n_ω, …) (a DataArray with dim omega when K is one).
+    """
+    if A_inf is None or omega is None:
+        raise ValueError("added_mass_from_irf needs A_inf and omega.")
+    Karr, tt, Kda = _as_array(K, t)
+    omega = np.asarray(omega, dtype=float)
+    if np.any(omega <= 0):
+        raise ValueError("omega must be > 0 (A(0) is the limit; use a small omega).")
+    S = filon_weights(tt, omega).imag
+    integ = np.tensordot(S, Karr, axes=(1, 0))
+    A = np.asarray(A_inf, dtype=float)[None] - integ / omega.reshape((-1,) + (1,) * (integ.ndim - 1))
+    return _wrap(A, omega, Kda)
+
+
+def damping_from_irf(K, t=None, omega=None):
+    """B(ω) = ∫_0^{t_end} K(t) cos(ωt) dt (eq. 2); returns (n_ω, …)."""
+    if omega is None:
+        raise ValueError("damping_from_irf needs omega.")
+    Karr, tt, Kda = _as_array(K, t)
+    omega = np.asarray(omega, dtype=float)
+    Cw = filon_weights(tt, omega).real
+    return _wrap(np.tensordot(Cw, Karr, axes=(1, 0)), omega, Kda)
+
+
+# ------------------------------------------------------------------------------ memory length
+def _relevant_scale(Kmax_diag, nd):
+    """sqrt(peak_ii peak_jj) per entry; dofs negligible beside their kind (1e-6) are excluded."""
+    rot = (np.arange(nd) % 6) >= 3 if nd % 6 == 0 else np.zeros(nd, bool)
+    kind_max = np.where(rot, Kmax_diag[rot].max(initial=0.0), Kmax_diag[~rot].max(initial=0.0))
+    keep = Kmax_diag > 1e-6 * kind_max
+    s = np.sqrt(np.outer(Kmax_diag, Kmax_diag))
+    return np.where(np.outer(keep, keep), s, np.inf)
+
+
+def memory_length(K, t=None, *, rtol: float = 0.01) -> float:
+    """T_K (s): the time after which |K_ij(t)| < rtol · sqrt(max|K_ii| max|K_jj|) for all entries.
+
+    The scale of entry (i, j) is that of its diagonals, so a weak coupling is judged against the
+    motions it couples, not against itself. Dofs whose K is below 1e-6 of the largest of their kind
+    (translation / rotation; e.g. yaw of an axisymmetric body, pure noise) are ignored. Warns
+    if K has not decayed within the given t (then T_K = t_end).
+    """
+    Karr, tt, _ = _as_array(K, t)
+    nd = Karr.shape[1]
+    scale = _relevant_scale(np.abs(np.diagonal(Karr, axis1=1, axis2=2)).max(axis=0), nd)
+    above = np.abs(Karr) > rtol * scale[None]
+    any_above = above.reshape(len(tt), -1).any(axis=1)
+    if not any_above.any():
+        return 0.0
+    last = int(np.flatnonzero(any_above)[-1])
+    if last == len(tt) - 1:
+        warnings.warn(f"K(t) has not decayed below rtol={rtol:g} of its scale by t = {tt[-1]:.4g} s: "
+                      "extend t to find the memory length.", HydroDatabaseWarning, stacklevel=2)
+        return float(tt[-1])
+    return float(tt[last + 1])
+
+
+def check_grid(db: xr.Dataset, memory_length: float, *, on_fail: str = "raise") -> float:
+    """Check that the ω grid resolves a memory of length T_K = `memory_length` (s).
+
+    Criterion: max Δω ≤ π / T_K. Derivation: sampling B(ω) at spacing Δω makes the cosine sum
+    (1) periodic in t with period 2π/Δω (Poisson summation: the computed K is
+    Σ_n K_even(t − 2πn/Δω)). K on [0, T_K] is free of its first alias K(2π/Δω − t) only if
+    2π/Δω − T_K ≥ T_K, i.e. Δω ≤ π/T_K. (Piecewise-linear integration damps the aliases but does
+    not remove the need to resolve B's features of width ~1/T_K.)
+    Returns the ratio max Δω · T_K / π (≤ 1 passes). on_fail: "raise" (ValueError) or "warn".
+    """
+    if on_fail not in ("raise", "warn"):
+        raise ValueError(f"on_fail={on_fail!r}; accepted: 'raise', 'warn'.")
+    om = np.asarray(db["omega"].values, dtype=float)
+    if len(om) < 2:
+        raise ValueError("the database has fewer than 2 frequencies: no impulse response possible.")
+    d = np.diff(om)
+    k = int(np.argmax(d))
+    ratio = float(d[k] * memory_length / np.pi)
+    if ratio > 1.0:
+        msg = (f"the omega grid is too coarse for a memory length T_K = {memory_length:.4g} s: "
+               f"d omega = {d[k]:.4g} rad/s between {om[k]:.4g} and {om[k + 1]:.4g} rad/s exceeds "
+               f"pi/T_K = {np.pi / memory_length:.4g} rad/s. Recompute the database with a step ≤ "
+               f"{np.pi / memory_length:.4g} rad/s (or accept a shorter memory).")
+        if on_fail == "raise":
+            raise ValueError(msg)
+        warnings.warn(msg, HydroDatabaseWarning, stacklevel=2)
+    return ratio

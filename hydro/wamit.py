@@ -1,0 +1,275 @@
+"""Reader of WAMIT output (.1, .3, .hst, .out) into the internal hydro database.
+
+Non-dimensionalisation (WAMIT user manual, "Definitions of nondimensional quantities"), with
+L = ULEN and k, m set by the modes (translations 1–3, rotations 4–6 of each body):
+
+    A_ij = rho L^k Ā_ij,        B_ij = rho omega L^k B̄_ij,   k = 3, 4, 5 for i, j both
+                                                              translations / mixed / both rotations
+    X_i  = rho g a L^m X̄_i,     m = 2 (force), 3 (moment)   (a: wave amplitude, here 1 m)
+    C_ij = rho g L^k C̄_ij,      k = 2, 3, 4 for 0, 1, 2 rotational modes among (i, j)
+
+Period conventions of the .1 file: period −1 is the zero-frequency limit (A_0, "Wave period =
+infinite" in the .out), period 0 the infinite-frequency limit (A_inf, "Wave period = zero"); the
+first column is the wave period in seconds (IPERIN = 1, the default; `first_column="omega"`
+reads files written with radian frequencies instead).
+
+Phase convention. WAMIT uses time dependence e^{+i omega t}: F(t) = Re[X e^{+i omega t}] for the
+incident wave whose elevation at the origin is Re[a e^{+i omega t}] (crest at the origin at
+t = 0). The internal convention is e^{−i omega t} with the same wave (eta at the origin
+Re[a e^{−i omega t}] = a cos(omega t)), so X_internal = conj(X_WAMIT): then
+Re[conj(X) e^{−i omega t}] = Re[X e^{+i omega t}], the same force history. Check on RM3: the surge
+force of a long wave leads the elevation by +90° in WAMIT (fluid acceleration ∝ d/dt cos) and
+lags by −90° after conjugation, as capytaine gives. A and B are real and need no conversion.
+
+Hydrostatics. WAMIT's .hst is the "hydrostatic and gravitational restoring" matrix about the body
+origin (XBODY, YBODY, ZBODY), coordinates of the .out relative to that origin (checked on RM3: the
+spar's centre of buoyancy is reported at z = +5.686 m, above its origin 21.29 m below the water):
+
+    C33 = rho g ∫n3 dS, C34 = rho g ∫y n3 dS, C35 = −rho g ∫x n3 dS, C45 = −rho g ∫xy n3 dS
+    C44 = rho g ∫y² n3 dS + rho g V z_B − m g z_G,  C55 = rho g ∫x² n3 dS + rho g V z_B − m g z_G
+    C46 = −rho g V x_B + m g x_G,                   C56 = −rho g V y_B + m g y_G
+
+with m = rho V (WAMIT's default for a freely floating body). ``hydrostatic_stiffness`` keeps the
+.hst as given (attrs say so). ``waterplane_stiffness`` removes rho g V (z_B − z_G) from C44 and
+C55, drops C46/C56 (and any other entry) and keeps only the water-plane terms 33, 34/43, 35/53,
+44, 55, 45/54. For rm3.out the centres of gravity are at the body origins (Z_G = 0), so the
+m g z_G part is zero there: C44_hst(float) = 7347.0 = ∫y² dA + V z_B = 7762.7 − 725.83 · 0.5727
+(ρg = 1 units), i.e. only the buoyancy term rho g V z_B is removed.
+
+Multi-body modes are numbered i = 6 (n − 1) + mode for body n; generalised modes (NEWMDS) are not
+supported. Bodies get the names `body_names` or "body0", "body1", …; RM3: ["float", "spar"].
+"""
+from __future__ import annotations
+
+import re
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from .database import AXES, CONVENTION, dof_labels
+
+_NUM = r"[-+]?\d*\.?\d+(?:[EeDd][-+]?\d+)?"
+
+
+def _paths(stem_or_paths):
+    if isinstance(stem_or_paths, dict):
+        paths = {k.lstrip("."): Path(v) for k, v in stem_or_paths.items()}
+    else:
+        stem = Path(stem_or_paths)
+        if stem.suffix in (".1", ".3", ".hst", ".out"):
+            stem = stem.with_suffix("")
+        paths = {ext: stem.with_name(stem.name + "." + ext) for ext in ("1", "3", "hst", "out")}
+    for ext in ("1", "out"):
+        if ext not in paths or not paths[ext].is_file():
+            raise FileNotFoundError(f"WAMIT file .{ext} not found ({paths.get(ext)}); read_wamit needs "
+                                    "the .1 (added mass, damping) and .out (bodies, units) files.")
+    return {k: v for k, v in paths.items() if v.is_file()}
+
+
+def _rows(path, ncol_min):
+    rows = []
+    with open(path) as f:
+        for line in f:
+            parts = line.split()
+            try:
+                vals = [float(p.replace("D", "E").replace("d", "e")) for p in parts]
+            except ValueError:
+                continue                                   # header lines
+            if len(vals) >= ncol_min:
+                rows.append(vals)
+    return rows
+
+
+def parse_out(path) -> dict:
+    """Gravity, ULEN, water depth, headings and per-body XBODY, volumes, centres from a WAMIT .out.
+
+    Returns dict with keys g, ulen, water_depth (inf for "infinite"), rho (None unless stated),
+    and bodies: list of dicts (xbody (4,), volumes (3,), cob (3,), cog (3,)); centres relative to
+    the body origin.
+    """
+    text = Path(path).read_text(errors="replace")
+    out = {"rho": None}
+    m = re.search(rf"Gravity:\s*({_NUM})", text)
+    out["g"] = float(m.group(1)) if m else None
+    m = re.search(rf"Length scale:\s*({_NUM})", text)
+    out["ulen"] = float(m.group(1)) if m else 1.0
+    m = re.search(rf"Water depth:\s*(infinite|{_NUM})", text)
+    out["water_depth"] = float("inf") if (m is None or m.group(1) == "infinite") else float(m.group(1))
+    m = re.search(rf"(?:density|RHO)\s*[:=]\s*({_NUM})", text, re.IGNORECASE)
+    if m:
+        out["rho"] = float(m.group(1))
+    bodies = []
+    for blk in re.split(r"Body number:\s*N=\s*", text)[1:]:
+        blk = blk.split("Output from  WAMIT")[0]
+
+        def vec(label, n):
+            mm = re.search(label + r"[^:\n]*:?\s*" + r"\s+".join([f"({_NUM})"] * n), blk)
+            if mm is None:
+                raise ValueError(f"{path}: no '{label}' line in a body block of the .out")
+            return np.array([float(x) for x in mm.groups()])
+
+        xb = re.search(rf"XBODY\s*=\s*({_NUM})\s*YBODY\s*=\s*({_NUM})\s*ZBODY\s*=\s*({_NUM})"
+                       rf"\s*PHIBODY\s*=\s*({_NUM})", blk)
+        if xb is None:
+            raise ValueError(f"{path}: no XBODY line in a body block of the .out")
+        bodies.append({"xbody": np.array([float(x) for x in xb.groups()]),
+                       "volumes": vec(r"Volumes \(VOLX,VOLY,VOLZ\)", 3),
+                       "cob": vec(r"Center of Buoyancy \(Xb,Yb,Zb\)", 3),
+                       "cog": vec(r"Center of Gravity\s+\(Xg,Yg,Zg\)", 3)})
+    if not bodies:
+        raise ValueError(f"{path}: no 'Body number: N=' blocks; is this a WAMIT .out file?")
+    out["bodies"] = bodies
+    return out
+
+
+def _k_matrix(n):
+    """Exponent k of L for A/B (3 + number of rotational modes among i, j), n dofs."""
+    rot = (np.arange(n) % 6) >= 3
+    return 3 + rot[:, None].astype(int) + rot[None, :].astype(int)
+
+
+def read_wamit(stem_or_paths, rho: float = 1000.0, g: float = 9.81, body_names=None, *,
+               first_column: str = "period") -> xr.Dataset:
+    """Read WAMIT .1/.3/.hst/.out files into the internal database (see module docstring).
+
+    stem_or_paths: path stem ("…/rm3") or one of the files, or a dict {"1": path, "3": …,
+    "hst": …, "out": …}. .3 and .hst are optional (then no excitation / stiffness variables).
+    rho (kg/m³) is used unless the .out states it; g (m/s²) is taken from the .out when given
+    there (a mismatch with `g` raises). body_names: one name per body, default "body0", ….
+    """
+    if first_column not in ("period", "omega"):
+        raise ValueError(f"first_column={first_column!r}; accepted: 'period', 'omega'.")
+    paths = _paths(stem_or_paths)
+    info = parse_out(paths["out"])
+    if info["rho"] is not None:
+        rho = info["rho"]
+    if info["g"] is not None:
+        if not np.isclose(info["g"], g, rtol=1e-4):
+            raise ValueError(f"g={g} differs from the gravity {info['g']} stated in {paths['out']}: "
+                             "the nondimensional data must be scaled with the run's g; pass g="
+                             f"{info['g']}.")
+        g = info["g"]
+    L = info["ulen"]
+    nb = len(info["bodies"])
+    names = [f"body{k}" for k in range(nb)] if body_names is None else list(body_names)
+    if len(names) != nb:
+        raise ValueError(f"body_names={body_names!r} has {len(names)} names but {paths['out']} has "
+                         f"{nb} bodies.")
+    n = 6 * nb
+    labels = dof_labels(names)
+    k_ab = _k_matrix(n)
+
+    # ---- .1: added mass and damping
+    rows = np.array([r[:5] + [np.nan] * (5 - len(r[:5])) for r in _rows(paths["1"], 4)])
+    col0, ii, jj = rows[:, 0], rows[:, 1].astype(int) - 1, rows[:, 2].astype(int) - 1
+    if ii.max() >= n or jj.max() >= n:
+        raise ValueError(f"{paths['1']}: mode index {max(ii.max(), jj.max()) + 1} > 6 × {nb} bodies; "
+                         "generalised modes are not supported.")
+
+    def matrix_at(mask, col):
+        M = np.zeros((n, n))
+        M[ii[mask], jj[mask]] = rows[mask, col]
+        return M
+
+    if first_column == "period":
+        special = {"zero": col0 == -1.0, "inf": col0 == 0.0}
+        reg = col0 > 0
+        omega_of = lambda c: 2.0 * np.pi / c                              # noqa: E731
+    else:
+        special = {"zero": col0 == 0.0, "inf": col0 == -1.0}
+        reg = col0 > 0
+        omega_of = lambda c: c                                            # noqa: E731
+    keys = np.unique(col0[reg])
+    omega = omega_of(keys)
+    order = np.argsort(omega)
+    keys, omega = keys[order], omega[order]
+    scale_a = rho * L ** k_ab
+    A = np.stack([matrix_at(col0 == c, 3) for c in keys]) * scale_a
+    B = np.stack([matrix_at(col0 == c, 4) for c in keys]) * scale_a * omega[:, None, None]
+    if not np.any(special["inf"]):
+        raise ValueError(f"{paths['1']} has no infinite-frequency rows (period 0): rerun WAMIT with "
+                         "period 0 in the period list to get A_inf (required).")
+
+    ds = xr.Dataset(coords={"omega": omega, "body": names, "influenced_dof": labels,
+                            "radiating_dof": labels, "axis": list(AXES)})
+    fm = ("omega", "influenced_dof", "radiating_dof")
+    ds["added_mass"] = (fm, A)
+    ds["radiation_damping"] = (fm, B)
+    ds["added_mass_inf"] = (fm[1:], matrix_at(special["inf"], 3) * scale_a)
+    if np.any(special["zero"]):
+        ds["added_mass_zero"] = (fm[1:], matrix_at(special["zero"], 3) * scale_a)
+
+    # ---- .3: excitation (period, heading deg, i, |X|, phase deg, Re, Im)
+    if "3" in paths:
+        r3 = np.array([r[:7] for r in _rows(paths["3"], 7)])
+        om3 = omega_of(r3[:, 0])
+        heads = np.unique(r3[:, 1])
+        if not np.allclose(np.unique(om3), omega, rtol=1e-6):
+            raise ValueError(f"{paths['3']}: its frequencies differ from those of {paths['1']}.")
+        X = np.zeros((len(omega), len(heads), n), dtype=complex)
+        io = np.searchsorted(omega, om3 * (1 - 1e-9))
+        ih = np.searchsorted(heads, r3[:, 1])
+        im = r3[:, 2].astype(int) - 1
+        rot = (im % 6) >= 3
+        X[io, ih, im] = (r3[:, 5] - 1j * r3[:, 6]) * rho * g * L ** (2 + rot)     # conj: e^{+iωt} → e^{-iωt}
+        ds = ds.assign_coords(wave_direction=np.deg2rad(heads))
+        ds["excitation"] = (("omega", "wave_direction", "influenced_dof"), X)
+
+    # ---- .out bodies: reference points, volumes, centres (inertial axes)
+    xb = np.array([b["xbody"] for b in info["bodies"]])
+    if np.any(xb[:, 3] != 0):
+        raise ValueError(f"{paths['out']}: PHIBODY ≠ 0 ({xb[:, 3]}) is not supported: the modes would be "
+                         "in rotated body axes, not inertial axes.")
+    ref = xb[:, :3]
+    vol = np.array([b["volumes"][2] for b in info["bodies"]]) * L ** 3
+    cob_rel = np.array([b["cob"] for b in info["bodies"]]) * L
+    cog_rel = np.array([b["cog"] for b in info["bodies"]]) * L
+    ds["reference_point"] = (("body", "axis"), ref)
+    ds["displaced_volume"] = (("body",), vol)
+    ds["center_of_buoyancy"] = (("body", "axis"), ref + cob_rel)
+    # ---- .hst: hydrostatics and the water-plane part
+    if "hst" in paths:
+        rh = np.array([r[:3] for r in _rows(paths["hst"], 3)])
+        C = np.zeros((n, n))
+        C[rh[:, 0].astype(int) - 1, rh[:, 1].astype(int) - 1] = rh[:, 2]
+        C = C * rho * g * L ** (k_ab - 1)
+        ds["hydrostatic_stiffness"] = (fm[1:], C)
+        ds["hydrostatic_stiffness"].attrs["includes"] = (
+            "WAMIT .hst as given: water-plane terms, rho g V z_B in C44/C55 and -rho g V x_B, "
+            "-rho g V y_B in C46/C56, and the gravity terms -m g z_G (C44/C55), +m g x_G, +m g y_G "
+            "(C46/C56) with m = rho V; z_B, z_G relative to each body origin")
+        W = np.zeros((n, n))
+        for b in range(nb):
+            o = 6 * b
+            Cb = C[o:o + 6, o:o + 6]
+            V = vol[b]
+            zb, zg = cob_rel[b, 2], cog_rel[b, 2]
+            wp = {(2, 2): Cb[2, 2],
+                  (2, 3): _pair(Cb, 2, 3), (2, 4): _pair(Cb, 2, 4), (3, 4): _pair(Cb, 3, 4),
+                  (3, 3): Cb[3, 3] - rho * g * V * (zb - zg),
+                  (4, 4): Cb[4, 4] - rho * g * V * (zb - zg)}
+            for (i, j), v in wp.items():
+                W[o + i, o + j] = W[o + j, o + i] = v
+        ds["waterplane_stiffness"] = (fm[1:], W)
+        ds["waterplane_stiffness"].attrs["includes"] = (
+            "water-plane terms only (C33, C34, C35, C44, C55, C45 about the body origin); "
+            "rho g V (z_B - z_G) removed from C44/C55, C46/C56 dropped")
+
+    ds.attrs = {
+        "rho": float(rho), "g": float(g), "water_depth": float(info["water_depth"]),
+        "convention": CONVENTION, "source": "hydro.wamit.read_wamit",
+        "wamit_files": ", ".join(str(p) for p in paths.values()),
+        "wamit_ulen": float(L), "wamit_first_column": first_column,
+        "wamit_conversion": "complex amplitudes conjugated (WAMIT exp(+i omega t) -> exp(-i omega t))",
+        "wamit_center_of_gravity": "; ".join(
+            f"{nm}: {np.array2string(ref[b] + cog_rel[b], precision=6)}" for b, nm in enumerate(names)),
+        "date_read": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+    }
+    return ds
+
+
+def _pair(C, i, j):
+    """A symmetric water-plane entry from the .hst (WAMIT may list only one of C_ij, C_ji)."""
+    return C[i, j] if C[i, j] != 0.0 else C[j, i]
