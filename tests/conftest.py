@@ -1,9 +1,13 @@
 import os
 
-import jax
+# One BLAS thread: the state-space fits and small solves are faster and steadier that way on the
+# 2-core CI machine (threaded BLAS measured up to 10× slower on first calls under load).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("MPLBACKEND", "Agg")
+
+import jax  # noqa: E402
 
 jax.config.update("jax_enable_x64", True)
-os.environ.setdefault("MPLBACKEND", "Agg")
 
 from pathlib import Path  # noqa: E402
 

@@ -1,0 +1,53 @@
+"""The command line and the notebooks (executed in smoke mode so they never rot)."""
+import os
+from pathlib import Path
+
+import nbformat
+import pytest
+import xarray as xr
+from conftest import CONFIGS, ROOT
+from nbclient import NotebookClient
+
+from mfm.cli import main
+
+
+def test_cli_info(capsys):
+    assert main(["info", str(CONFIGS / "m4_132.toml")]) == 0
+    out = capsys.readouterr().out
+    assert "M4 132: 6 bodies, 5 coordinates" in out and "float6.angle  (damper 6)" in out
+
+
+def test_cli_simulate_and_plot(tmp_path, capsys):
+    nc = tmp_path / "dp.nc"
+    assert main(["simulate", str(CONFIGS / "double_pendulum.toml"), "--duration", "0.5", "--dt", "0.01",
+                 "--initial", "upper.angle=0.3", "--integrator", "beeman", "--out", str(nc)]) == 0
+    ds = xr.open_dataset(nc)
+    assert ds.sizes["time"] == 51 and float(ds.q.isel(time=0, coordinate=0)) == 0.3
+    assert ds.attrs["integrator"] == "beeman"
+    png = tmp_path / "layout.png"
+    assert main(["plot", str(CONFIGS / "m4_134.toml"), "--out", str(png)]) == 0
+    assert png.stat().st_size > 10_000 and png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_cli_errors_are_one_line(tmp_path, capsys):
+    assert main(["simulate", str(CONFIGS / "double_pendulum.toml"), "--initial", "elbow=0.3",
+                 "--out", str(tmp_path / "x.nc")]) == 2
+    err = capsys.readouterr().err
+    assert "'elbow' is not a coordinate" in err
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[[bodies]]\nname = "a"\nmass = -1\ncom = [0, 0, 0]\nprincipal_inertia = [1, 1, 1]\n'
+                   '[bodies.joint]\ntype = "free"\n')
+    assert main(["info", str(bad)]) == 2
+    assert "bodies[0] ('a').mass" in capsys.readouterr().err
+
+
+NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
+def test_notebook_runs_in_smoke_mode(path, monkeypatch):
+    monkeypatch.setenv("MFM_SMOKE", "1")
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    nb = nbformat.read(path, as_version=4)
+    NotebookClient(nb, timeout=900, kernel_name="python3",
+                   resources={"metadata": {"path": str(path.parent)}}).execute()
