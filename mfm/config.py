@@ -38,10 +38,13 @@ import numpy as np
 from .tree import (JOINT_KINDS, PLANAR_DOFS, ROOT_DOFS, BodySpec, ConfigError, JointSpec,
                    check_inertia, tree_order)
 
-TOP_KEYS = {"model", "bodies"}
+TOP_KEYS = {"model", "bodies", "hydro", "moorings"}
+HYDRO_KEYS = {"database", "names", "body_coupling", "added_mass_inf", "rho", "g", "notes"}
+BODY_HYDRO_KEYS = {"body", "drag_coefficient", "drag_area", "notes"}
+MOORING_KEYS = {"name", "body", "point", "stiffness", "notes"}
 MODEL_KEYS = {"name", "gravity", "description"}
 BODY_KEYS = {"name", "mass", "com", "inertia", "principal_inertia", "radii_of_gyration", "parent",
-             "joint", "notes"}
+             "joint", "hydro", "notes"}
 JOINT_KEYS = {"type", "axis", "point", "dofs", "damping", "stiffness", "rest", "notes"}
 
 
@@ -155,6 +158,69 @@ def _parse_inertia(raw: dict, mass: float, where: str) -> np.ndarray:
     return check_inertia(J, f"{where}.{key}")
 
 
+def _parse_body_hydro(raw, where, name):
+    if not isinstance(raw, dict):
+        raise ConfigError(f"{where}: expected a table such as {{ body = \"float\" }}")
+    _unknown(raw, BODY_HYDRO_KEYS, where)
+    out = {"body": raw.get("body", name)}
+    if not isinstance(out["body"], str):
+        raise ConfigError(f"{where}.body: {out['body']!r} is not a database body name")
+    cd = _vector(raw.get("drag_coefficient", [0, 0, 0]), 3, f"{where}.drag_coefficient")
+    area = _vector(raw.get("drag_area", [0, 0, 0]), 3, f"{where}.drag_area")
+    for key, v in (("drag_coefficient", cd), ("drag_area", area)):
+        if np.any(v < 0):
+            raise ConfigError(f"{where}.{key}: {v.tolist()} has a negative entry; give values ≥ 0 "
+                              "per inertial axis x, y, z")
+    out["drag"] = cd * area
+    return out
+
+
+def _parse_hydro(raw, source):
+    if not isinstance(raw, dict):
+        raise ConfigError("hydro: expected a table")
+    _unknown(raw, HYDRO_KEYS, "hydro")
+    if "database" not in raw or not isinstance(raw["database"], str):
+        raise ConfigError("hydro.database: missing; the path (relative to the config) of a hydro "
+                          "database: a NetCDF from `mfm hydro`/capytaine, or WAMIT output (.out)")
+    out = {"database": raw["database"], "names": raw.get("names"),
+           "body_coupling": raw.get("body_coupling", True),
+           "added_mass_inf": raw.get("added_mass_inf", "consistent"),
+           "rho": raw.get("rho"), "g": raw.get("g")}
+    if not isinstance(out["body_coupling"], bool):
+        raise ConfigError(f"hydro.body_coupling: {out['body_coupling']!r} is not true or false")
+    if out["added_mass_inf"] not in ("consistent", "database"):
+        raise ConfigError(f"hydro.added_mass_inf: {out['added_mass_inf']!r}; accepted: "
+                          "'consistent', 'database'")
+    if out["names"] is not None and (not isinstance(out["names"], list)
+                                     or not all(isinstance(n, str) for n in out["names"])):
+        raise ConfigError(f"hydro.names: {out['names']!r} is not a list of body names (WAMIT "
+                          "bodies in file order)")
+    return out
+
+
+def _parse_moorings(raw, names):
+    if not isinstance(raw, list):
+        raise ConfigError("moorings: expected [[moorings]] tables")
+    out = []
+    for i, m in enumerate(raw):
+        where = f"moorings[{i}]"
+        if not isinstance(m, dict):
+            raise ConfigError(f"{where}: expected a table")
+        _unknown(m, MOORING_KEYS, where)
+        body = m.get("body")
+        if body not in names:
+            raise ConfigError(f"{where}.body: {body!r} is not a body; known bodies: {names}")
+        k = _vector(m.get("stiffness"), 3, f"{where}.stiffness") if "stiffness" in m else None
+        if k is None or np.any(k < 0):
+            raise ConfigError(f"{where}.stiffness: {m.get('stiffness')!r}; give [kx, ky, kz] ≥ 0 in "
+                              "N/m (inertial axes)")
+        if "point" not in m:
+            raise ConfigError(f"{where}.point: missing; the attachment point [x, y, z] (m, q = 0)")
+        out.append({"name": str(m.get("name", f"mooring{i}")), "body": body,
+                    "point": _vector(m["point"], 3, f"{where}.point"), "stiffness": k})
+    return out
+
+
 def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodySpec]]:
     """Validate a parsed TOML document. Returns (model options, bodies in tree order)."""
     _unknown(data, TOP_KEYS, source)
@@ -200,9 +266,15 @@ def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodyS
             raise ConfigError(f"{where}.joint: missing; accepted types: {list(JOINT_KINDS)}")
         joint = _parse_joint(raw["joint"], f"{where}.joint", parent is None)
         extra = {k: raw[k] for k in ("notes",) if k in raw}
+        if "hydro" in raw:
+            extra["hydro"] = _parse_body_hydro(raw["hydro"], f"{where}.hydro", name)
         bodies.append(BodySpec(name=name, mass=mass, com=com, inertia=inertia, parent=parent,
                                joint=joint, extra=extra))
-    return options, tree_order(bodies)
+    ordered = tree_order(bodies)
+    if "hydro" in data:
+        options["hydro"] = _parse_hydro(data["hydro"], source)
+    options["moorings"] = _parse_moorings(data.get("moorings", []), [b.name for b in bodies])
+    return options, ordered
 
 
 def load_config(path: str | Path) -> tuple[dict, list[BodySpec]]:

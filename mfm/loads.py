@@ -2,10 +2,12 @@
 
 A load is an immutable pytree (``equinox.Module``) called as
 
-    load(model, t, q, qd, z, kin) -> LoadOutput
+    load(model, t, q, qd, z, kin, memory) -> LoadOutput
 
-with ``kin`` the :class:`~mfm.kinematics.Kinematics` at q and ``z`` its own first-order states
-(``n_states`` of them, e.g. radiation state-space states). It returns Cartesian body loads
+with ``kin`` the :class:`~mfm.kinematics.Kinematics` at (q, q̇), ``z`` its own first-order states
+(``n_states`` of them, e.g. radiation state-space states) and ``memory`` its discrete memory (e.g.
+the velocity history of a radiation convolution): made by ``init_memory`` and renewed after every
+time step by ``update_memory``; read-only within a step. It returns Cartesian body loads
 ``body`` (n, 6: force in inertial axes, moment about the CoM in body axes), generalised loads
 ``tau`` (n_q), the state derivative ``zd`` and an optional acceleration-proportional matrix
 ``mass`` (n_q, n_q) that the solver moves to the left-hand side. Loads enter the equations of
@@ -36,7 +38,28 @@ class Load(eqx.Module):
     def initial_state(self, model) -> jnp.ndarray:
         return jnp.zeros(self.n_states)
 
-    def __call__(self, model, t, q, qd, z, kin) -> LoadOutput:  # pragma: no cover - abstract
+    def init_memory(self, model, t0, q0, qd0, dt):
+        """Discrete memory at the start of a run (default: none)."""
+        return ()
+
+    def update_memory(self, model, t, q, qd, kin, memory):
+        """Memory after a step that ended at (t, q, q̇) (default: unchanged)."""
+        return memory
+
+    def reaction_loads(self, model, t, q, qd, qdd, z, kin, memory, out: LoadOutput):
+        """Cartesian loads (n, 6) this load puts on the bodies, for the joint reactions: by default
+        ``out.body``; a load with acceleration-proportional terms adds them here."""
+        return out.body
+
+    def diagnostics(self, model, t, q, qd, qdd, z, kin, memory, out: LoadOutput) -> dict:
+        """Named arrays recorded at every saved sample (e.g. wave elevation, PTO power)."""
+        return {}
+
+    def annotate(self, ds, records: dict):
+        """Add this load's recorded diagnostics to the result dataset (with dims and units)."""
+        return ds
+
+    def __call__(self, model, t, q, qd, z, kin, memory=()) -> LoadOutput:  # pragma: no cover
         raise NotImplementedError
 
 
@@ -45,7 +68,7 @@ class BodyWrench(Load):
     (N m, body axes, about the CoM)."""
     wrench: jnp.ndarray
 
-    def __call__(self, model, t, q, qd, z, kin):
+    def __call__(self, model, t, q, qd, z, kin, memory=()):
         return LoadOutput(body=self.wrench)
 
 
@@ -56,9 +79,28 @@ class CoordinateForceSeries(Load):
     step: jnp.ndarray
     values: jnp.ndarray
 
-    def __call__(self, model, t, q, qd, z, kin):
+    def __call__(self, model, t, q, qd, z, kin, memory=()):
         s = (t - self.t0) / self.step
         n = self.values.shape[0]
         k = jnp.clip(jnp.floor(s), 0, n - 2).astype(int)
         w = jnp.clip(s - k, 0.0, 1.0)
         return LoadOutput(tau=(1.0 - w) * self.values[k] + w * self.values[k + 1])
+
+
+class PointSprings(Load):
+    """Linear springs from points on bodies to their positions at q = 0 (e.g. a linear mooring):
+    F = −diag(k) (p − p₀) at each point p (inertial axes), N. ``body_index`` static; ``d`` (m, 3)
+    point − CoM in body axes; ``p0`` (m, 3); ``stiffness`` (m, 3) N/m."""
+    body_index: tuple[int, ...] = eqx.field(static=True)
+    d: jnp.ndarray
+    p0: jnp.ndarray
+    stiffness: jnp.ndarray
+
+    def __call__(self, model, t, q, qd, z, kin, memory=()):
+        W = jnp.zeros((model.n_bodies, 6))
+        for k, i in enumerate(self.body_index):
+            R = kin.E[i, :3, :3]
+            rho = R @ self.d[k]
+            f = -self.stiffness[k] * (kin.E[i, :3, 3] + rho - self.p0[k])
+            W = W.at[i, :3].add(f).at[i, 3:].add(R.T @ jnp.cross(rho, f))
+        return LoadOutput(body=W)

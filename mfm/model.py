@@ -72,6 +72,8 @@ class Model(eqx.Module):
     stiffness: jnp.ndarray
     damping: jnp.ndarray
     rest: jnp.ndarray
+    hydro: object = eqx.field(static=True, default=None)
+    moorings: object = None
 
     @property
     def n_bodies(self) -> int:
@@ -184,13 +186,30 @@ def compile_tree(bodies: list[BodySpec], *, name: str = "model", gravity: float 
     )
 
 
-def load(path: str | Path, hydro: bool = False) -> Model:
+def load(path: str | Path, hydro: bool = True, body_coupling: bool | None = None) -> Model:
     """Load a TOML float-tree config and compile it.
 
-    ``hydro=False`` returns the mechanics-only model (bodies, joints, joint spring–dampers, gravity).
+    hydro: with True (default) and a ``[hydro]`` table in the config, the model carries its water
+        (database, reference points, drag; see :mod:`mfm.water`); False gives the mechanics-only
+        model (bodies, joints, joint spring–dampers, moorings, gravity).
+    body_coupling: overrides ``hydro.body_coupling`` (hydrodynamic interaction between bodies: the
+        cross-body blocks of A∞, A(ω), B(ω) and K).
     """
-    if hydro:
-        raise NotImplementedError("mfm.load(..., hydro=True): the hydrodynamic model assembly is "
-                                  "not part of this version; load with hydro=False")
     options, bodies = load_config(path)
-    return compile_tree(bodies, name=options["name"], gravity=options["gravity"])
+    model = compile_tree(bodies, name=options["name"], gravity=options["gravity"])
+    if options["moorings"]:
+        from .loads import PointSprings
+
+        idx = tuple(model.body_index(m["body"]) for m in options["moorings"])
+        model = dataclasses.replace(model, moorings=PointSprings(
+            body_index=idx,
+            d=jnp.asarray(np.stack([m["point"] - np.asarray(model.com[i])
+                                    for m, i in zip(options["moorings"], idx)])),
+            p0=jnp.asarray(np.stack([m["point"] for m in options["moorings"]])),
+            stiffness=jnp.asarray(np.stack([m["stiffness"] for m in options["moorings"]]))))
+    if hydro and "hydro" in options:
+        from .water import load_hydro_spec
+
+        model = dataclasses.replace(model, hydro=load_hydro_spec(
+            model, bodies, options["hydro"], Path(path).parent, body_coupling))
+    return model

@@ -31,6 +31,22 @@ class SimulationError(RuntimeError):
     """The simulation went non-finite; the message gives the time, the state and the likely cause."""
 
 
+def model_loads(model: Model, sea=None, *, dt, duration, t0=0.0, ramp=0.0,
+                radiation="convolution", memory=None, state_space_options=None) -> tuple[Load, ...]:
+    """The loads a model carries itself: its moorings and, with a [hydro] config, its water for
+    this sea and time grid (see :func:`mfm.water.build_water`). Pass them to :func:`rollout`."""
+    out = []
+    if model.hydro is not None:
+        from .water import build_water
+
+        out.append(build_water(model, model.hydro, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
+                               radiation=radiation, memory=memory,
+                               state_space_options=state_space_options))
+    if model.moorings is not None:
+        out.append(model.moorings)
+    return tuple(out)
+
+
 def _as_loads(loads) -> tuple[Load, ...]:
     if loads is None:
         return ()
@@ -43,15 +59,19 @@ def _as_loads(loads) -> tuple[Load, ...]:
     return loads
 
 
-def applied_loads(model: Model, loads: Sequence[Load], t, q, qd, z, kin):
+def applied_loads(model: Model, loads: Sequence[Load], t, q, qd, z, kin, memories=None,
+                  with_outputs=False):
     """Sum the external loads at one state: (body (n, 6) | None, tau (n_q,) | None,
-    mass (n_q, n_q) | None, zd (n_states,)). Load states are concatenated in z in ``loads`` order."""
+    mass (n_q, n_q) | None, zd (n_states,)), plus the per-load outputs if ``with_outputs``.
+    Load states are concatenated in z in ``loads`` order."""
     sizes = [ld.n_states for ld in loads]
     offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
+    memories = memories if memories is not None else tuple(() for _ in loads)
     body = tau = mass = None
-    zds = []
+    zds, outs = [], []
     for k, ld in enumerate(loads):
-        out = ld(model, t, q, qd, z[offsets[k]:offsets[k + 1]], kin)
+        out = ld(model, t, q, qd, z[offsets[k]:offsets[k + 1]], kin, memories[k])
+        outs.append(out)
         if out.body is not None:
             body = out.body if body is None else body + out.body
         if out.tau is not None:
@@ -60,48 +80,96 @@ def applied_loads(model: Model, loads: Sequence[Load], t, q, qd, z, kin):
             mass = out.mass if mass is None else mass + out.mass
         zds.append(jnp.zeros(sizes[k]) if out.zd is None else out.zd)
     zd = jnp.concatenate(zds) if zds else jnp.zeros(0)
+    if with_outputs:
+        return body, tau, mass, zd, outs
     return body, tau, mass, zd
 
 
-def dynamics_function(model: Model, loads: Sequence[Load] = ()):
+def dynamics_function(model: Model, loads: Sequence[Load] = (), memories=None):
     """The system ``f(t, q, q̇, z) -> (q̈, ż)`` of the integrators: MFM equations of motion plus the
-    external loads."""
+    external loads (with their memories of the current step)."""
 
     def f(t, q, qd, z):
         kin = kinematics(model, q, qd)
-        body, tau, mass, zd = applied_loads(model, loads, t, q, qd, z, kin)
+        body, tau, mass, zd = applied_loads(model, loads, t, q, qd, z, kin, memories)
         return evaluate(model, q, qd, tau=tau, body_loads=body, extra_mass=mass, kin=kin).qdd, zd
 
     return f
 
 
-def _rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_every):
+def _init_memories(model, loads, t0, q0, qd0, dt):
+    return tuple(ld.init_memory(model, t0, q0, qd0, dt) for ld in loads)
+
+
+def _update_memories(model, loads, s, memories):
+    if not loads:
+        return memories
+    kin = kinematics(model, s.q, s.qd)
+    return tuple(ld.update_memory(model, s.t, s.q, s.qd, kin, mem) for ld, mem in zip(loads, memories))
+
+
+def _record(model, loads, s, mem):
+    """What the dataset keeps of one saved state: poses, reactions, energies, load diagnostics."""
+    kin = kinematics(model, s.q, s.qd)
+    body, tau, mass, _, outs = applied_loads(model, loads, s.t, s.q, s.qd, s.z, kin, mem,
+                                             with_outputs=True)
+    ev = evaluate(model, s.q, s.qd, tau=tau, body_loads=body, extra_mass=mass, kin=kin)
+    sizes = [ld.n_states for ld in loads]
+    offs = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
+    # the joints carry every load on the bodies, acceleration-proportional ones included
+    F = None
+    diag = {}
+    for k, (ld, out) in enumerate(zip(loads, outs)):
+        zk = s.z[offs[k]:offs[k + 1]]
+        Fk = ld.reaction_loads(model, s.t, s.q, s.qd, ev.qdd, zk, kin, mem[k], out)
+        if Fk is not None:
+            F = Fk if F is None else F + Fk
+        diag.update(ld.diagnostics(model, s.t, s.q, s.qd, ev.qdd, zk, kin, mem[k], out))
+    ev_r = ev._replace(F=ev.F - (0.0 if body is None else body) + (0.0 if F is None else F))
+    f_j, m_j = reaction_loads(model, ev_r)
+    T, V = energies(model, s.q, s.qd)
+    angles = jax.vmap(se3.euler_zyx)(kin.E[:, :3, :3])
+    return dict(body_position=kin.E[:, :3, 3], body_rotation=angles, joint_force=f_j,
+                joint_moment=m_j, kinetic_energy=T, potential_energy=V, qdd=ev.qdd, **diag)
+
+
+def _rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_every, record):
     TRACES["rollout"] += 1
-    f = dynamics_function(model, loads)
-    state = integrator.init(f, t0, q0, qd0, z0)
+    mem0 = _init_memories(model, loads, t0, q0, qd0, dt)
+    state = integrator.init(dynamics_function(model, loads, mem0), t0, q0, qd0, z0)
 
-    def block(s, _):
-        s, _ = jax.lax.scan(lambda s, _: (integrator.step(f, s, dt), None), s, None,
-                            length=save_every)
-        return s, (s.t, s.q, s.qd, s.qdd, s.z, s.iterations)
+    def one_step(carry, _):
+        s, mem = carry
+        s = integrator.step(dynamics_function(model, loads, mem), s, dt)
+        return (s, _update_memories(model, loads, s, mem)), None
 
-    _, traj = jax.lax.scan(block, state, None, length=n_steps // save_every)
-    first = (state.t, state.q, state.qd, state.qdd, state.z, state.iterations)
-    return tuple(jnp.concatenate([a[None], b]) for a, b in zip(first, traj))
+    def saved(s, mem):
+        out = (s.t, s.q, s.qd, s.qdd, s.z, s.iterations)
+        return out + ((_record(model, loads, s, mem),) if record else ())
+
+    def block(carry, _):
+        carry, _ = jax.lax.scan(one_step, carry, None, length=save_every)
+        return carry, saved(*carry)
+
+    _, traj = jax.lax.scan(block, (state, mem0), None, length=n_steps // save_every)
+    first = saved(state, mem0)
+    return jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), first, traj)
 
 
-_rollout_jit = jax.jit(_rollout_impl, static_argnames=("n_steps", "integrator", "save_every"))
+_rollout_jit = jax.jit(_rollout_impl,
+                       static_argnames=("n_steps", "integrator", "save_every", "record"))
 
 
 def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=None,
-            save_every: int = 1, t0=0.0, z0=None):
+            save_every: int = 1, t0=0.0, z0=None, record: bool = False):
     """Pure, jit-compiled rollout: returns ``(t, q, qd, qdd, z, iterations)`` arrays with a leading
     time axis of length ``n_steps // save_every + 1`` (the initial state first).
 
     Compiled once per (topology, n_steps, integrator, save_every, loads structure): changing any
     array parameter of ``model`` or ``loads``, ``dt``, ``q0``, ``qd0`` reuses the compiled code, and
     the function can be ``jax.vmap``-ed over a batched model or ``jax.grad``-ed (RK4, semi-implicit
-    and Newmark; Beeman's while loop is forward-mode only).
+    and Newmark; Beeman's while loop is forward-mode only). ``record=True`` appends a dict of
+    per-sample outputs (poses, joint reactions, energies, load diagnostics) as a 7th item.
     """
     loads = _as_loads(loads)
     integ = _integrators.get(integrator)
@@ -112,7 +180,8 @@ def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=
         z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
     return _rollout_jit(model, loads, q0, qd0, jnp.asarray(z0, jnp.float64),
                         jnp.asarray(t0, jnp.float64), jnp.asarray(dt, jnp.float64),
-                        n_steps=int(n_steps), integrator=integ, save_every=int(save_every))
+                        n_steps=int(n_steps), integrator=integ, save_every=int(save_every),
+                        record=record)
 
 
 def _initial_vector(model: Model, value, what: str) -> np.ndarray:
@@ -176,32 +245,41 @@ def _raise_nonfinite(model, integ, t, q, qd, dt, loads):
 
 
 def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="rk4",
-             q0=None, qd0=None, loads=None, save_every: int = 1, t0: float = 0.0) -> xr.Dataset:
+             q0=None, qd0=None, loads=None, save_every: int = 1, t0: float = 0.0,
+             ramp: float = 0.0, radiation: str = "convolution", memory: float | None = None,
+             state_space_options: dict | None = None) -> xr.Dataset:
     """Simulate a model in the time domain.
 
     Parameters
     ----------
-    model: a compiled :class:`~mfm.model.Model`.
-    sea: the sea state; must be None for a mechanics-only model.
+    model: a compiled :class:`~mfm.model.Model` (with its water if the config has ``[hydro]``).
+    sea: a sea state from :mod:`hydro.waves` (``Regular``, ``Jonswap``, …), or None (still water,
+        or no water at all for a mechanics-only model).
     duration, dt: s. The run has ``round(duration / dt)`` steps.
     integrator: ``"rk4"`` (default), ``"beeman"`` (seed 001 eq. 52), ``"semi_implicit"``,
         ``"newmark"``, or an instance from :mod:`mfm.integrators`.
     q0, qd0: initial coordinates and rates, arrays (n_q,) or dicts by coordinate name (others 0).
     loads: an :class:`mfm.loads.Load` or a sequence of them (external loads).
     save_every: keep every k-th step in the output.
+    ramp: s, the start-up ramp of the excitation (½(1 − cos πt/ramp)).
+    radiation: ``"convolution"`` (direct, window T_K from the decay of K; ``memory`` overrides it,
+        s), ``"state_space"`` (the passive fit of :mod:`hydro.statespace`, options in
+        ``state_space_options``) or ``"none"`` (A∞ only).
 
     Returns an :class:`xarray.Dataset` with ``q``, ``qd``, ``qdd`` (time, coordinate),
     ``body_position`` (time, body, axis) CoM in inertial axes, ``body_rotation`` (time, body, angle)
     roll/pitch/yaw (R = R_z(yaw) R_y(pitch) R_x(roll)), ``joint_force`` and ``joint_moment``
     (time, body, axis): the load each body's joint transmits from the parent (inertial axes, moment
-    about the joint point), ``kinetic_energy`` and ``potential_energy`` (time), and
-    ``iterations`` (corrector iterations of the step), with units and provenance in attributes.
+    about the joint point), ``kinetic_energy`` and ``potential_energy`` (time), ``iterations``
+    (corrector iterations of the step), ``pto_power`` and ``pto_displacement`` (time, pto) for each
+    joint damper; with water also ``eta`` (time), ``xi`` (time, hydro_dof) and ``hydro_force``
+    (time, component, hydro_dof). Units and provenance are in the attributes.
 
     Raises :class:`SimulationError` when the state goes non-finite.
     """
-    if sea is not None:
-        raise ValueError("sea: this model has no hydrodynamics (mfm.load(..., hydro=False)); pass "
-                         "sea=None")
+    if sea is not None and model.hydro is None:
+        raise ValueError("sea: this model has no hydrodynamics (no [hydro] table in its config, or "
+                         "mfm.load(..., hydro=False)); pass sea=None")
     if not (dt > 0 and math.isfinite(dt)):
         raise ValueError(f"dt: {dt!r} must be a positive number of seconds")
     if not (duration > 0 and math.isfinite(duration)):
@@ -212,47 +290,29 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     if save_every < 1 or n_steps % save_every:
         raise ValueError(f"save_every: {save_every} must be a positive divisor of the {n_steps} "
                          "steps")
-    loads = _as_loads(loads)
+    if ramp < 0:
+        raise ValueError(f"ramp: {ramp!r} must be ≥ 0 s")
+    loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp, radiation=radiation,
+                        memory=memory, state_space_options=state_space_options) + _as_loads(loads)
     integ = _integrators.get(integrator)
     q0 = _initial_vector(model, q0, "q0")
     qd0 = _initial_vector(model, qd0, "qd0")
-    t, q, qd, qdd, z, iters = (np.asarray(a) for a in rollout(
-        model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
-        save_every=save_every, t0=t0))
+    out = rollout(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
+                  save_every=save_every, t0=t0, record=True)
+    t, q, qd, qdd, z, iters = (np.asarray(a) for a in out[:6])
     if not (np.isfinite(q).all() and np.isfinite(qd).all()):
         _raise_nonfinite(model, integ, t, q, qd, dt, loads)
-    post = _postprocess(model, loads, t, q, qd, z)
-    return _dataset(model, integ, dt, t, q, qd, qdd, iters, post)
+    rec = {k: np.asarray(v) for k, v in out[6].items()}
+    ds = _dataset(model, integ, dt, t, q, qd, rec["qdd"], iters, rec)
+    for ld in loads:
+        ds = ld.annotate(ds, rec)
+    return ds
 
 
-def _postprocess_impl(model, loads, t, q, qd, z):
-    TRACES["postprocess"] += 1
-
-    def one(t, q, qd, z):
-        kin = kinematics(model, q, qd)
-        body, tau, mass, _ = applied_loads(model, loads, t, q, qd, z, kin)
-        ev = evaluate(model, q, qd, tau=tau, body_loads=body, extra_mass=mass, kin=kin)
-        # Note: acceleration-proportional load terms (``mass``) act through q̈ only; a load that
-        # has them must also report its Cartesian part in ``body`` for the reactions to hold it.
-        f_j, m_j = reaction_loads(model, ev)
-        T, V = energies(model, q, qd)
-        angles = jax.vmap(se3.euler_zyx)(kin.E[:, :3, :3])
-        return kin.E[:, :3, 3], angles, f_j, m_j, T, V, ev.qdd
-
-    return jax.vmap(one)(t, q, qd, z)
-
-
-_postprocess_jit = jax.jit(_postprocess_impl)
-
-
-def _postprocess(model, loads, t, q, qd, z):
-    return tuple(np.asarray(a) for a in _postprocess_jit(model, loads, jnp.asarray(t),
-                                                         jnp.asarray(q), jnp.asarray(qd),
-                                                         jnp.asarray(z)))
-
-
-def _dataset(model, integ, dt, t, q, qd, qdd, iters, post) -> xr.Dataset:
-    pos, ang, f_j, m_j, T, V, _ = post
+def _dataset(model, integ, dt, t, q, qd, qdd, iters, rec) -> xr.Dataset:
+    pos, ang, f_j, m_j = (rec[k] for k in ("body_position", "body_rotation", "joint_force",
+                                           "joint_moment"))
+    T, V = rec["kinetic_energy"], rec["potential_energy"]
     coords = {"time": ("time", t, {"units": "s"}),
               "coordinate": list(model.coordinates),
               "body": list(model.body_names),
@@ -299,6 +359,15 @@ def _dataset(model, integ, dt, t, q, qd, qdd, iters, post) -> xr.Dataset:
                            "the CoM, parallel to inertial at q = 0",
         },
     )
+    damped = [k for k in range(model.n_coordinates) if float(model.damping[k]) > 0]
+    if damped:
+        c = np.asarray(model.damping)[damped]
+        ds = ds.assign_coords(pto=[model.coordinates[k] for k in damped])
+        ds["pto_power"] = (("time", "pto"), c * qd[:, damped] ** 2,
+                           {"long_name": "power absorbed by each joint damper, c q̇²", "units": "W"})
+        ds["pto_displacement"] = (("time", "pto"), q[:, damped],
+                                  {"long_name": "joint coordinate of each damper (relative angle or "
+                                   "stroke)", "units": "rad or m"})
     return ds
 
 
