@@ -39,12 +39,12 @@ from .tree import (JOINT_KINDS, PLANAR_DOFS, ROOT_DOFS, BodySpec, ConfigError, J
                    check_inertia, tree_order)
 
 TOP_KEYS = {"model", "bodies", "hydro", "moorings"}
-HYDRO_KEYS = {"database", "names", "body_coupling", "added_mass_inf", "rho", "g", "notes"}
+HYDRO_KEYS = {"database", "names", "body_coupling", "added_mass_inf", "rho", "g", "bem", "notes"}
 BODY_HYDRO_KEYS = {"body", "drag_coefficient", "drag_area", "notes"}
 MOORING_KEYS = {"name", "body", "point", "stiffness", "notes"}
 MODEL_KEYS = {"name", "gravity", "description"}
 BODY_KEYS = {"name", "mass", "com", "inertia", "principal_inertia", "radii_of_gyration", "parent",
-             "joint", "hydro", "notes"}
+             "joint", "hydro", "geometry", "notes"}
 JOINT_KEYS = {"type", "axis", "point", "dofs", "damping", "stiffness", "rest", "notes"}
 
 
@@ -185,7 +185,9 @@ def _parse_hydro(raw, source):
     out = {"database": raw["database"], "names": raw.get("names"),
            "body_coupling": raw.get("body_coupling", True),
            "added_mass_inf": raw.get("added_mass_inf", "consistent"),
-           "rho": raw.get("rho"), "g": raw.get("g")}
+           "rho": raw.get("rho"), "g": raw.get("g"), "bem": raw.get("bem")}
+    if out["bem"] is not None and not isinstance(out["bem"], dict):
+        raise ConfigError("hydro.bem: expected a table of BEM settings (see mfm.bemgen)")
     if not isinstance(out["body_coupling"], bool):
         raise ConfigError(f"hydro.body_coupling: {out['body_coupling']!r} is not true or false")
     if out["added_mass_inf"] not in ("consistent", "database"):
@@ -265,7 +267,8 @@ def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodyS
         if "joint" not in raw:
             raise ConfigError(f"{where}.joint: missing; accepted types: {list(JOINT_KINDS)}")
         joint = _parse_joint(raw["joint"], f"{where}.joint", parent is None)
-        extra = {k: raw[k] for k in ("notes",) if k in raw}
+        # geometry (hull shape for `mfm hydro`) is checked by hydro.geometry when a BEM runs
+        extra = {k: raw[k] for k in ("notes", "geometry") if k in raw}
         if "hydro" in raw:
             extra["hydro"] = _parse_body_hydro(raw["hydro"], f"{where}.hydro", name)
         bodies.append(BodySpec(name=name, mass=mass, com=com, inertia=inertia, parent=parent,

@@ -50,54 +50,52 @@ def _cross_cols(a, J):
 
 
 class HydroGeometry(eqx.Module):
-    """Where the hydro bodies sit on the tree: static body indices, arrays of offsets (body axes)."""
+    """Where the hydro bodies sit on the tree: static body indices, arrays of offsets (body axes).
+    Every method works on all hydro bodies at once (gathers by the static indices)."""
     body_index: tuple[int, ...] = eqx.field(static=True)
     d_ref: jnp.ndarray      # (K, 3) reference point − CoM at q = 0
     ref0: jnp.ndarray       # (K, 3) reference points at q = 0 (inertial)
 
+    def _frames(self, kin):
+        idx = np.asarray(self.body_index)
+        R = kin.E[idx, :3, :3]
+        rho = jnp.einsum("kab,kb->ka", R, self.d_ref)
+        return idx, R, rho
+
     def h_matrix(self, kin):
         """H (6K, n_q): ξ̇ = H q̇; and the rotation matrices (K, 3, 3), lever arms ρ (K, 3)."""
-        rows, Rs, rhos = [], [], []
-        for k, i in enumerate(self.body_index):
-            R = kin.E[i, :3, :3]
-            rho = R @ self.d_ref[k]
-            w_cols = R @ kin.B[i, 3:]                       # inertial angular velocity Jacobian
-            lin = kin.B[i, :3] + _cross_cols(rho, w_cols) * -1.0  # v + ω × ρ = v − ρ × ω
-            rows += [lin, w_cols]
-            Rs.append(R)
-            rhos.append(rho)
-        return jnp.concatenate(rows, axis=0), jnp.stack(Rs), jnp.stack(rhos)
+        idx, R, rho = self._frames(kin)
+        w_cols = jnp.einsum("kab,kbq->kaq", R, kin.B[idx, 3:])     # inertial ω Jacobian
+        lin = kin.B[idx, :3] - jnp.cross(rho[:, :, None], w_cols, axis=1)   # v + ω × ρ
+        H = jnp.concatenate([lin, w_cols], axis=1)
+        return H.reshape(-1, H.shape[-1]), R, rho
 
     def xi(self, kin):
         """ξ (6K,): displacement of each reference point and its rotation vector."""
-        out = []
-        for k, i in enumerate(self.body_index):
-            R = kin.E[i, :3, :3]
-            r = kin.E[i, :3, 3] + R @ self.d_ref[k]
-            out += [r - self.ref0[k], se3.so3_log(R)]
-        return jnp.concatenate(out)
+        idx, R, rho = self._frames(kin)
+        r = kin.E[idx, :3, 3] + rho - self.ref0
+        return jnp.concatenate([r, jax.vmap(se3.so3_log)(R)], axis=1).reshape(-1)
 
     def velocity_and_bias(self, kin):
         """ξ̇ (6K,) and Ḣ q̇ (6K,) from the tree walk's velocities and velocity-product terms."""
-        v, a = [], []
-        for k, i in enumerate(self.body_index):
-            R = kin.E[i, :3, :3]
-            rho = R @ self.d_ref[k]
-            w = R @ kin.X[i, 3:]
-            beta = R @ kin.bias[i, 3:]                      # d/dt(R ω_b) = R ω̇_b
-            v += [kin.X[i, :3] + jnp.cross(w, rho), w]
-            a += [kin.bias[i, :3] + jnp.cross(beta, rho) + jnp.cross(w, jnp.cross(w, rho)), beta]
-        return jnp.concatenate(v), jnp.concatenate(a)
+        idx, R, rho = self._frames(kin)
+        w = jnp.einsum("kab,kb->ka", R, kin.X[idx, 3:])
+        beta = jnp.einsum("kab,kb->ka", R, kin.bias[idx, 3:])     # d/dt(R ω_b) = R ω̇_b
+        v = jnp.concatenate([kin.X[idx, :3] + jnp.cross(w, rho), w], axis=1)
+        a = jnp.concatenate([kin.bias[idx, :3] + jnp.cross(beta, rho)
+                             + jnp.cross(w, jnp.cross(w, rho)), beta], axis=1)
+        return v.reshape(-1), a.reshape(-1)
 
-    def to_body_wrench(self, F, kin, n_bodies):
-        """Hydro loads F (6K: force at r_k, moment about r_k, inertial) → body wrenches (n, 6)."""
-        W = jnp.zeros((n_bodies, 6))
-        for k, i in enumerate(self.body_index):
-            R = kin.E[i, :3, :3]
-            rho = R @ self.d_ref[k]
-            f, m = F[6 * k:6 * k + 3], F[6 * k + 3:6 * k + 6]
-            W = W.at[i, :3].add(f).at[i, 3:].add(R.T @ (m + jnp.cross(rho, f)))
-        return W
+    def to_body_wrench(self, F, kin, n_bodies, point_offset=None):
+        """Loads F (6K: force at r_k, moment about r_k, inertial) → body wrenches (n, 6): force,
+        and moment about the CoM in body axes Rᵀ(m + ρ × f). ``point_offset`` (K, 3) replaces ρ
+        (the point of application relative to the CoM, inertial) when given."""
+        idx, R, rho = self._frames(kin)
+        rho = rho if point_offset is None else point_offset
+        F = F.reshape(-1, 6)
+        f, m = F[:, :3], F[:, 3:]
+        mb = jnp.einsum("kba,kb->ka", R, m + jnp.cross(rho, f))
+        return jnp.zeros((n_bodies, 6)).at[idx].add(jnp.concatenate([f, mb], axis=1))
 
 
 class Water(Load):
@@ -183,13 +181,17 @@ class Water(Load):
         return dict(excitation=exc, radiation=rad, hydrostatic=hyd_stat, drag=drag,
                     added_mass_bias=-(self.A_inf @ hbias)), zd, v, hbias
 
+    def _buoyancy(self, kin):
+        """ρgV ẑ at each centre of buoyancy: as loads at r_k (6K,) and the CoB lever (K, 3)."""
+        R = kin.E[np.asarray(self.geometry.body_index), :3, :3]
+        lever = jnp.einsum("kab,kb->ka", R, self.d_cob)
+        f = jnp.zeros_like(lever).at[:, 2].set(self.buoyancy)
+        return f, lever
+
     def _buoyancy_wrench(self, kin, n_bodies):
-        W = jnp.zeros((n_bodies, 6))
-        for k, i in enumerate(self.geometry.body_index):
-            R = kin.E[i, :3, :3]
-            f = jnp.array([0.0, 0.0, 1.0]) * self.buoyancy[k]
-            W = W.at[i, 2].add(self.buoyancy[k]).at[i, 3:].add(R.T @ jnp.cross(R @ self.d_cob[k], f))
-        return W
+        f, lever = self._buoyancy(kin)
+        F = jnp.concatenate([f, jnp.zeros_like(f)], axis=1).reshape(-1)
+        return self.geometry.to_body_wrench(F, kin, n_bodies, point_offset=lever)
 
     def __call__(self, model, t, q, qd, z, kin, memory=()):
         comps, zd, _, _ = self._forces(t, kin, z, memory)
@@ -208,12 +210,9 @@ class Water(Load):
         H, _, _ = self.geometry.h_matrix(kin)
         comps["added_mass"] = -(self.A_inf @ (H @ qdd + hbias))
         comps.pop("added_mass_bias")
-        buoy = jnp.zeros_like(v).reshape(-1, 6)
-        for k, i in enumerate(self.geometry.body_index):
-            R = kin.E[i, :3, :3]
-            lever = R @ self.d_cob[k] - R @ self.geometry.d_ref[k]
-            f = jnp.array([0.0, 0.0, 1.0]) * self.buoyancy[k]
-            buoy = buoy.at[k, :3].set(f).at[k, 3:].set(jnp.cross(lever, f))
+        f, lever = self._buoyancy(kin)
+        rho = self.geometry._frames(kin)[2]
+        buoy = jnp.concatenate([f, jnp.cross(lever - rho, f)], axis=1)
         comps["buoyancy"] = buoy.reshape(-1)
         return {"eta": self._series(self.eta_values, t), "xi": self.geometry.xi(kin),
                 "hydro_force": jnp.stack([comps[c] for c in HYDRO_COMPONENTS])}
