@@ -15,11 +15,11 @@ from .dynamics import (coriolis_matrix, energies, evaluate, forward_dynamics,  #
                        mass_matrix, reaction_loads)
 from .kinematics import b_matrix, b_matrix_dot, body_poses, kinematics  # noqa: E402
 from .model import Model, compile_tree, load  # noqa: E402
-from .simulate import SimulationError, rollout, simulate  # noqa: E402
+from .simulate import SimulationError, StabilityWarning, rollout, simulate  # noqa: E402
 from .tree import ConfigError  # noqa: E402
 
 __all__ = ["ConfigError", "Model", "SimulationError", "b_matrix", "b_matrix_dot", "body_poses",
            "compile_tree", "config", "coriolis_matrix", "energies", "equilibrium", "evaluate",
            "forward_dynamics", "frequency_response", "natural_frequencies", "water",
            "integrators", "kinematics", "load", "loads", "mass_matrix", "reaction_loads",
-           "rollout", "se3", "simulate"]
+           "rollout", "se3", "simulate", "StabilityWarning"]

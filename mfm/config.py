@@ -38,14 +38,15 @@ import numpy as np
 from .tree import (JOINT_KINDS, PLANAR_DOFS, ROOT_DOFS, BodySpec, ConfigError, JointSpec,
                    check_inertia, tree_order)
 
-TOP_KEYS = {"model", "bodies", "hydro", "moorings"}
+TOP_KEYS = {"model", "bodies", "hydro", "moorings", "ptos"}
+PTO_KEYS = {"name", "kind", "body", "point", "anchor_body", "anchor", "mu", "beta", "kappa", "notes"}
 HYDRO_KEYS = {"database", "names", "body_coupling", "added_mass_inf", "rho", "g", "bem", "notes"}
 BODY_HYDRO_KEYS = {"body", "drag_coefficient", "drag_area", "notes"}
 MOORING_KEYS = {"name", "body", "point", "stiffness", "notes"}
 MODEL_KEYS = {"name", "gravity", "description"}
 BODY_KEYS = {"name", "mass", "com", "inertia", "principal_inertia", "radii_of_gyration", "parent",
              "joint", "hydro", "geometry", "notes"}
-JOINT_KEYS = {"type", "axis", "point", "dofs", "damping", "stiffness", "rest", "notes"}
+JOINT_KEYS = {"type", "axis", "point", "dofs", "damping", "stiffness", "rest", "locked", "notes"}
 
 
 def _unknown(keys, allowed, where):
@@ -125,6 +126,17 @@ def _parse_joint(raw: Any, where: str, is_root: bool) -> JointSpec:
             dofs = tuple(d for d in ROOT_DOFS if d in req)
     elif "dofs" in raw:
         raise ConfigError(f"{where}.dofs: only a free root takes dofs; remove the key")
+    locked = raw.get("locked", False)
+    if not isinstance(locked, bool):
+        raise ConfigError(f"{where}.locked: {locked!r} is not true or false")
+    if locked and kind not in ("revolute", "prismatic"):
+        raise ConfigError(f"{where}.locked: only a revolute or prismatic joint can be locked")
+    if locked:
+        # a locked hinge (seed 004, severe seas) is rigid at its q = 0 position: no coordinate
+        for key in ("damping", "stiffness", "rest"):
+            if key in raw:
+                raise ConfigError(f"{where}.{key}: a locked joint has no coordinate; remove the key")
+        return JointSpec(kind="fixed", axis=axis, point=point, locked=True)
     spec = JointSpec(kind=kind, axis=axis, point=point, dofs=dofs)
     n = spec.n_coordinates
     loads = {}
@@ -197,6 +209,40 @@ def _parse_hydro(raw, source):
                                      or not all(isinstance(n, str) for n in out["names"])):
         raise ConfigError(f"hydro.names: {out['names']!r} is not a list of body names (WAMIT "
                           "bodies in file order)")
+    return out
+
+
+def _parse_ptos(raw, names):
+    if not isinstance(raw, list):
+        raise ConfigError("ptos: expected [[ptos]] tables")
+    out = []
+    for i, p in enumerate(raw):
+        where = f"ptos[{i}]"
+        if not isinstance(p, dict):
+            raise ConfigError(f"{where}: expected a table")
+        _unknown(p, PTO_KEYS, where)
+        if p.get("kind", "hydraulic") != "hydraulic":
+            raise ConfigError(f"{where}.kind: {p.get('kind')!r}; accepted: 'hydraulic' (joint "
+                              "spring–dampers are set on the joint itself: damping, stiffness)")
+        if p.get("body") not in names:
+            raise ConfigError(f"{where}.body: {p.get('body')!r} is not a body; known bodies: {names}")
+        anchor_body = p.get("anchor_body")
+        if anchor_body is not None and anchor_body not in names:
+            raise ConfigError(f"{where}.anchor_body: {anchor_body!r} is not a body; known bodies: "
+                              f"{names} (leave it out to anchor in the inertial frame)")
+        for key in ("point", "anchor"):
+            if key not in p:
+                raise ConfigError(f"{where}.{key}: missing; a point [x, y, z] in m at q = 0")
+        vals = {}
+        for key in ("mu", "beta", "kappa"):
+            vals[key] = _number(p.get(key, 0.0), f"{where}.{key}")
+            if vals[key] < 0:
+                raise ConfigError(f"{where}.{key}: {vals[key]} is negative; give a value ≥ 0")
+        point, anchor = _vector(p["point"], 3, f"{where}.point"), _vector(p["anchor"], 3, f"{where}.anchor")
+        if np.linalg.norm(point - anchor) < 1e-9:
+            raise ConfigError(f"{where}: point and anchor coincide; a piston needs a length")
+        out.append({"name": str(p.get("name", f"pto{i}")), "body": p["body"], "point": point,
+                    "anchor_body": anchor_body, "anchor": anchor, **vals})
     return out
 
 
@@ -277,6 +323,7 @@ def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodyS
     if "hydro" in data:
         options["hydro"] = _parse_hydro(data["hydro"], source)
     options["moorings"] = _parse_moorings(data.get("moorings", []), [b.name for b in bodies])
+    options["ptos"] = _parse_ptos(data.get("ptos", []), [b.name for b in bodies])
     return options, ordered
 
 

@@ -74,6 +74,7 @@ class Model(eqx.Module):
     rest: jnp.ndarray
     hydro: object = eqx.field(static=True, default=None)
     moorings: object = None
+    ptos: object = None
 
     @property
     def n_bodies(self) -> int:
@@ -207,6 +208,24 @@ def load(path: str | Path, hydro: bool = True, body_coupling: bool | None = None
                                     for m, i in zip(options["moorings"], idx)])),
             p0=jnp.asarray(np.stack([m["point"] for m in options["moorings"]])),
             stiffness=jnp.asarray(np.stack([m["stiffness"] for m in options["moorings"]]))))
+    if options["ptos"]:
+        from .points import BodyPoints
+        from .ptos import HydraulicPTO
+
+        P = options["ptos"]
+        ia = tuple(model.body_index(p["body"]) for p in P)
+        ib = tuple(model.body_index(p["anchor_body"]) if p["anchor_body"] else 0 for p in P)
+        com = np.asarray(model.com)
+        model = dataclasses.replace(model, ptos=HydraulicPTO(
+            a=BodyPoints(body_index=ia, d_ref=jnp.asarray(np.stack([p["point"] - com[i] for p, i in zip(P, ia)])),
+                         ref0=jnp.asarray(np.stack([p["point"] for p in P]))),
+            b=BodyPoints(body_index=ib, d_ref=jnp.asarray(np.stack([p["anchor"] - com[i] for p, i in zip(P, ib)])),
+                         ref0=jnp.asarray(np.stack([p["anchor"] for p in P]))),
+            anchor=jnp.asarray(np.stack([p["anchor"] for p in P])),
+            mu=jnp.asarray([p["mu"] for p in P]), beta=jnp.asarray([p["beta"] for p in P]),
+            kappa=jnp.asarray([p["kappa"] for p in P]),
+            length0=jnp.asarray([np.linalg.norm(p["point"] - p["anchor"]) for p in P]),
+            b_fixed=tuple(p["anchor_body"] is None for p in P), names=tuple(p["name"] for p in P)))
     if hydro and "hydro" in options:
         from .water import load_hydro_spec
 

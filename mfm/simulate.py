@@ -9,6 +9,7 @@ from __future__ import annotations
 import collections
 import datetime
 import math
+import warnings
 from typing import Sequence
 
 import jax
@@ -25,6 +26,10 @@ from .model import Model
 
 # How many times each compiled function was traced (a retrace means a recompilation); tests use it.
 TRACES: collections.Counter = collections.Counter()
+
+
+class StabilityWarning(UserWarning):
+    """dt is beyond the integrator's stability limit for the model's shortest natural period."""
 
 
 class SimulationError(RuntimeError):
@@ -44,6 +49,8 @@ def model_loads(model: Model, sea=None, *, dt, duration, t0=0.0, ramp=0.0,
                                state_space_options=state_space_options))
     if model.moorings is not None:
         out.append(model.moorings)
+    if model.ptos is not None:
+        out.append(model.ptos)
     return tuple(out)
 
 
@@ -204,14 +211,22 @@ def _initial_vector(model: Model, value, what: str) -> np.ndarray:
     return arr
 
 
+@jax.jit
+def _stiffness_jacobian(model, loads, q):
+    """∂q̈/∂q at (q, q̇ = 0, z = 0, t = 0): compiled once per model and loads structure."""
+    TRACES["stiffness"] += 1
+    qd0 = jnp.zeros(model.n_coordinates)
+    mems = _init_memories(model, loads, 0.0, q, qd0, 1.0)
+    f = dynamics_function(model, loads, mems)
+    z0 = jnp.zeros(sum(ld.n_states for ld in loads))
+    return jax.jacfwd(lambda x: f(0.0, x, qd0, z0)[0])(q)
+
+
 def shortest_natural_period(model: Model, q, loads=()) -> float:
     """Estimate of the shortest natural period (s) at configuration q (q̇ = 0): from the
     generalised eigenproblem K v = ω² M* v with K = −∂q̈/∂q · M* linearised numerically by jax.
     Returns inf when nothing is restoring."""
-    f = dynamics_function(model, _as_loads(loads))
-    z0 = jnp.zeros(sum(ld.n_states for ld in _as_loads(loads)))
-    qd0 = jnp.zeros(model.n_coordinates)
-    Jq = jax.jacfwd(lambda x: f(0.0, x, qd0, z0)[0])(jnp.asarray(q, jnp.float64))
+    Jq = _stiffness_jacobian(model, _as_loads(loads), jnp.asarray(q, jnp.float64))
     lam = np.linalg.eigvals(-np.asarray(Jq)).real
     lam_max = lam.max() if lam.size else 0.0
     return math.inf if lam_max <= 0 else 2.0 * math.pi / math.sqrt(lam_max)
@@ -247,7 +262,7 @@ def _raise_nonfinite(model, integ, t, q, qd, dt, loads):
 def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="rk4",
              q0=None, qd0=None, loads=None, save_every: int = 1, t0: float = 0.0,
              ramp: float = 0.0, radiation: str = "convolution", memory: float | None = None,
-             state_space_options: dict | None = None) -> xr.Dataset:
+             state_space_options: dict | None = None, check_stability: bool = True) -> xr.Dataset:
     """Simulate a model in the time domain.
 
     Parameters
@@ -265,6 +280,8 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     radiation: ``"convolution"`` (direct, window T_K from the decay of K; ``memory`` overrides it,
         s), ``"state_space"`` (the passive fit of :mod:`hydro.statespace`, options in
         ``state_space_options``) or ``"none"`` (A∞ only).
+    check_stability: warn (:class:`StabilityWarning`) before running when dt exceeds the
+        integrator's stability limit at the shortest natural period of the model linearised at q0.
 
     Returns an :class:`xarray.Dataset` with ``q``, ``qd``, ``qdd`` (time, coordinate),
     ``body_position`` (time, body, axis) CoM in inertial axes, ``body_rotation`` (time, body, angle)
@@ -297,6 +314,15 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     integ = _integrators.get(integrator)
     q0 = _initial_vector(model, q0, "q0")
     qd0 = _initial_vector(model, qd0, "qd0")
+    if check_stability and math.isfinite(integ.stability_limit):
+        T_min = shortest_natural_period(model, q0, loads)
+        if math.isfinite(T_min) and 2 * math.pi * dt / T_min > integ.stability_limit:
+            warnings.warn(
+                f"dt = {dt:.4g} s is beyond the stability limit of {integ.name}: the shortest natural "
+                f"period of the model linearised at q0 is {T_min:.4g} s, ω dt = "
+                f"{2 * math.pi * dt / T_min:.3g} > {integ.stability_limit:.3g}. Use dt < "
+                f"{T_min * integ.stability_limit / (2 * math.pi):.3g} s or integrator='newmark'.",
+                StabilityWarning, stacklevel=2)
     out = rollout(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
                   save_every=save_every, t0=t0, record=True)
     t, q, qd, qdd, z, iters = (np.asarray(a) for a in out[:6])

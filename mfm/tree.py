@@ -45,6 +45,7 @@ class JointSpec:
     stiffness: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0))
     damping: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0))
     rest: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0))
+    locked: bool = False
 
     @property
     def n_coordinates(self) -> int:

@@ -40,62 +40,9 @@ import xarray as xr
 from . import se3
 from .loads import Load, LoadOutput
 from .model import Model
+from .points import BodyPoints
 
 MODES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
-
-
-def _cross_cols(a, J):
-    """a × J[:, k] for every column k: a (3,), J (3, m)."""
-    return jnp.stack([a[1] * J[2] - a[2] * J[1], a[2] * J[0] - a[0] * J[2], a[0] * J[1] - a[1] * J[0]])
-
-
-class HydroGeometry(eqx.Module):
-    """Where the hydro bodies sit on the tree: static body indices, arrays of offsets (body axes).
-    Every method works on all hydro bodies at once (gathers by the static indices)."""
-    body_index: tuple[int, ...] = eqx.field(static=True)
-    d_ref: jnp.ndarray      # (K, 3) reference point − CoM at q = 0
-    ref0: jnp.ndarray       # (K, 3) reference points at q = 0 (inertial)
-
-    def _frames(self, kin):
-        idx = np.asarray(self.body_index)
-        R = kin.E[idx, :3, :3]
-        rho = jnp.einsum("kab,kb->ka", R, self.d_ref)
-        return idx, R, rho
-
-    def h_matrix(self, kin):
-        """H (6K, n_q): ξ̇ = H q̇; and the rotation matrices (K, 3, 3), lever arms ρ (K, 3)."""
-        idx, R, rho = self._frames(kin)
-        w_cols = jnp.einsum("kab,kbq->kaq", R, kin.B[idx, 3:])     # inertial ω Jacobian
-        lin = kin.B[idx, :3] - jnp.cross(rho[:, :, None], w_cols, axis=1)   # v + ω × ρ
-        H = jnp.concatenate([lin, w_cols], axis=1)
-        return H.reshape(-1, H.shape[-1]), R, rho
-
-    def xi(self, kin):
-        """ξ (6K,): displacement of each reference point and its rotation vector."""
-        idx, R, rho = self._frames(kin)
-        r = kin.E[idx, :3, 3] + rho - self.ref0
-        return jnp.concatenate([r, jax.vmap(se3.so3_log)(R)], axis=1).reshape(-1)
-
-    def velocity_and_bias(self, kin):
-        """ξ̇ (6K,) and Ḣ q̇ (6K,) from the tree walk's velocities and velocity-product terms."""
-        idx, R, rho = self._frames(kin)
-        w = jnp.einsum("kab,kb->ka", R, kin.X[idx, 3:])
-        beta = jnp.einsum("kab,kb->ka", R, kin.bias[idx, 3:])     # d/dt(R ω_b) = R ω̇_b
-        v = jnp.concatenate([kin.X[idx, :3] + jnp.cross(w, rho), w], axis=1)
-        a = jnp.concatenate([kin.bias[idx, :3] + jnp.cross(beta, rho)
-                             + jnp.cross(w, jnp.cross(w, rho)), beta], axis=1)
-        return v.reshape(-1), a.reshape(-1)
-
-    def to_body_wrench(self, F, kin, n_bodies, point_offset=None):
-        """Loads F (6K: force at r_k, moment about r_k, inertial) → body wrenches (n, 6): force,
-        and moment about the CoM in body axes Rᵀ(m + ρ × f). ``point_offset`` (K, 3) replaces ρ
-        (the point of application relative to the CoM, inertial) when given."""
-        idx, R, rho = self._frames(kin)
-        rho = rho if point_offset is None else point_offset
-        F = F.reshape(-1, 6)
-        f, m = F[:, :3], F[:, 3:]
-        mb = jnp.einsum("kba,kb->ka", R, m + jnp.cross(rho, f))
-        return jnp.zeros((n_bodies, 6)).at[idx].add(jnp.concatenate([f, mb], axis=1))
 
 
 class Water(Load):
@@ -110,7 +57,7 @@ class Water(Load):
     origin ``eta_values`` (n,) on the same grid.
     Static: ``radiation`` ("convolution" | "state_space" | "none"), ``n_lags``.
     """
-    geometry: HydroGeometry
+    geometry: BodyPoints
     A_inf: jnp.ndarray
     C_wp: jnp.ndarray
     buoyancy: jnp.ndarray
@@ -444,8 +391,8 @@ def build_water(model: Model, spec: HydroSpec, sea, *, dt: float, duration: floa
     elif radiation == "convolution":
         W_current, W_lag = spec.kernel(dt, memory)
         n_lags = W_lag.shape[1]
-    geometry = HydroGeometry(body_index=spec.body_index, d_ref=jnp.asarray(spec.d_ref),
-                             ref0=jnp.asarray(spec.ref0))
+    geometry = BodyPoints(body_index=spec.body_index, d_ref=jnp.asarray(spec.d_ref),
+                          ref0=jnp.asarray(spec.ref0))
     f64 = lambda a: jnp.asarray(a, dtype=jnp.float64)  # noqa: E731
     return Water(geometry=geometry, A_inf=f64(A_inf), C_wp=f64(spec.C_wp),
                  buoyancy=f64(spec.rho * spec.g * spec.volume), d_cob=f64(spec.d_cob),

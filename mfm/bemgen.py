@@ -1,0 +1,394 @@
+"""``mfm hydro CONFIG``: the hydro database of a config, generated with capytaine from the hulls
+described in the config itself.
+
+A config describes each wet body's hull in a ``[bodies.geometry]`` table (the body spec of
+:mod:`hydro.geometry` without ``name``, which is the body's name)::
+
+    [[bodies]]
+    name = "float1"
+    com = [0.0, 0.0, -0.0634]
+    ...
+    [bodies.geometry]
+    shape = "cylinder"          # cylinder | sphere | hemisphere | mesh
+    radius = 0.10               # m
+    draft = 0.0746              # m
+    base = "flat"               # flat | hemisphere | rounded (+ knuckle_radius)
+    # origin = [x, y, 0]        # default [com_x, com_y, 0]: the axis under the CoM
+    # reference_point = [x, y, z]   # default: the body's CoM at q = 0
+    # file = "hull.stl"         # shape "mesh": relative to the config
+
+and the BEM settings in ``[hydro.bem]`` (every key checked, unknown keys are errors)::
+
+    [hydro]
+    database = "../hydro/data/m4_111.nc"   # where `mfm hydro` writes (relative to the config)
+    [hydro.bem]
+    omega_min = 0.25            # rad/s  } a linear grid of n_omega frequencies, or instead
+    omega_max = 25.0            # rad/s  }
+    n_omega = 100               #        }
+    # omega = [0.5, 1.0, 2.0]   # an explicit list (rad/s)
+    headings_deg = [0.0]        # wave headings, degrees (0 = waves travelling to +x); default [0]
+    water_depth = 1.0           # m, or "inf"; default "inf"
+    dx = 0.03                   # panel size, m (required)
+    lid = true                  # water-plane lid against irregular frequencies; default true
+    symmetry = "auto"           # auto | xOz | rotation | none; default auto
+    infinite_frequency = true   # also ω = ∞ (A∞, which mfm.load needs); default true
+    rho = 1000.0                # kg/m³; default [hydro] rho, else 1000
+    g = 9.81                    # m/s²; default [hydro] g, else [model] gravity
+    notes = "..."               # free text
+
+Bodies without a ``geometry`` table are dry (not in the database). The reference point of each
+body's 6 modes defaults to its CoM at q = 0: the MFM applies loads about the CoM, and
+:mod:`mfm.water` maps any reference point anyway.
+
+The file is written atomically (a temporary file, checked by loading it the way ``mfm.load``
+does, then renamed), so a failed or interrupted run never leaves a partial database.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import numbers
+import os
+import re
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from .config import load_config
+from .tree import ConfigError
+
+BEM_KEYS = {"omega_min", "omega_max", "n_omega", "omega", "headings_deg", "water_depth", "dx",
+            "lid", "symmetry", "infinite_frequency", "rho", "g", "notes"}
+GEOMETRY_KEYS = {"shape", "radius", "draft", "base", "knuckle_radius", "origin",
+                 "reference_point", "file"}
+SYMMETRIES = ("auto", "xOz", "rotation", "none")
+
+
+KH_MIN = 0.1  # capytaine 3.0 (Delhommeau): no finite-depth Green function below kh = 0.1
+
+# ------------------------------------------------------------------------------------------------
+# Settings
+
+
+def _wavenumber(omega: float, depth: float, g: float) -> float:
+    """k of ω² = g k tanh(k h) (Newton from the deep-water k)."""
+    k = max(omega * omega / g, omega / math.sqrt(g * depth))
+    for _ in range(50):
+        t = math.tanh(k * depth)
+        f = g * k * t - omega * omega
+        df = g * t + g * k * depth * (1.0 - t * t)
+        step = f / df
+        k -= step
+        if abs(step) < 1e-14 * k:
+            break
+    return k
+
+
+def _num(v, where, *, positive=True, integer=False):
+    if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
+        raise ConfigError(f"{where}: {v!r} is not a finite number")
+    if integer and int(v) != v:
+        raise ConfigError(f"{where}: {v!r} is not a whole number")
+    if positive and v <= 0:
+        raise ConfigError(f"{where}: {v!r} must be > 0")
+    return int(v) if integer else float(v)
+
+
+def _bool(v, where):
+    if not isinstance(v, bool):
+        raise ConfigError(f"{where}: {v!r} is not true or false")
+    return v
+
+
+def bem_settings(raw: dict | None, *, hydro: dict | None = None, gravity: float = 9.81,
+                 overrides: dict | None = None) -> dict:
+    """Validate the ``[hydro.bem]`` table (plus ``overrides``) → the keyword arguments of
+    ``hydro.bem.solve`` (omega in rad/s, wave_directions in rad, ...) and a JSON-able record
+    of the settings as given (``"record"``)."""
+    raw = dict(raw or {})
+    if overrides:
+        ov = dict(overrides)
+        if "omega" in ov:
+            for k in ("omega_min", "omega_max", "n_omega"):
+                raw.pop(k, None)
+        if any(k in ov for k in ("omega_min", "omega_max", "n_omega")):
+            raw.pop("omega", None)
+        bad = sorted(set(ov) - BEM_KEYS)
+        if bad:
+            raise ConfigError(f"overrides: unknown key(s) {bad}; accepted keys: {sorted(BEM_KEYS)}")
+        raw.update(ov)
+    bad = sorted(set(raw) - BEM_KEYS)
+    if bad:
+        raise ConfigError(f"hydro.bem: unknown key(s) {bad}; accepted keys: {sorted(BEM_KEYS)}")
+    w = "hydro.bem"
+    grid = [k for k in ("omega_min", "omega_max", "n_omega") if k in raw]
+    if "omega" in raw:
+        if grid:
+            raise ConfigError(f"{w}: give either omega (a list, rad/s) or omega_min, omega_max, "
+                              f"n_omega (a linear grid), not both; found omega and {grid}")
+        om = raw["omega"]
+        if not isinstance(om, list) or not om:
+            raise ConfigError(f"{w}.omega: {om!r} is not a non-empty list of frequencies (rad/s)")
+        omega = np.array([_num(v, f"{w}.omega[{i}]") for i, v in enumerate(om)])
+    else:
+        if len(grid) != 3:
+            missing = sorted({"omega_min", "omega_max", "n_omega"} - set(grid))
+            raise ConfigError(f"{w}: missing {missing}; give omega_min, omega_max (rad/s) and "
+                              f"n_omega for a linear grid, or omega = [...]")
+        lo = _num(raw["omega_min"], f"{w}.omega_min")
+        hi = _num(raw["omega_max"], f"{w}.omega_max")
+        n = _num(raw["n_omega"], f"{w}.n_omega", integer=True)
+        if hi < lo or (n > 1 and hi == lo):
+            raise ConfigError(f"{w}.omega_max: {hi} must be > omega_min ({lo})")
+        omega = np.linspace(lo, hi, n)
+    hd = raw.get("headings_deg", [0.0])
+    if isinstance(hd, numbers.Real) and not isinstance(hd, bool):
+        hd = [hd]
+    if not isinstance(hd, list) or not hd:
+        raise ConfigError(f"{w}.headings_deg: {hd!r} is not a non-empty list of headings (degrees)")
+    headings = [_num(v, f"{w}.headings_deg[{i}]", positive=False) for i, v in enumerate(hd)]
+    depth = raw.get("water_depth", "inf")
+    if isinstance(depth, str):
+        if depth.strip().lower() not in ("inf", "infinite", "infinity"):
+            raise ConfigError(f"{w}.water_depth: {depth!r}; give a depth in m or \"inf\"")
+        depth = math.inf
+    else:
+        depth = _num(depth, f"{w}.water_depth")
+    if "dx" not in raw:
+        raise ConfigError(f"{w}.dx: missing; the panel size in m (e.g. 0.03 for the M4 floats)")
+    dx = _num(raw["dx"], f"{w}.dx")
+    lid = _bool(raw.get("lid", True), f"{w}.lid")
+    inf = _bool(raw.get("infinite_frequency", True), f"{w}.infinite_frequency")
+    sym = raw.get("symmetry", "auto")
+    if sym not in SYMMETRIES:
+        raise ConfigError(f"{w}.symmetry: {sym!r}; accepted: {list(SYMMETRIES)}")
+    hydro = hydro or {}
+    rho = raw.get("rho", hydro.get("rho") if hydro.get("rho") is not None else 1000.0)
+    g = raw.get("g", hydro.get("g") if hydro.get("g") is not None else gravity)
+    rho = _num(rho, f"{w}.rho")
+    g = _num(g, f"{w}.g")
+    if math.isfinite(depth):
+        w0 = float(np.min(omega))
+        kh = _wavenumber(w0, depth, g) * depth
+        if kh < KH_MIN:
+            w_min = math.sqrt(g * KH_MIN / depth * math.tanh(KH_MIN))
+            key = "omega" if "omega" in raw else "omega_min"
+            raise ConfigError(f"{w}.{key}: ω = {w0:g} rad/s gives kh = {kh:.3g} at water_depth "
+                              f"{depth:g} m; capytaine's finite-depth Green function needs "
+                              f"kh >= {KH_MIN} (ω >= {w_min:.4g} rad/s here): raise the lowest "
+                              f"frequency")
+    record = {k: raw[k] for k in sorted(raw)}
+    kwargs = {"omega": omega, "dx": dx, "wave_directions": [math.radians(b) for b in headings],
+              "water_depth": depth, "rho": rho, "g": g, "lid": lid, "symmetry": sym,
+              "infinite_frequency": inf}
+    return {"kwargs": kwargs, "record": record, "headings_deg": headings}
+
+
+# ------------------------------------------------------------------------------------------------
+# Geometry
+
+
+def _geometry_error(msg: str, where: str) -> str:
+    """hydro.geometry's message with ``body spec #i`` replaced by ``bodies[i] ('name').geometry.<key>``."""
+    text = re.sub(r"^body spec(?: #\d+)?: ", "", msg)
+    m = re.search(r"'([A-Za-z_]+)'", text)
+    key = m.group(1) if m and m.group(1) in GEOMETRY_KEYS else None
+    return f"{where}.geometry{'.' + key if key else ''}: {text}"
+
+
+def body_specs(config_path, raw: dict | None = None, bodies=None) -> list[dict]:
+    """The hydro.geometry body specs of a config's wet bodies (those with a ``geometry`` table),
+    in the order of the config's ``[[bodies]]``, normalised (defaults filled in)."""
+    from hydro import geometry as geo
+
+    config_path = Path(config_path)
+    if raw is None:
+        raw = tomllib.loads(config_path.read_text())
+    if bodies is None:
+        bodies = load_config(config_path)[1]
+    com = {b.name: np.asarray(b.com, dtype=float) for b in bodies}
+    specs = []
+    for i, rb in enumerate(raw.get("bodies", [])):
+        if "geometry" not in rb:
+            continue
+        name = rb["name"]
+        where = f"bodies[{i}] ({name!r})"
+        gtab = rb["geometry"]
+        if not isinstance(gtab, dict):
+            raise ConfigError(f"{where}.geometry: expected a table such as {{ shape = \"cylinder\", "
+                              f"radius = 0.1, draft = 0.07, base = \"flat\" }}")
+        bad = sorted(set(gtab) - GEOMETRY_KEYS)
+        if bad:
+            raise ConfigError(f"{where}.geometry.{bad[0]}: unknown key(s) {bad}; accepted keys: "
+                              f"{sorted(GEOMETRY_KEYS)} (the name is the body's)")
+        c = com[name]
+        spec = dict(gtab)
+        spec["name"] = name
+        spec.setdefault("origin", [float(c[0]), float(c[1]), 0.0])
+        spec.setdefault("reference_point", [float(v) for v in c])
+        if spec.get("shape") == "mesh" and isinstance(spec.get("file"), str):
+            f = Path(spec["file"])
+            spec["file"] = str(f if f.is_absolute() else config_path.parent / f)
+        try:
+            specs.append(geo.normalize_spec(spec, i))
+        except (ValueError, TypeError) as e:
+            raise ConfigError(_geometry_error(str(e), where)) from None
+    if not specs:
+        raise ConfigError(f"{config_path}: no body has a [bodies.geometry] table; `mfm hydro` needs "
+                          "the hull of each wet body (see mfm.bemgen)")
+    try:
+        geo.normalize_specs(specs)
+    except ValueError as e:
+        raise ConfigError(f"bodies: {e}") from None
+    return specs
+
+
+# ------------------------------------------------------------------------------------------------
+# Generation
+
+
+def _sha256(path) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def _check_database(path: Path, config_path: Path, options: dict, bodies) -> None:
+    """Load ``path`` the way ``mfm.load(config)`` does (open_any_database → from_capytaine →
+    schema checks → the config's bodies on the tree)."""
+    from .model import compile_tree
+    from .water import load_hydro_spec
+
+    model = compile_tree(bodies, name=options["name"], gravity=options["gravity"])
+    hyd = dict(options.get("hydro") or {})
+    hyd["database"] = str(Path(path).resolve())
+    load_hydro_spec(model, bodies, hyd, Path(config_path).parent)
+
+
+def _check_finite(ds, infinite_frequency) -> None:
+    """Every radiation coefficient finite, and the excitation at every finite ω: capytaine logs
+    and skips a problem that fails (e.g. a missing optional dependency) and leaves NaN there."""
+    bad = []
+    for v in ("added_mass", "radiation_damping"):
+        a = np.asarray(ds[v].values)
+        if not np.all(np.isfinite(a)):
+            w = ds["omega"].values[~np.all(np.isfinite(a.reshape(a.shape[0], -1)), axis=1)]
+            bad.append(f"{v} at ω = {w[:5].tolist()}{' ...' if len(w) > 5 else ''}")
+    finite = np.isfinite(ds["omega"].values)
+    x = np.asarray(ds["excitation_force"].values)[finite]
+    if not np.all(np.isfinite(x)):
+        bad.append("excitation_force at finite ω")
+    if bad:
+        raise RuntimeError("mfm hydro: the BEM results hold NaN (capytaine skipped problems; see its "
+                           "warnings above): " + "; ".join(bad) + ". Nothing was written; if "
+                           "hydro.bem cached this result, delete the cache file or pass cache=False.")
+
+
+def _human(nbytes: int) -> str:
+    return f"{nbytes / 1e6:.2f} MB" if nbytes >= 1e5 else f"{nbytes / 1e3:.1f} kB"
+
+
+def generate(config_path, *, out=None, force=False, progress=True, n_threads=None,
+             overrides=None, cache=True, cache_dir=None) -> Path:
+    """Solve the BEM of a config's hulls and write its hydro database.
+
+    config_path: a TOML config whose wet bodies carry ``[bodies.geometry]`` and whose ``[hydro]``
+        table has ``database`` (the output, relative to the config) and ``bem`` (the settings).
+    out: write here instead of ``[hydro] database`` (a ``.nc`` path).
+    force: overwrite an existing file. Without it an existing file made from the same config
+        contents and settings is kept ("up to date"); any other existing file is an error.
+    progress: tqdm bar over the frequencies. n_threads: capytaine threads (None: all cores).
+    overrides: dict of ``[hydro.bem]`` keys replacing the config's (e.g. a coarse ``dx`` for a
+        test, or ``omega``); recorded in the file.
+    cache, cache_dir: the result cache of ``hydro.bem.solve``.
+
+    Returns the path written. Prints a one-line summary.
+    """
+    from hydro import bem
+
+    config_path = Path(config_path)
+    options, bodies = load_config(config_path)
+    text = config_path.read_text()
+    raw = tomllib.loads(text)
+    hydro = options.get("hydro") or {}
+    out_given = out is not None
+    if out is None:
+        if not hydro.get("database"):
+            raise ConfigError(f"{config_path}: no [hydro] database path; add [hydro] database = "
+                              "\"<file>.nc\" (relative to the config) or pass out=")
+        out = Path(os.path.normpath(config_path.parent / hydro["database"]))
+    out = Path(out)
+    if out.suffix != ".nc":
+        raise ConfigError(f"out: {str(out)!r}: `mfm hydro` writes NetCDF; give a path ending in .nc")
+    settings = bem_settings(hydro.get("bem"), hydro=hydro, gravity=options["gravity"],
+                            overrides=overrides)
+    specs = body_specs(config_path, raw, bodies)
+    kw = settings["kwargs"]
+    config_sha = hashlib.sha256(text.encode()).hexdigest()
+    key = hashlib.sha256(json.dumps({"config": config_sha, "overrides": overrides or {}},
+                                    sort_keys=True, default=str).encode()).hexdigest()
+
+    if out.exists() and not force:
+        stored = None
+        try:
+            import xarray as xr
+            with xr.open_dataset(out) as f:
+                stored = f.attrs.get("mfm_generate_key")
+        except Exception:  # noqa: BLE001 - unreadable: treat as foreign
+            pass
+        if stored == key:
+            print(f"mfm hydro: {out} is up to date (same config contents and settings); "
+                  f"use --force to solve again")
+            return out
+        raise FileExistsError(f"mfm hydro: {str(out)!r} exists and was not made from this config "
+                              f"as it is now; use --force to overwrite it")
+
+    if n_threads is not None:
+        try:
+            import threadpoolctl  # noqa: F401 - capytaine needs it to honour n_threads
+        except ImportError:
+            # capytaine would skip every problem (a logged warning each) and return NaNs
+            print(f"mfm hydro: n_threads={n_threads} needs the package threadpoolctl, which is "
+                  f"missing; using the default threads (set OMP_NUM_THREADS to limit them)")
+            n_threads = None
+    t0 = time.perf_counter()
+    ds = bem.solve(specs, n_threads=n_threads, progress=progress, cache=cache,
+                   cache_dir=cache_dir, **kw)
+    wall = time.perf_counter() - t0
+    _check_finite(ds, kw["infinite_frequency"])
+    command = f"mfm hydro {config_path}" + (f" --out {out}" if out_given else "")
+    ds.attrs.update({
+        "generated_by": command,
+        "mfm_config": str(config_path),
+        "mfm_config_sha256": config_sha,
+        "mfm_bem_settings": json.dumps(settings["record"], sort_keys=True, default=str),
+        "mfm_overrides": json.dumps(overrides or {}, sort_keys=True, default=str),
+        "mfm_generate_key": key,
+        "mfm_headings_deg": json.dumps(settings["headings_deg"]),
+        "mfm_wall_time_s": round(wall, 1),
+        "mfm_n_threads": str(n_threads),
+    })
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(f".{out.stem}.tmp{os.getpid()}.nc")
+    try:
+        bem.save(ds, tmp)
+        if kw["infinite_frequency"]:
+            _check_database(tmp, config_path, options, bodies)
+        else:
+            print("mfm hydro: note: infinite_frequency = false: no A∞, so mfm.load cannot use this "
+                  "file (a capytaine dataset for other uses)")
+        os.replace(tmp, out)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    n_w = int(np.isfinite(ds["omega"].values).sum())
+    inf = " + ∞" if kw["infinite_frequency"] else ""
+    depth = "inf" if math.isinf(kw["water_depth"]) else f"{kw['water_depth']:g} m"
+    panels = int(ds.attrs["nb_hull_panels"]) + int(ds.attrs["nb_lid_panels"])
+    how = "cache hit" if ds.attrs.get("cache_status") == "hit" else f"{wall:.1f} s"
+    print(f"mfm hydro: wrote {out} ({len(specs)} bodies, {n_w} ω{inf}, "
+          f"{len(settings['headings_deg'])} heading(s), dx {kw['dx']:g} m, depth {depth}, "
+          f"{panels} panels, symmetry {ds.attrs['symmetry_used']}, {how}, "
+          f"{_human(out.stat().st_size)})")
+    return out
