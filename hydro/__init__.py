@@ -7,17 +7,19 @@ import jax
 
 jax.config.update("jax_enable_x64", True)
 
-# helper B
-from hydro.waves import (  # noqa: E402
+# sea states, spectra and excitation time series
+from hydro.waves import (  # noqa: E402,F401
     Jonswap, MeasuredElevation, PiersonMoskowitz, Regular, Spreading, UserSpectrum, WaveComponents,
     elevation, ramp, wavenumber,
 )
-from hydro.excitation import excitation_coefficients, excitation_dataarray, excitation_time_series  # noqa: E402
+from hydro.excitation import (  # noqa: E402,F401
+    excitation_coefficients, excitation_dataarray, excitation_time_series,
+)
 
-# helper C: BEM databases from capytaine (capytaine itself is imported lazily inside them).
+# BEM databases from capytaine (capytaine itself is imported lazily inside them).
 from hydro import bem, geometry  # noqa: E402,F401
 
-# helper A: database schema, WAMIT reader, radiation memory (K(t), Ogilvie), state space.
+# database schema, WAMIT reader, radiation memory (K(t), Ogilvie), state space.
 from hydro import database, radiation, statespace, wamit  # noqa: E402,F401
 from hydro.database import from_capytaine, open_database, select_bodies, to_netcdf, validate  # noqa: E402,F401
 from hydro.wamit import read_wamit  # noqa: E402,F401

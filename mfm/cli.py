@@ -25,7 +25,7 @@ def _pairs(items, what):
 def cmd_info(args):
     import mfm
 
-    model = mfm.load(args.config)
+    model = mfm.load(args.config, hydro=False)
     print(f"{model.name}: {model.n_bodies} bodies, {model.n_coordinates} coordinates, "
           f"gravity {float(model.gravity)} m/s²")
     print("\ntree:")
@@ -147,7 +147,7 @@ def cmd_plot(args):
     import mfm
     from mfm.plotting import plot_layout
 
-    model = mfm.load(args.config)
+    model = mfm.load(args.config, hydro=False)
     fig = plot_layout(model)
     out = Path(args.out or Path(args.config).with_suffix(".png").name)
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -32,12 +32,10 @@ from pathlib import Path
 from typing import Sequence
 
 import equinox as eqx
-import jax
 import jax.numpy as jnp
 import numpy as np
 import xarray as xr
 
-from . import se3
 from .loads import Load, LoadOutput
 from .model import Model
 from .points import BodyPoints
@@ -299,6 +297,14 @@ class HydroSpec:
         return float(om[idx[0]]), float(om[idx[-1]])
 
     def state_space(self, **options):
+        """The passive state-space fit of :mod:`hydro.statespace` (cached per options). The fit
+        band defaults to (0.2 ω_c, 2 ω_c) with the Froude frequency ω_c = √(g/L), L the cube root
+        of the largest displaced volume: RM3's (0.2, 2.0) rad/s at full scale, 1.2–12 rad/s for the
+        M4 model, so each database is fitted where its waves act (clipped to its grid)."""
+        if "omega_fit" not in options:
+            om = np.asarray(self.db["omega"].values)
+            wc = math.sqrt(self.g / float(np.max(self.volume)) ** (1.0 / 3.0))
+            options["omega_fit"] = (max(0.2 * wc, float(om[0])), min(2.0 * wc, float(om[-1])))
         key = ("ss", tuple(sorted(options.items())))
         if key not in self._cache:
             from hydro.statespace import fit_state_space

@@ -1,6 +1,4 @@
 """The command line and the notebooks (executed in smoke mode so they never rot)."""
-import os
-from pathlib import Path
 
 import nbformat
 import pytest

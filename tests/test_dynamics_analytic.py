@@ -2,8 +2,6 @@
 import jax
 import jax.numpy as jnp
 import numpy as np
-import pytest
-from scipy.spatial.transform import Rotation
 
 import mfm
 from mfm.config import parse_config

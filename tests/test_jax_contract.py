@@ -7,7 +7,7 @@ from conftest import CONFIGS
 import mfm
 from mfm.simulate import TRACES
 
-MODEL = mfm.load(CONFIGS / "m4_111.toml")
+MODEL = mfm.load(CONFIGS / "m4_111.toml", hydro=False)  # mechanics in vacuum
 Q0 = np.array([0.0, 0.0, 0.05, -0.1])
 QD0 = np.array([0.0, 0.0, 0.0, 0.8])  # a hinge rate, so that the damper works
 DT, N = 0.005, 200

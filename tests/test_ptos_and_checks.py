@@ -1,6 +1,5 @@
 """PTO laws (locked hinge, hydraulic μ/β/κ), moorings, stability warnings, natural frequencies,
 joint reactions with water, and the hydro command line."""
-import math
 import warnings
 
 import numpy as np

@@ -7,7 +7,7 @@ from conftest import CONFIGS
 import mfm
 from mfm.config import parse_config
 
-MODEL = mfm.load(CONFIGS / "m4_134.toml")
+MODEL = mfm.load(CONFIGS / "m4_134.toml", hydro=False)  # mechanics in vacuum
 
 
 def test_dataset_contents_and_netcdf_roundtrip(tmp_path):
