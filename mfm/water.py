@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Sequence
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 import xarray as xr
@@ -48,7 +49,9 @@ class Water(Load):
 
     Arrays (float64): ``A_inf`` (6K, 6K); ``C_wp`` (6K, 6K); ``buoyancy`` (K,) = ρ g V, N;
     ``d_cob`` (K, 3) CoB − CoM at q = 0; ``drag`` (K, 3) = ½ ρ C_D A per inertial axis;
-    ``ss_A``, ``ss_B``, ``ss_C`` the radiation state space (empty when unused); ``W_current``
+    ``ss_p``, ``ss_r`` the radiation state space in modal form (one complex state per pole of
+    each fitted entry, conjugate pairs folded: ż = p z + ξ̇_j, F_i = −Σ Re(r z); O(n_x) per
+    evaluation instead of a dense A); ``W_current``
     (3, 6K, 6K) and ``W_lag`` (3, N, 6K, 6K) the convolution weights per stage offset 0, dt/2, dt
     (:meth:`HydroSpec.kernel`); the excitation
     ``exc_values`` (n, 6K) on the grid ``exc_t0 + j·exc_step`` and the wave elevation at the
@@ -61,9 +64,8 @@ class Water(Load):
     buoyancy: jnp.ndarray
     d_cob: jnp.ndarray
     drag: jnp.ndarray
-    ss_A: jnp.ndarray
-    ss_B: jnp.ndarray
-    ss_C: jnp.ndarray
+    ss_p: jnp.ndarray       # (n_x,) complex poles (modal form), as (re, im) pairs: (n_x, 2)
+    ss_r: jnp.ndarray       # (n_x, 2) residues (re, im), conjugate pairs folded (×2)
     W_current: jnp.ndarray
     W_lag: jnp.ndarray
     dt: jnp.ndarray
@@ -74,10 +76,12 @@ class Water(Load):
     radiation: str = eqx.field(static=True)
     n_lags: int = eqx.field(static=True)
     dofs: tuple[str, ...] = eqx.field(static=True)
+    ss_in: tuple[int, ...] = eqx.field(static=True, default=())    # input dof j of each state
+    ss_out: tuple[int, ...] = eqx.field(static=True, default=())   # output dof i of each state
 
     @property
     def n_states(self) -> int:
-        return self.ss_A.shape[0] if self.radiation == "state_space" else 0
+        return 2 * len(self.ss_in) if self.radiation == "state_space" else 0
 
     # -- convolution memory: ξ̇ at the step times t_n, t_{n−1}, … (newest first)
     def init_memory(self, model, t0, q0, qd0, dt):
@@ -106,7 +110,14 @@ class Water(Load):
     def radiation_force(self, t, v, z, memory):
         """−∫K ξ̇: convolution over the history (trapezoidal in the lag) or −C z (state space)."""
         if self.radiation == "state_space":
-            return -(self.ss_C @ z), self.ss_A @ z + self.ss_B @ v
+            n = len(self.ss_in)
+            zr, zi = z[:n], z[n:]
+            pr, pi = self.ss_p[:, 0], self.ss_p[:, 1]
+            u = v[np.asarray(self.ss_in)]
+            zd = jnp.concatenate([pr * zr - pi * zi + u, pr * zi + pi * zr])
+            out = self.ss_r[:, 0] * zr - self.ss_r[:, 1] * zi
+            F = jax.ops.segment_sum(out, jnp.asarray(np.asarray(self.ss_out)), num_segments=v.shape[0])
+            return -F, zd
         if self.radiation == "none":
             return jnp.zeros_like(v), None
         t_n, hist = memory
@@ -385,14 +396,22 @@ def build_water(model: Model, spec: HydroSpec, sea, *, dt: float, duration: floa
         comps = sea.components(water_depth=spec.water_depth, g=spec.g)
         exc = excitation_time_series(spec.database(), comps, t_grid, ramp_duration=ramp)
         eta = np.asarray(elevation(comps, t_grid, ramp_duration=ramp)).reshape(-1)
-    empty = np.zeros((0, 0))
-    ss_A, ss_B, ss_C = empty, np.zeros((0, nd)), np.zeros((nd, 0))
+    ss_p, ss_r, ss_in, ss_out = np.zeros((0, 2)), np.zeros((0, 2)), (), ()
     W_current, W_lag = np.zeros((3, nd, nd)), np.zeros((3, 1, nd, nd))
     A_inf = spec.added_mass_inf()
     n_lags = 1
     if radiation == "state_space":
         ss = spec.state_space(**(state_space_options or {}))
-        ss_A, ss_B, ss_C = ss.A, ss.B, ss.C
+        poles, res, ins, outs = [], [], [], []
+        for (i, j), P, R in zip(ss.entries, ss.poles, ss.residues):
+            keep = P.imag >= 0.0                      # one of each conjugate pair, residue × 2
+            poles.append(P[keep])
+            res.append(R[keep] * np.where(P[keep].imag > 0.0, 2.0, 1.0))
+            ins += [j] * int(keep.sum())
+            outs += [i] * int(keep.sum())
+        P, R = np.concatenate(poles), np.concatenate(res)
+        ss_p, ss_r = np.stack([P.real, P.imag], 1), np.stack([R.real, R.imag], 1)
+        ss_in, ss_out = tuple(ins), tuple(outs)
         A_inf = np.asarray(ss.added_mass_inf) * spec.mask
     elif radiation == "convolution":
         W_current, W_lag = spec.kernel(dt, memory)
@@ -402,7 +421,7 @@ def build_water(model: Model, spec: HydroSpec, sea, *, dt: float, duration: floa
     f64 = lambda a: jnp.asarray(a, dtype=jnp.float64)  # noqa: E731
     return Water(geometry=geometry, A_inf=f64(A_inf), C_wp=f64(spec.C_wp),
                  buoyancy=f64(spec.rho * spec.g * spec.volume), d_cob=f64(spec.d_cob),
-                 drag=f64(spec.drag), ss_A=f64(ss_A), ss_B=f64(ss_B), ss_C=f64(ss_C),
+                 drag=f64(spec.drag), ss_p=f64(ss_p), ss_r=f64(ss_r), ss_in=ss_in, ss_out=ss_out,
                  W_current=f64(W_current), W_lag=f64(W_lag), dt=f64(dt), exc_t0=f64(t0), exc_step=f64(0.5 * dt),
                  exc_values=f64(exc), eta_values=f64(eta), radiation=radiation, n_lags=n_lags,
                  dofs=spec.dofs)
