@@ -109,7 +109,9 @@ class Beeman:
 
     q̈ₙ₊₁ depends on q̇ₙ₊₁, so (52b) is iterated from the predictor q̇ₙ + dt q̈ₙ until the relative
     change of q̈ₙ₊₁ is below ``tol`` (the seed uses 1 %) or ``max_iter`` is reached. z advances by
-    the trapezoidal rule inside the same iteration. Second order. The iteration is a while loop:
+    the trapezoidal rule inside the same iteration; the current iterate of q̈ is passed to f, so
+    acceleration terms on the right-hand side (the seed's added mass) are iterated with it.
+    Second order. The iteration is a while loop:
     forward-mode differentiable, not reverse-mode (use RK4 or Newmark for gradients).
     """
     tol: float = 0.01
@@ -126,7 +128,7 @@ class Beeman:
         q = s.q + dt * (s.qd + 0.5 * dt * s.qdd)
         qd0 = s.qd + dt * s.qdd
         z0 = s.z + dt * s.zd
-        a0, zd0 = f(t, q, qd0, z0)
+        a0, zd0 = f(t, q, qd0, z0, s.qdd)
 
         def cond(c):
             k, a, _, _, _, change = c
@@ -136,7 +138,7 @@ class Beeman:
             k, a, zd, _, _, _ = c
             qd = s.qd + 0.5 * dt * (s.qdd + a)
             z = s.z + 0.5 * dt * (s.zd + zd)
-            a_new, zd_new = f(t, q, qd, z)
+            a_new, zd_new = f(t, q, qd, z, a)
             return k + 1, a_new, zd_new, qd, z, _rel_change(a_new, a)
 
         k, a, zd, qd, z, _ = jax.lax.while_loop(

@@ -2,7 +2,7 @@
 
 A load is an immutable pytree (``equinox.Module``) called as
 
-    load(model, t, q, qd, z, kin, memory) -> LoadOutput
+    load(model, t, q, qd, z, kin, memory, qdd_guess=None) -> LoadOutput
 
 with ``kin`` the :class:`~mfm.kinematics.Kinematics` at (q, q̇), ``z`` its own first-order states
 (``n_states`` of them, e.g. radiation state-space states) and ``memory`` its discrete memory (e.g.
@@ -11,7 +11,9 @@ time step by ``update_memory``; read-only within a step. It returns Cartesian bo
 ``body`` (n, 6: force in inertial axes, moment about the CoM in body axes), generalised loads
 ``tau`` (n_q), the state derivative ``zd`` and an optional acceleration-proportional matrix
 ``mass`` (n_q, n_q) that the solver moves to the left-hand side. Loads enter the equations of
-motion as ``Bᵀ body + tau``.
+motion as ``Bᵀ body + tau``. ``qdd_guess`` is the current acceleration iterate of a
+predictor–corrector integrator (Beeman), for loads that put acceleration terms on the right-hand
+side instead (the seed 001 scheme); None otherwise.
 """
 from __future__ import annotations
 
@@ -59,7 +61,7 @@ class Load(eqx.Module):
         """Add this load's recorded diagnostics to the result dataset (with dims and units)."""
         return ds
 
-    def __call__(self, model, t, q, qd, z, kin, memory=()) -> LoadOutput:  # pragma: no cover
+    def __call__(self, model, t, q, qd, z, kin, memory=(), qdd_guess=None) -> LoadOutput:  # pragma: no cover
         raise NotImplementedError
 
 
@@ -68,7 +70,7 @@ class BodyWrench(Load):
     (N m, body axes, about the CoM)."""
     wrench: jnp.ndarray
 
-    def __call__(self, model, t, q, qd, z, kin, memory=()):
+    def __call__(self, model, t, q, qd, z, kin, memory=(), qdd_guess=None):
         return LoadOutput(body=self.wrench)
 
 
@@ -79,7 +81,7 @@ class CoordinateForceSeries(Load):
     step: jnp.ndarray
     values: jnp.ndarray
 
-    def __call__(self, model, t, q, qd, z, kin, memory=()):
+    def __call__(self, model, t, q, qd, z, kin, memory=(), qdd_guess=None):
         s = (t - self.t0) / self.step
         n = self.values.shape[0]
         k = jnp.clip(jnp.floor(s), 0, n - 2).astype(int)
@@ -96,7 +98,7 @@ class PointSprings(Load):
     p0: jnp.ndarray
     stiffness: jnp.ndarray
 
-    def __call__(self, model, t, q, qd, z, kin, memory=()):
+    def __call__(self, model, t, q, qd, z, kin, memory=(), qdd_guess=None):
         W = jnp.zeros((model.n_bodies, 6))
         for k, i in enumerate(self.body_index):
             R = kin.E[i, :3, :3]

@@ -51,7 +51,7 @@ class HydraulicPTO(Load):
         gdot_qd = jnp.sum(u * (aa - ab), axis=1) + (jnp.sum(dv * dv, axis=1) - wd**2) / L
         return L - self.length0, wd, g, gdot_qd, u
 
-    def __call__(self, model, t, q, qd, z, kin, memory=()):
+    def __call__(self, model, t, q, qd, z, kin, memory=(), qdd_guess=None):
         w, wd, g, gdot_qd, _ = self._kinematics(kin)
         f = self.mu * gdot_qd + self.beta * wd + self.kappa * w
         return LoadOutput(tau=-(g.T @ f), mass=jnp.einsum("p,pi,pj->ij", self.mu, g, g))

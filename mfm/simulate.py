@@ -19,7 +19,7 @@ import xarray as xr
 
 from . import integrators as _integrators
 from . import se3
-from .dynamics import energies, evaluate, reaction_loads
+from .dynamics import energies, evaluate, mass_matrix, reaction_loads
 from .kinematics import kinematics
 from .loads import Load
 from .model import Model
@@ -37,7 +37,8 @@ class SimulationError(RuntimeError):
 
 
 def model_loads(model: Model, sea=None, *, dt, duration, t0=0.0, ramp=0.0,
-                radiation="convolution", memory=None, state_space_options=None) -> tuple[Load, ...]:
+                radiation="convolution", memory=None, state_space_options=None,
+                added_mass="lhs") -> tuple[Load, ...]:
     """The loads a model carries itself: its moorings and, with a [hydro] config, its water for
     this sea and time grid (see :func:`mfm.water.build_water`). Pass them to :func:`rollout`."""
     out = []
@@ -46,7 +47,7 @@ def model_loads(model: Model, sea=None, *, dt, duration, t0=0.0, ramp=0.0,
 
         out.append(build_water(model, model.hydro, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                                radiation=radiation, memory=memory,
-                               state_space_options=state_space_options))
+                               state_space_options=state_space_options, added_mass=added_mass))
     if model.moorings is not None:
         out.append(model.moorings)
     if model.ptos is not None:
@@ -67,7 +68,7 @@ def _as_loads(loads) -> tuple[Load, ...]:
 
 
 def applied_loads(model: Model, loads: Sequence[Load], t, q, qd, z, kin, memories=None,
-                  with_outputs=False):
+                  with_outputs=False, qdd_guess=None):
     """Sum the external loads at one state: (body (n, 6) | None, tau (n_q,) | None,
     mass (n_q, n_q) | None, zd (n_states,)), plus the per-load outputs if ``with_outputs``.
     Load states are concatenated in z in ``loads`` order."""
@@ -77,7 +78,7 @@ def applied_loads(model: Model, loads: Sequence[Load], t, q, qd, z, kin, memorie
     body = tau = mass = None
     zds, outs = [], []
     for k, ld in enumerate(loads):
-        out = ld(model, t, q, qd, z[offsets[k]:offsets[k + 1]], kin, memories[k])
+        out = ld(model, t, q, qd, z[offsets[k]:offsets[k + 1]], kin, memories[k], qdd_guess=qdd_guess)
         outs.append(out)
         if out.body is not None:
             body = out.body if body is None else body + out.body
@@ -96,9 +97,10 @@ def dynamics_function(model: Model, loads: Sequence[Load] = (), memories=None):
     """The system ``f(t, q, q̇, z) -> (q̈, ż)`` of the integrators: MFM equations of motion plus the
     external loads (with their memories of the current step)."""
 
-    def f(t, q, qd, z):
+    def f(t, q, qd, z, qdd_guess=None):
         kin = kinematics(model, q, qd)
-        body, tau, mass, zd = applied_loads(model, loads, t, q, qd, z, kin, memories)
+        body, tau, mass, zd = applied_loads(model, loads, t, q, qd, z, kin, memories,
+                                            qdd_guess=qdd_guess)
         return evaluate(model, q, qd, tau=tau, body_loads=body, extra_mass=mass, kin=kin).qdd, zd
 
     return f
@@ -119,7 +121,7 @@ def _record(model, loads, s, mem):
     """What the dataset keeps of one saved state: poses, reactions, energies, load diagnostics."""
     kin = kinematics(model, s.q, s.qd)
     body, tau, mass, _, outs = applied_loads(model, loads, s.t, s.q, s.qd, s.z, kin, mem,
-                                             with_outputs=True)
+                                             with_outputs=True, qdd_guess=s.qdd)
     ev = evaluate(model, s.q, s.qd, tau=tau, body_loads=body, extra_mass=mass, kin=kin)
     sizes = [ld.n_states for ld in loads]
     offs = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
@@ -238,6 +240,21 @@ def _raise_nonfinite(model, integ, t, q, qd, dt, loads):
     coords = [model.coordinates[j] for j in range(model.n_coordinates)
               if not (np.isfinite(q[k, j]) and np.isfinite(qd[k, j]))]
     k_ok = max(k - 1, 0)
+    for ld in loads:
+        if getattr(ld, "added_mass", "lhs") == "rhs":
+            # the fixed-point iteration a ← M*⁻¹(F − Hᵀ A∞ H a) contracts only if the spectral
+            # radius of M*⁻¹ Hᵀ A∞ H is below 1
+            kin = kinematics(model, q[k_ok], qd[k_ok])
+            H = np.asarray(ld.geometry.h_matrix(kin)[0])
+            Ms = np.asarray(mass_matrix(model, q[k_ok]))
+            r = float(np.abs(np.linalg.eigvals(np.linalg.solve(Ms, H.T @ np.asarray(ld.A_inf) @ H))).max())
+            if r >= 1.0:
+                raise SimulationError(
+                    f"the state went non-finite at t = {t[k]:.6g} s in coordinate(s) {coords}. "
+                    f"Likely cause: added_mass='rhs' (the seed 001 iteration of A∞ ξ̈ on the "
+                    f"right-hand side) diverges here: the spectral radius of M*⁻¹ Hᵀ A∞ H is "
+                    f"{r:.3g} ≥ 1 (added mass larger than the structural mass). Use "
+                    "added_mass='lhs' (A∞ in M*, no iteration).")
     T_min = shortest_natural_period(model, q[k_ok], loads)
     lines = [f"the state went non-finite at t = {t[k]:.6g} s (first saved sample; last finite at "
              f"t = {t[k_ok]:.6g} s) in coordinate(s) {coords}."]
@@ -262,7 +279,8 @@ def _raise_nonfinite(model, integ, t, q, qd, dt, loads):
 def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="rk4",
              q0=None, qd0=None, loads=None, save_every: int = 1, t0: float = 0.0,
              ramp: float = 0.0, radiation: str = "convolution", memory: float | None = None,
-             state_space_options: dict | None = None, check_stability: bool = True) -> xr.Dataset:
+             state_space_options: dict | None = None, check_stability: bool = True,
+             added_mass: str = "lhs") -> xr.Dataset:
     """Simulate a model in the time domain.
 
     Parameters
@@ -280,6 +298,10 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     radiation: ``"convolution"`` (direct, window T_K from the decay of K; ``memory`` overrides it,
         s), ``"state_space"`` (the passive fit of :mod:`hydro.statespace`, options in
         ``state_space_options``) or ``"none"`` (A∞ only).
+    added_mass: ``"lhs"`` (A∞ in M*, the default) or ``"rhs"``: the scheme of seed 001 §5, A∞ ξ̈
+        on the right-hand side with the acceleration iterated in Beeman's corrector (needs
+        ``integrator="beeman"``; converges only where A∞ is smaller than the structural mass; the
+        iteration counts are in ``iterations``).
     check_stability: warn (:class:`StabilityWarning`) before running when dt exceeds the
         integrator's stability limit at the shortest natural period of the model linearised at q0.
 
@@ -309,9 +331,16 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                          "steps")
     if ramp < 0:
         raise ValueError(f"ramp: {ramp!r} must be ≥ 0 s")
-    loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp, radiation=radiation,
-                        memory=memory, state_space_options=state_space_options) + _as_loads(loads)
     integ = _integrators.get(integrator)
+    if added_mass not in ("lhs", "rhs"):
+        raise ValueError(f"added_mass={added_mass!r}; accepted: 'lhs' (A∞ in M*), 'rhs' (seed 001)")
+    if added_mass == "rhs" and integ.name != "beeman":
+        raise ValueError(f"added_mass='rhs' (the seed 001 scheme) iterates the acceleration in "
+                         f"Beeman's corrector; integrator={integ.name!r} has none: use "
+                         "integrator='beeman' or added_mass='lhs'")
+    loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp, radiation=radiation,
+                        memory=memory, state_space_options=state_space_options,
+                        added_mass=added_mass) + _as_loads(loads)
     q0 = _initial_vector(model, q0, "q0")
     qd0 = _initial_vector(model, qd0, "qd0")
     if check_stability and math.isfinite(integ.stability_limit):

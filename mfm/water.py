@@ -76,6 +76,7 @@ class Water(Load):
     radiation: str = eqx.field(static=True)
     n_lags: int = eqx.field(static=True)
     dofs: tuple[str, ...] = eqx.field(static=True)
+    added_mass: str = eqx.field(static=True, default="lhs")
     ss_in: tuple[int, ...] = eqx.field(static=True, default=())    # input dof j of each state
     ss_out: tuple[int, ...] = eqx.field(static=True, default=())   # output dof i of each state
 
@@ -149,15 +150,25 @@ class Water(Load):
         F = jnp.concatenate([f, jnp.zeros_like(f)], axis=1).reshape(-1)
         return self.geometry.to_body_wrench(F, kin, n_bodies, point_offset=lever)
 
-    def __call__(self, model, t, q, qd, z, kin, memory=()):
+    def __call__(self, model, t, q, qd, z, kin, memory=(), qdd_guess=None):
         comps, zd, _, _ = self._forces(t, kin, z, memory)
         F = sum(comps.values())
         H, _, _ = self.geometry.h_matrix(kin)
+        rhs = self.added_mass == "rhs" and qdd_guess is not None
+        if rhs:
+            # seed 001 §5: −A∞ ξ̈ on the right-hand side with the corrector's acceleration iterate.
+            # Without an iterate (start of a run, linearisation) the iteration's converged value
+            # is used instead: A∞ on the left.
+            F = F - self.A_inf @ (H @ qdd_guess)
         body = self.geometry.to_body_wrench(F, kin, model.n_bodies) + self._buoyancy_wrench(kin, model.n_bodies)
-        return LoadOutput(body=body, zd=zd, mass=H.T @ self.A_inf @ H)
+        mass = None if rhs else H.T @ self.A_inf @ H
+        return LoadOutput(body=body, zd=zd, mass=mass)
 
     def reaction_loads(self, model, t, q, qd, qdd, z, kin, memory, out):
-        # out.body holds −A∞ Ḣq̇; add −A∞ H q̈ so that the bodies feel the whole −A∞ ξ̈
+        # out.body holds −A∞ Ḣq̇; add −A∞ H q̈ so that the bodies feel the whole −A∞ ξ̈ (with
+        # added_mass="rhs" out.body already holds −A∞ H q̈ of the recorded iterate)
+        if self.added_mass == "rhs" and out.mass is None:
+            return out.body
         H, _, _ = self.geometry.h_matrix(kin)
         return out.body + self.geometry.to_body_wrench(-(self.A_inf @ (H @ qdd)), kin, model.n_bodies)
 
@@ -373,7 +384,7 @@ class HydroSpec:
 
 def build_water(model: Model, spec: HydroSpec, sea, *, dt: float, duration: float, t0: float = 0.0,
                 ramp: float = 0.0, radiation: str = "convolution", memory: float | None = None,
-                state_space_options: dict | None = None) -> Water:
+                state_space_options: dict | None = None, added_mass: str = "lhs") -> Water:
     """The :class:`Water` load of ``model`` for one sea state and time grid.
 
     sea: a ``hydro.waves`` sea state (Regular, Jonswap, …) or None for still water.
@@ -424,6 +435,7 @@ def build_water(model: Model, spec: HydroSpec, sea, *, dt: float, duration: floa
                  drag=f64(spec.drag), ss_p=f64(ss_p), ss_r=f64(ss_r), ss_in=ss_in, ss_out=ss_out,
                  W_current=f64(W_current), W_lag=f64(W_lag), dt=f64(dt), exc_t0=f64(t0), exc_step=f64(0.5 * dt),
                  exc_values=f64(exc), eta_values=f64(eta), radiation=radiation, n_lags=n_lags,
+                 added_mass=added_mass,
                  dofs=spec.dofs)
 
 

@@ -29,7 +29,7 @@ class Maxwell(Load):
     def n_states(self):
         return 1
 
-    def __call__(self, model, t, q, qd, z, kin, memory=()):
+    def __call__(self, model, t, q, qd, z, kin, memory=(), qdd_guess=None):
         stretch = q[0] - z[0]
         return LoadOutput(tau=jnp.array([-self.k * stretch]), zd=jnp.array([self.k * stretch / self.c]))
 
