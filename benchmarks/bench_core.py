@@ -6,7 +6,6 @@ Reports medians over repeats: µs per jit-compiled forward_dynamics call, compil
 wall time of a 20,000-step simulation (rollout only, and the full `simulate` with its dataset).
 """
 import argparse
-import statistics
 import time
 from pathlib import Path
 
@@ -15,17 +14,9 @@ import jax.numpy as jnp
 import numpy as np
 
 import mfm
+from timing import median_time
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def median_time(fn, repeats):
-    ts = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t0)
-    return statistics.median(ts)
 
 
 def main():

@@ -16,19 +16,11 @@ import numpy as np
 
 import hydro
 import mfm
+from timing import median_time
 from mfm.simulate import model_loads, rollout
 
 ROOT = Path(__file__).resolve().parents[1]
 warnings.simplefilter("ignore")
-
-
-def med(fn, n):
-    ts = []
-    for _ in range(n):
-        t0 = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t0)
-    return statistics.median(ts)
 
 
 def main():
@@ -59,18 +51,18 @@ def main():
         t0 = time.perf_counter()
         rollout(model, q0, q0, dt=dt, n_steps=n, loads=loads)[1].block_until_ready()
         first = time.perf_counter() - t0
-        warm = med(lambda: rollout(model, q0, q0, dt=dt, n_steps=n, loads=loads)[1].block_until_ready(),
+        warm = median_time(lambda: rollout(model, q0, q0, dt=dt, n_steps=n, loads=loads)[1].block_until_ready(),
                    args.repeats)
         extra = f", {loads[0].n_lags} lags" if rad == "convolution" else f", {nx} states"
         print(f"rollout RK4 {rad:>12s}{extra}: compile+first {first:.2f} s, warm {warm * 1e3:.1f} ms "
               f"({warm / n * 1e6:.1f} µs/step)")
         for integ in ("semi_implicit", "beeman"):
             rollout(model, q0, q0, dt=dt, n_steps=n, loads=loads, integrator=integ)[1].block_until_ready()
-            w2 = med(lambda: rollout(model, q0, q0, dt=dt, n_steps=n, loads=loads,
+            w2 = median_time(lambda: rollout(model, q0, q0, dt=dt, n_steps=n, loads=loads,
                                      integrator=integ)[1].block_until_ready(), args.repeats)
             print(f"    with {integ}: warm {w2 * 1e3:.1f} ms")
         mfm.simulate(model, sea, duration=duration, dt=dt, ramp=20.0, radiation=rad)
-        w = med(lambda: mfm.simulate(model, sea, duration=duration, dt=dt, ramp=20.0, radiation=rad), 3)
+        w = median_time(lambda: mfm.simulate(model, sea, duration=duration, dt=dt, ramp=20.0, radiation=rad), 3)
         print(f"simulate {rad} (loads built, rollout, dataset): warm {w:.2f} s")
 
 

@@ -32,21 +32,12 @@ import warnings
 import numpy as np
 import xarray as xr
 
-from hydro.waves import WaveComponents, _harmonic_sum, ramp
+from hydro.waves import WaveComponents, _check_components, _harmonic_sum, ramp
 
 __all__ = ["excitation_coefficients", "excitation_time_series", "excitation_dataarray"]
 
 _REL_TOL = 1e-9  # relative slack on grid edges (rounding of stored coordinates)
 _HEADING_TOL = 1e-9  # rad
-
-
-def _check_components(components) -> WaveComponents:
-    if not isinstance(components, WaveComponents):
-        raise TypeError(
-            f"components must be a WaveComponents, got {type(components).__name__}; "
-            "call sea.components(water_depth=..., g=...) first"
-        )
-    return components
 
 
 def _excitation_table(db: xr.Dataset, dofs):

@@ -212,20 +212,31 @@ def _parse_hydro(raw, source):
     return out
 
 
-def _parse_ptos(raw, names):
+def _tables(raw, section, keys):
+    """(where, table) for each table of an array of tables ``[[section]]``, keys checked."""
     if not isinstance(raw, list):
-        raise ConfigError("ptos: expected [[ptos]] tables")
-    out = []
-    for i, p in enumerate(raw):
-        where = f"ptos[{i}]"
-        if not isinstance(p, dict):
+        raise ConfigError(f"{section}: expected [[{section}]] tables")
+    for i, table in enumerate(raw):
+        where = f"{section}[{i}]"
+        if not isinstance(table, dict):
             raise ConfigError(f"{where}: expected a table")
-        _unknown(p, PTO_KEYS, where)
+        _unknown(table, keys, where)
+        yield where, table
+
+
+def _body_ref(table, key, where, names):
+    if table.get(key) not in names:
+        raise ConfigError(f"{where}.{key}: {table.get(key)!r} is not a body; known bodies: {names}")
+    return table[key]
+
+
+def _parse_ptos(raw, names):
+    out = []
+    for i, (where, p) in enumerate(_tables(raw, "ptos", PTO_KEYS)):
         if p.get("kind", "hydraulic") != "hydraulic":
             raise ConfigError(f"{where}.kind: {p.get('kind')!r}; accepted: 'hydraulic' (joint "
                               "spring–dampers are set on the joint itself: damping, stiffness)")
-        if p.get("body") not in names:
-            raise ConfigError(f"{where}.body: {p.get('body')!r} is not a body; known bodies: {names}")
+        _body_ref(p, "body", where, names)
         anchor_body = p.get("anchor_body")
         if anchor_body is not None and anchor_body not in names:
             raise ConfigError(f"{where}.anchor_body: {anchor_body!r} is not a body; known bodies: "
@@ -247,17 +258,9 @@ def _parse_ptos(raw, names):
 
 
 def _parse_moorings(raw, names):
-    if not isinstance(raw, list):
-        raise ConfigError("moorings: expected [[moorings]] tables")
     out = []
-    for i, m in enumerate(raw):
-        where = f"moorings[{i}]"
-        if not isinstance(m, dict):
-            raise ConfigError(f"{where}: expected a table")
-        _unknown(m, MOORING_KEYS, where)
-        body = m.get("body")
-        if body not in names:
-            raise ConfigError(f"{where}.body: {body!r} is not a body; known bodies: {names}")
+    for i, (where, m) in enumerate(_tables(raw, "moorings", MOORING_KEYS)):
+        body = _body_ref(m, "body", where, names)
         k = _vector(m.get("stiffness"), 3, f"{where}.stiffness") if "stiffness" in m else None
         if k is None or np.any(k < 0):
             raise ConfigError(f"{where}.stiffness: {m.get('stiffness')!r}; give [kx, ky, kz] ≥ 0 in "
