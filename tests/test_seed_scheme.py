@@ -2,7 +2,6 @@
 against ours (A∞ in M*), and where the seed's iteration cannot work."""
 import warnings
 
-import numpy as np
 import pytest
 from conftest import CONFIGS
 
