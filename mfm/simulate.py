@@ -67,13 +67,17 @@ def _as_loads(loads) -> tuple[Load, ...]:
     return loads
 
 
+def _state_offsets(loads: Sequence[Load]) -> np.ndarray:
+    """Where each load's states start in z (they are concatenated in ``loads`` order)."""
+    return np.concatenate([[0], np.cumsum([ld.n_states for ld in loads])]).astype(int)
+
+
 def applied_loads(model: Model, loads: Sequence[Load], t, q, qd, z, kin, memories=None,
                   with_outputs=False, qdd_guess=None):
     """Sum the external loads at one state: (body (n, 6) | None, tau (n_q,) | None,
     mass (n_q, n_q) | None, zd (n_states,)), plus the per-load outputs if ``with_outputs``.
     Load states are concatenated in z in ``loads`` order."""
-    sizes = [ld.n_states for ld in loads]
-    offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
+    offsets = _state_offsets(loads)
     memories = memories if memories is not None else tuple(() for _ in loads)
     body = tau = mass = None
     zds, outs = [], []
@@ -86,7 +90,7 @@ def applied_loads(model: Model, loads: Sequence[Load], t, q, qd, z, kin, memorie
             tau = out.tau if tau is None else tau + out.tau
         if out.mass is not None:
             mass = out.mass if mass is None else mass + out.mass
-        zds.append(jnp.zeros(sizes[k]) if out.zd is None else out.zd)
+        zds.append(jnp.zeros(ld.n_states) if out.zd is None else out.zd)
     zd = jnp.concatenate(zds) if zds else jnp.zeros(0)
     if with_outputs:
         return body, tau, mass, zd, outs
@@ -123,8 +127,7 @@ def _record(model, loads, s, mem):
     body, tau, mass, _, outs = applied_loads(model, loads, s.t, s.q, s.qd, s.z, kin, mem,
                                              with_outputs=True, qdd_guess=s.qdd)
     ev = evaluate(model, s.q, s.qd, tau=tau, body_loads=body, extra_mass=mass, kin=kin)
-    sizes = [ld.n_states for ld in loads]
-    offs = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
+    offs = _state_offsets(loads)
     # the joints carry every load on the bodies, acceleration-proportional ones included
     F = None
     diag = {}
@@ -225,9 +228,9 @@ def _stiffness_jacobian(model, loads, q):
 
 
 def shortest_natural_period(model: Model, q, loads=()) -> float:
-    """Estimate of the shortest natural period (s) at configuration q (q̇ = 0): from the
-    generalised eigenproblem K v = ω² M* v with K = −∂q̈/∂q · M* linearised numerically by jax.
-    Returns inf when nothing is restoring."""
+    """Estimate of the shortest natural period (s) at configuration q (q̇ = 0): 2π/√λ_max with λ
+    the eigenvalues of −∂q̈/∂q (jax Jacobian of the full dynamics: its mass matrix, added mass
+    included, and every restoring load). Returns inf when nothing is restoring."""
     Jq = _stiffness_jacobian(model, _as_loads(loads), jnp.asarray(q, jnp.float64))
     lam = np.linalg.eigvals(-np.asarray(Jq)).real
     lam_max = lam.max() if lam.size else 0.0
