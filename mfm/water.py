@@ -109,7 +109,8 @@ class Water(Load):
         return (1.0 - w) * values[k] + w * values[k + 1]
 
     def radiation_force(self, t, v, z, memory):
-        """−∫K ξ̇: convolution over the history (trapezoidal in the lag) or −C z (state space)."""
+        """−∫K ξ̇ and the state derivative: the product-integration weights of the convolution
+        (:meth:`HydroSpec.kernel`) applied to the velocity history, or the modal state space."""
         if self.radiation == "state_space":
             n = len(self.ss_in)
             zr, zi = z[:n], z[n:]
@@ -194,6 +195,7 @@ class Water(Load):
                              {"long_name": "hydrodynamic loads on each body's reference point, "
                               "inertial axes", "units": "N or N m"})
         ds.attrs["radiation"] = self.radiation
+        ds.attrs["added_mass"] = self.added_mass
         return ds
 
 
