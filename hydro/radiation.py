@@ -79,10 +79,13 @@ def _tail_fit(omega, B, fit_fraction, noise):
     X = np.stack([np.ones_like(lx), -lx], axis=1)
     coef, *_ = np.linalg.lstsq(X, ly, rcond=None)
     n = coef[1]
-    c = np.sign(Bw[-1]) * np.exp(coef[0])
-    resid = np.sqrt(np.mean((X @ coef - ly) ** 2, axis=0))
+    # all-zero entries (e.g. yaw of a body of revolution) fit absurd exponents: they are tapered
+    # (ok is False), so their c is set to 0 rather than left to overflow
+    with np.errstate(over="ignore", invalid="ignore"):
+        c = np.sign(Bw[-1]) * np.exp(coef[0])
+        resid = np.sqrt(np.mean((X @ coef - ly) ** 2, axis=0))
     ok = same_sign & above & (n > 1.0) & (n < 20.0) & (resid < 0.2)
-    return c, n, ok
+    return np.where(ok, c, 0.0), n, ok
 
 
 def _taper(omega, fraction):
