@@ -416,6 +416,7 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
     finally:
         cpt_log.setLevel(level)
     ds = _augment(ds, specs, hulls, rho=rho, g=g)
+    _check_finite(ds)
     n_hull = body.mesh.nb_faces
     n_lid = 0 if body.lid_mesh is None else body.lid_mesh.nb_faces
     ds.attrs.update({
@@ -443,6 +444,24 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
         os.replace(tmp, path)  # atomic: a concurrent reader never sees a half-written file
         ds.attrs["cache_file"] = str(path)
     return ds
+
+
+def _check_finite(ds):
+    """Refuse (and never cache) results capytaine left as NaN: it skips problems it cannot solve
+    (finite depth with kh < 0.1; `n_threads` without threadpoolctl) with a log line only."""
+    finite_w = np.isfinite(ds["omega"].values)
+    bad = []
+    for v in ("added_mass", "radiation_damping", "excitation_force"):
+        if v not in ds:
+            continue
+        vals = ds[v].values if v != "excitation_force" else ds[v].values[finite_w]
+        if not np.all(np.isfinite(vals)):
+            w = ds["omega"].values[~np.isfinite(vals).reshape(vals.shape[0], -1).all(axis=1)]
+            bad.append(f"{v} at omega = {np.array2string(w[:5], precision=4)}")
+    if bad:
+        raise RuntimeError("capytaine returned NaN for " + "; ".join(bad) + ": it skipped those "
+                           "problems (finite depth needs k h ≥ 0.1, i.e. a higher omega_min; "
+                           "n_threads needs threadpoolctl installed). Nothing was cached.")
 
 
 def _keel(spec, dx):

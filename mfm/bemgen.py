@@ -368,6 +368,7 @@ def generate(config_path, *, out=None, force=False, progress=True, n_threads=Non
         "mfm_headings_deg": json.dumps(settings["headings_deg"]),
         "mfm_wall_time_s": round(wall, 1),
         "mfm_n_threads": str(n_threads),
+        "mfm_omp_num_threads": os.environ.get("OMP_NUM_THREADS", ""),
     })
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.stem}.tmp{os.getpid()}.nc")
