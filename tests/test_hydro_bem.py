@@ -242,20 +242,14 @@ def test_mesh_file_box_hydrostatics(tmp_path):
     assert lid is not None and lid.nb_faces > 0
 
 
-def _rm3_dir():
-    here = Path(__file__).resolve()
-    for d in (here.parents[1] / "data" / "rm3", here.parents[2] / "shared" / "data" / "rm3"):
-        if (d / "float.stl").exists() and (d / "rm3.out").exists():
-            return d
-    return None
+RM3_DIR = Path(__file__).resolve().parents[1] / "hydro" / "data" / "rm3"   # shipped with the repo
 
 
-@pytest.mark.skipif(_rm3_dir() is None, reason="RM3 data (data/rm3 or ../shared/data/rm3) absent")
 def test_mesh_file_rm3_float_against_wamit():
     """The RM3 float STL at WAMIT's body origin (z = -0.72 m) against rm3.out: volume 725.833 m³,
     C33 = 285.52 ρg, C44 = 7347.0 ρg about the body origin. The STL is a different panelling of the
     hull than WAMIT's input (measured differences 0.14-0.35 %): 1 %."""
-    d = _rm3_dir()
+    d = RM3_DIR
     s = geo.normalize_spec({"name": "float", "shape": "mesh", "file": str(d / "float.stl"),
                             "origin": [0.0, 0.0, -0.72]})
     h = geo.hull_hydrostatics(geo.body_meshes(s, 1.0)[0], s["reference_point"], rho=RHO, g=G)

@@ -182,7 +182,6 @@ def test_argument_errors_and_depth_warning():
 RM3 = Path(hydro.__file__).parent / "data" / "rm3"
 
 
-@pytest.mark.skipif(not (RM3 / "rm3.3").exists(), reason="hydro/data/rm3 (WAMIT RM3 files) not shipped")
 def test_rm3_regular_wave_against_raw_wamit_file():
     from hydro.wamit import read_wamit
 
