@@ -167,9 +167,7 @@ def test_from_capytaine_transposes_and_splits(rm3):
 
 @pytest.fixture(scope="module")
 def sphere():
-    path = DATA / "sphere.nc"
-    if not path.exists():
-        pytest.skip("hydro/data/sphere.nc not generated")
+    path = DATA / "sphere.nc"   # shipped (hydro/data/README.md)
     return D.from_capytaine(xr.open_dataset(path))
 
 

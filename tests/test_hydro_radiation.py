@@ -100,9 +100,7 @@ def test_rm3_added_mass_and_damping_from_K(rm3, rm3_K):
 
 
 def test_sphere_added_mass_from_K():
-    path = DATA / "sphere.nc"
-    if not path.exists():
-        pytest.skip("hydro/data/sphere.nc not generated")
+    path = DATA / "sphere.nc"   # shipped (hydro/data/README.md)
     sp = D.from_capytaine(xr.open_dataset(path))
     om = sp.omega.values
     K = R.impulse_response(sp, np.arange(0.0, 40.0, 0.01))
