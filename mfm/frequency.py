@@ -27,10 +27,8 @@ from .model import Model
 def _static_loads(model: Model):
     from .simulate import applied_loads, model_loads
 
-    if model.hydro is not None:
-        loads = model_loads(model, None, dt=1.0, duration=1.0, radiation="none")
-    else:
-        loads = model_loads(model, None, dt=1.0, duration=1.0)
+    # still water, no radiation: the static loads (gravity, buoyancy, water plane, moorings, PTOs)
+    loads = model_loads(model, None, dt=1.0, duration=1.0, radiation="none")
     mems = tuple(ld.init_memory(model, 0.0, jnp.zeros(model.n_coordinates),
                                 jnp.zeros(model.n_coordinates), 1.0) for ld in loads)
     nz = sum(ld.n_states for ld in loads)
@@ -58,9 +56,10 @@ def equilibrium(model: Model, q_guess=None, *, tol: float = 1e-10, max_iter: int
     Gj = jax.jit(G)
     Jj = jax.jit(jax.jacfwd(G))
     q = jnp.zeros(model.n_coordinates) if q_guess is None else jnp.asarray(q_guess, jnp.float64)
-    scale = float(jnp.max(jnp.abs(jnp.einsum("nai,na->i", kinematics(model, q).B,
-                                             gravity_loads(model))))) + 1e-300
-    scale = max(scale, float(jnp.max(model.mass)) * float(model.gravity))
+    # the size of the loads that must balance: generalised weights, or the largest weight
+    scale = max(float(jnp.max(jnp.abs(jnp.einsum("nai,na->i", kinematics(model, q).B,
+                                                 gravity_loads(model))))),
+                float(jnp.max(model.mass)) * float(model.gravity))
     for it in range(max_iter):
         g = np.asarray(Gj(q))
         if np.abs(g).max() < tol * scale:
