@@ -403,9 +403,19 @@ def _frequencies(omega_range, n_components, repeat_period, jitter, rng):
     return centres + offsets, np.full(n, d)
 
 
+@dataclass(frozen=True, kw_only=True, eq=False)
 class _SpectralSea:
-    """Discretisation shared by the spectral seas (fields seed, heading, spreading, n_components,
-    omega_range, repeat_period, frequency_jitter; method spectrum(ω) and _default_range())."""
+    """Discretisation shared by the spectral seas: the keyword fields seed, heading, spreading,
+    n_components, omega_range, repeat_period, frequency_jitter; subclasses give spectrum(ω) and
+    _default_range()."""
+
+    seed: int = 0
+    heading: float = 0.0
+    spreading: Spreading | None = None
+    n_components: int | None = None
+    omega_range: tuple[float, float] | None = None
+    repeat_period: float | None = None
+    frequency_jitter: float = 0.5
 
     def _check_common(self):
         object.__setattr__(self, "seed", _seed(self.seed))
@@ -489,13 +499,6 @@ class Jonswap(_SpectralSea):
     hs: float
     tp: float
     gamma: float = 3.3
-    seed: int = 0
-    heading: float = 0.0
-    spreading: Spreading | None = None
-    n_components: int | None = None
-    omega_range: tuple[float, float] | None = None
-    repeat_period: float | None = None
-    frequency_jitter: float = 0.5
     normalisation: str = "exact"
     _a_gamma: float = field(init=False, repr=False, compare=False, default=1.0)
 
@@ -530,13 +533,6 @@ class PiersonMoskowitz(_SpectralSea):
 
     hs: float
     tp: float
-    seed: int = 0
-    heading: float = 0.0
-    spreading: Spreading | None = None
-    n_components: int | None = None
-    omega_range: tuple[float, float] | None = None
-    repeat_period: float | None = None
-    frequency_jitter: float = 0.5
 
     def __post_init__(self):
         object.__setattr__(self, "hs", _positive("hs (significant wave height, m)", self.hs))
@@ -562,13 +558,6 @@ class UserSpectrum(_SpectralSea):
 
     omega: np.ndarray
     S: np.ndarray
-    seed: int = 0
-    heading: float = 0.0
-    spreading: Spreading | None = None
-    n_components: int | None = None
-    omega_range: tuple[float, float] | None = None
-    repeat_period: float | None = None
-    frequency_jitter: float = 0.5
 
     def __post_init__(self):
         w = _readonly_float("omega", self.omega)
