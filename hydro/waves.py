@@ -486,8 +486,27 @@ def jonswap_normalisation(gamma: float, method: str = "exact") -> float:
     return 1.0 / (below + above)
 
 
+@dataclass(frozen=True, eq=False)
+class _PeakSea(_SpectralSea):
+    """Seas given by significant wave height hs (m) and peak period tp (s)."""
+
+    hs: float
+    tp: float
+
+    def _check_hs_tp(self):
+        object.__setattr__(self, "hs", _positive("hs (significant wave height, m)", self.hs))
+        object.__setattr__(self, "tp", _positive("tp (peak period, s)", self.tp))
+
+    @property
+    def omega_peak(self) -> float:
+        return 2.0 * math.pi / self.tp
+
+    def _default_range(self):
+        return (DEFAULT_BAND[0] * self.omega_peak, DEFAULT_BAND[1] * self.omega_peak)
+
+
 @dataclass(frozen=True)
-class Jonswap(_SpectralSea):
+class Jonswap(_PeakSea):
     """JONSWAP sea (DNV-RP-C205 form): S(ω) = A_γ S_PM(ω; Hs, Tp) γ^{exp(−(ω−ωp)²/(2σ²ωp²))},
     σ = 0.07 for ω <= ωp and 0.09 above, ωp = 2π/Tp. S in m² s/rad, one-sided.
 
@@ -496,28 +515,18 @@ class Jonswap(_SpectralSea):
     omega_range = (0.5 ωp, 5 ωp). See the module docstring for the discretisation.
     """
 
-    hs: float
-    tp: float
     gamma: float = 3.3
     normalisation: str = "exact"
     _a_gamma: float = field(init=False, repr=False, compare=False, default=1.0)
 
     def __post_init__(self):
-        object.__setattr__(self, "hs", _positive("hs (significant wave height, m)", self.hs))
-        object.__setattr__(self, "tp", _positive("tp (peak period, s)", self.tp))
+        self._check_hs_tp()
         gamma = _finite("gamma", self.gamma)
         if gamma < 1.0:
             raise ValueError(f"gamma (peak enhancement) must be >= 1 (1 = Pierson–Moskowitz, 3.3 typical), got {self.gamma!r}")
         object.__setattr__(self, "gamma", gamma)
         self._check_common()
         object.__setattr__(self, "_a_gamma", jonswap_normalisation(gamma, self.normalisation))
-
-    @property
-    def omega_peak(self) -> float:
-        return 2.0 * math.pi / self.tp
-
-    def _default_range(self):
-        return (DEFAULT_BAND[0] * self.omega_peak, DEFAULT_BAND[1] * self.omega_peak)
 
     def spectrum(self, omega) -> np.ndarray:
         """S(ω) in m² s/rad for ω in rad/s (any shape; 0 for ω <= 0)."""
@@ -527,24 +536,13 @@ class Jonswap(_SpectralSea):
 
 
 @dataclass(frozen=True)
-class PiersonMoskowitz(_SpectralSea):
+class PiersonMoskowitz(_PeakSea):
     """Pierson–Moskowitz sea in the Hs–Tp form: S(ω) = (5/16) Hs² ωp⁴ ω⁻⁵ exp(−(5/4)(ωp/ω)⁴),
     m² s/rad; ∫₀^∞ S dω = Hs²/16 analytically. Default band omega_range = (0.5 ωp, 5 ωp)."""
 
-    hs: float
-    tp: float
-
     def __post_init__(self):
-        object.__setattr__(self, "hs", _positive("hs (significant wave height, m)", self.hs))
-        object.__setattr__(self, "tp", _positive("tp (peak period, s)", self.tp))
+        self._check_hs_tp()
         self._check_common()
-
-    @property
-    def omega_peak(self) -> float:
-        return 2.0 * math.pi / self.tp
-
-    def _default_range(self):
-        return (DEFAULT_BAND[0] * self.omega_peak, DEFAULT_BAND[1] * self.omega_peak)
 
     def spectrum(self, omega) -> np.ndarray:
         """S(ω) in m² s/rad for ω in rad/s (any shape; 0 for ω <= 0)."""
