@@ -22,6 +22,8 @@ from typing import NamedTuple
 import equinox as eqx
 import jax.numpy as jnp
 
+from .points import BodyPoints
+
 
 class LoadOutput(NamedTuple):
     body: jnp.ndarray | None = None
@@ -91,18 +93,12 @@ class CoordinateForceSeries(Load):
 
 class PointSprings(Load):
     """Linear springs from points on bodies to their positions at q = 0 (e.g. a linear mooring):
-    F = −diag(k) (p − p₀) at each point p (inertial axes), N. ``body_index`` static; ``d`` (m, 3)
-    point − CoM in body axes; ``p0`` (m, 3); ``stiffness`` (m, 3) N/m."""
-    body_index: tuple[int, ...] = eqx.field(static=True)
-    d: jnp.ndarray
-    p0: jnp.ndarray
+    F = −diag(k) (p − p₀) at each point p (inertial axes), N. ``points`` the attachment points
+    (:class:`~mfm.points.BodyPoints`, p₀ = their positions at q = 0); ``stiffness`` (m, 3) N/m."""
+    points: BodyPoints
     stiffness: jnp.ndarray
 
     def __call__(self, model, t, q, qd, z, kin, memory=(), qdd_guess=None):
-        W = jnp.zeros((model.n_bodies, 6))
-        for k, i in enumerate(self.body_index):
-            R = kin.E[i, :3, :3]
-            rho = R @ self.d[k]
-            f = -self.stiffness[k] * (kin.E[i, :3, 3] + rho - self.p0[k])
-            W = W.at[i, :3].add(f).at[i, 3:].add(R.T @ jnp.cross(rho, f))
-        return LoadOutput(body=W)
+        f = -self.stiffness * (self.points.positions(kin) - self.points.ref0)
+        F = jnp.concatenate([f, jnp.zeros_like(f)], axis=1).reshape(-1)
+        return LoadOutput(body=self.points.to_body_wrench(F, kin, model.n_bodies))

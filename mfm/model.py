@@ -200,28 +200,23 @@ def load(path: str | Path, hydro: bool = True, body_coupling: bool | None = None
     model = compile_tree(bodies, name=options["name"], gravity=options["gravity"])
     if options["moorings"]:
         from .loads import PointSprings
+        from .points import BodyPoints
 
-        idx = tuple(model.body_index(m["body"]) for m in options["moorings"])
+        M = options["moorings"]
         model = dataclasses.replace(model, moorings=PointSprings(
-            body_index=idx,
-            d=jnp.asarray(np.stack([m["point"] - np.asarray(model.com[i])
-                                    for m, i in zip(options["moorings"], idx)])),
-            p0=jnp.asarray(np.stack([m["point"] for m in options["moorings"]])),
-            stiffness=jnp.asarray(np.stack([m["stiffness"] for m in options["moorings"]]))))
+            points=BodyPoints.on_bodies(model.com, [model.body_index(m["body"]) for m in M],
+                                        [m["point"] for m in M]),
+            stiffness=jnp.asarray(np.stack([m["stiffness"] for m in M]))))
     if options["ptos"]:
         from .points import BodyPoints
         from .ptos import HydraulicPTO
 
         P = options["ptos"]
-        ia = tuple(model.body_index(p["body"]) for p in P)
-        ib = tuple(model.body_index(p["anchor_body"]) if p["anchor_body"] else 0 for p in P)
-        com = np.asarray(model.com)
+        ia = [model.body_index(p["body"]) for p in P]
+        ib = [model.body_index(p["anchor_body"]) if p["anchor_body"] else 0 for p in P]
         model = dataclasses.replace(model, ptos=HydraulicPTO(
-            a=BodyPoints(body_index=ia, d_ref=jnp.asarray(np.stack([p["point"] - com[i] for p, i in zip(P, ia)])),
-                         ref0=jnp.asarray(np.stack([p["point"] for p in P]))),
-            b=BodyPoints(body_index=ib, d_ref=jnp.asarray(np.stack([p["anchor"] - com[i] for p, i in zip(P, ib)])),
-                         ref0=jnp.asarray(np.stack([p["anchor"] for p in P]))),
-            anchor=jnp.asarray(np.stack([p["anchor"] for p in P])),
+            a=BodyPoints.on_bodies(model.com, ia, [p["point"] for p in P]),
+            b=BodyPoints.on_bodies(model.com, ib, [p["anchor"] for p in P]),
             mu=jnp.asarray([p["mu"] for p in P]), beta=jnp.asarray([p["beta"] for p in P]),
             kappa=jnp.asarray([p["kappa"] for p in P]),
             length0=jnp.asarray([np.linalg.norm(p["point"] - p["anchor"]) for p in P]),

@@ -64,6 +64,15 @@ class BodyPoints(eqx.Module):
         mb = jnp.einsum("kba,kb->ka", R, m + jnp.cross(rho, f))
         return jnp.zeros((n_bodies, 6)).at[idx].add(jnp.concatenate([f, mb], axis=1))
 
+    @classmethod
+    def on_bodies(cls, com, body_index, points) -> "BodyPoints":
+        """Points given in inertial axes at q = 0 (K, 3), fixed on the bodies ``body_index``
+        whose centres of mass at q = 0 are ``com`` (n, 3)."""
+        points = np.asarray(points, dtype=float).reshape(-1, 3)
+        d = points - np.asarray(com)[list(body_index)]
+        return cls(body_index=tuple(int(i) for i in body_index), d_ref=jnp.asarray(d),
+                   ref0=jnp.asarray(points))
+
     def positions(self, kin):
         """Inertial positions of the points (K, 3)."""
         idx, R, rho = self._frames(kin)

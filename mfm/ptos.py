@@ -19,13 +19,12 @@ from .points import BodyPoints
 
 class HydraulicPTO(Load):
     """Hydraulic PTOs (seed 000): arrays ``mu`` (P,) kg, ``beta`` (P,) N s/m, ``kappa`` (P,) N/m,
-    ``length0`` (P,) m; ``a`` the attachment points (BodyPoints, one per PTO); ``b`` the points on
-    the other bodies (one per PTO; a point on a body) and ``anchor`` (P, 3) used where
-    ``b_fixed[p]`` (static) is True (the other end fixed in the inertial frame). ``names`` static.
+    ``length0`` (P,) m; ``a`` the attachment points (BodyPoints, one per PTO); ``b`` the other
+    ends (BodyPoints): a point on a body, or, where ``b_fixed[p]`` (static) is True, a point fixed
+    in the inertial frame at ``b.ref0``. ``names`` static.
     Absorbed power β ẇ²."""
     a: BodyPoints
     b: BodyPoints
-    anchor: jnp.ndarray
     mu: jnp.ndarray
     beta: jnp.ndarray
     kappa: jnp.ndarray
@@ -37,7 +36,7 @@ class HydraulicPTO(Load):
         """Stroke w, rate ẇ, rows g (P, n_q) and ġq̇ (P,)."""
         fixed = jnp.asarray(np.array(self.b_fixed, dtype=float))[:, None]
         pa, pb = self.a.positions(kin), self.b.positions(kin)
-        pb = fixed * self.anchor + (1.0 - fixed) * pb
+        pb = fixed * self.b.ref0 + (1.0 - fixed) * pb
         va, aa = (x.reshape(-1, 6)[:, :3] for x in self.a.velocity_and_bias(kin))
         vb, ab = (x.reshape(-1, 6)[:, :3] * (1.0 - fixed) for x in self.b.velocity_and_bias(kin))
         Ha = self.a.h_matrix(kin)[0].reshape(len(self.names), 6, -1)[:, :3]
