@@ -33,6 +33,7 @@ from types import MappingProxyType
 
 import numpy as np
 import xarray as xr
+from scipy.linalg import solve_triangular
 from scipy.optimize import nnls
 
 from .radiation import filon_weights, impulse_response, memory_length
@@ -53,14 +54,15 @@ def _basis(s, poles):
 
 
 def _real_ls(M, rhs, w):
-    """Weighted least squares on complex rows, real unknowns (columns scaled for conditioning)."""
-    Mw, rw = M * w[:, None], rhs * w
+    """Weighted least squares on complex rows, real unknowns (columns scaled for conditioning);
+    ``rhs`` (n_s,) or (n_s, n_f) for several right-hand sides."""
+    Mw, rw = M * w[:, None], rhs * (w if rhs.ndim == 1 else w[:, None])
     Mr = np.vstack([Mw.real, Mw.imag])
     rr = np.concatenate([rw.real, rw.imag])
     sc = np.linalg.norm(Mr, axis=0)
     sc[sc == 0] = 1.0
     x, *_ = np.linalg.lstsq(Mr / sc, rr, rcond=None)
-    return x / sc
+    return x / (sc if x.ndim == 1 else sc[:, None])
 
 
 def _initial_poles(order, w_lo, w_hi):
@@ -75,16 +77,45 @@ def _flip(poles):
     return [complex(-abs(p.real) if p.real != 0 else -1e-6, abs(p.imag)) for p in poles]
 
 
+def _sigma_ls(Phi, F, w):
+    """The σ coefficients of vector fitting with one pole set for the columns of F (n_s, n_f):
+    each function's own residues eliminated by projecting its rows [−f_k Φ | f_k] onto the
+    complement of the (shared) residue columns Φ (Gustavsen's fast VF, with one orthogonal basis
+    for all functions), then the σ rows of all functions stacked and solved together."""
+    n = Phi.shape[1]
+    Pw = Phi * w[:, None]
+    P = np.vstack([Pw.real, Pw.imag])                                    # (2n_s, n)
+    sp = np.linalg.norm(P, axis=0)
+    sp[sp == 0] = 1.0
+    U, _ = np.linalg.qr(P / sp)                                          # orthonormal, (2n_s, n)
+    Fw = F * w[:, None]
+    G = -Fw.T[:, :, None] * Phi[None]                                    # (n_f, n_s, n)
+    Q = np.concatenate([G.real, G.imag], axis=1)                         # (n_f, 2n_s, n)
+    b = np.concatenate([Fw.real, Fw.imag], axis=0).T                     # (n_f, 2n_s)
+    Q = Q - np.einsum("sa,fab->fsb", U, np.einsum("sa,fsb->fab", U, Q))
+    b = b - (b @ U) @ U.T
+    lhs, rhs = Q.reshape(-1, n), b.reshape(-1)
+    cs = np.linalg.norm(lhs, axis=0)
+    cs[cs == 0] = 1.0
+    x, *_ = np.linalg.lstsq(lhs / cs, rhs, rcond=None)
+    return x / cs
+
+
 def _vf(s, f, w, order, w_lo, w_hi, n_iter=10):
-    """Vector fitting of f(s) ≈ Σ r/(s−p); returns poles (Im ≥ 0 representatives), coefficients."""
+    """Vector fitting of f(s) ≈ Σ r/(s−p); returns poles (Im ≥ 0 representatives), coefficients.
+    f (n_s,): one function; f (n_s, n_f): n_f functions with one common pole set (coefficients
+    (n_coef, n_f))."""
     poles = _initial_poles(order, w_lo, w_hi)
     extra = np.zeros((len(s), 0))
     ne = 0
     for _ in range(n_iter):
         Phi = _basis(s, poles)
         n = Phi.shape[1]
-        x = _real_ls(np.hstack([Phi, extra, -f[:, None] * Phi]), f, w)
-        ct = x[n + ne:]
+        if f.ndim == 2:
+            ct = _sigma_ls(Phi, f, w)
+        else:
+            x = _real_ls(np.hstack([Phi, extra, -f[:, None] * Phi]), f, w)
+            ct = x[n + ne:]
         # zeros of sigma(s) = 1 + Σ ct φ: eig(Λ − b ctᵀ) in the real block form
         Lam = np.zeros((n, n))
         b = np.zeros(n)
@@ -184,37 +215,44 @@ def _enforce_passivity(fits, done, nd, dpk, dof_ok, s_fit, w_fit, w_max, max_ite
     ok = np.asarray(dof_ok, bool)
     grid = _passivity_grid(w_max)
     keys = list(done)
-    phis = [_basis(1j * grid, fits[done[k]][0]) for k in keys]
+    # entries with one common pole set (pole_sharing="common") share their bases
+    basis_of = {}
+
+    def bases(poles):
+        if id(poles) not in basis_of:
+            Pf = _basis(s_fit, poles) * np.sqrt(w_fit)[:, None]
+            basis_of[id(poles)] = (_basis(1j * grid, poles),
+                                   np.linalg.inv(np.linalg.qr(np.vstack([Pf.real, Pf.imag]), mode="r")))
+        return basis_of[id(poles)]
+
+    phis = [bases(fits[done[k]][0])[0] for k in keys]
     sizes = [ph.shape[1] for ph in phis]
     offs = np.concatenate([[0], np.cumsum(sizes)])
     # metric of least change: the weighted fit residual, ||P_e Δc_e|| with P_e = R_e-factor of
-    # the weighted basis on the fit grid; Δc = R⁻¹ y with y the minimum-norm solution
-    Rinv = np.zeros((offs[-1], offs[-1]))
-    for e, (i, j) in enumerate(keys):
-        Pf = _basis(s_fit, fits[done[(i, j)]][0]) * (np.sqrt(w_fit) * D[i] * D[j])[:, None]
-        R = np.linalg.qr(np.vstack([Pf.real, Pf.imag]), mode="r")
-        sl = slice(offs[e], offs[e + 1])
-        Rinv[sl, sl] = np.linalg.inv(R)
+    # the weighted basis on the fit grid (scaled by D_i D_j); Δc = R⁻¹ y with y the minimum-norm
+    # solution. R⁻¹ is block diagonal: kept per entry
+    Rinv = [bases(fits[done[(i, j)]][0])[1] / (D[i] * D[j]) for (i, j) in keys]
+    sls = [slice(offs[e], offs[e + 1]) for e in range(len(keys))]
     c0 = np.concatenate([fits[done[k]][1] for k in keys])
     rows, rhs = [], []
     for it in range(max_iter):
         c = c0.copy()
         if rows:
-            # min ||y||, y = R Δc, s.t. M y ≥ δ (M = G R⁻¹): least-distance programming by
-            # Lawson & Hanson's NNLS route: u ≥ 0 minimising ||[Mᵀ; δᵀ] u − e_{n+1}||, then
-            # y = −r[:n]/r[n] with r the residual (no factorisation of the growing M Mᵀ)
-            M = np.array(rows) @ Rinv
+            # min ||y||, y = R Δc, s.t. M y ≥ δ (M = G R⁻¹): least-distance programming through
+            # its dual, min μᵀ(M Mᵀ)μ − 2δᵀμ over μ ≥ 0, y = Mᵀμ; an NNLS in the n_c
+            # constraint multipliers (n_c ≪ the 12,000 coefficients of M4 134's common fit)
+            G = np.array(rows)
+            M = np.concatenate([G[:, sl] @ Ri for sl, Ri in zip(sls, Rinv)], axis=1)
             delta = np.array(rhs) - np.array(rows) @ c0
             sc = np.linalg.norm(M, axis=1)
             Ms, ds = M / sc[:, None], delta / sc
-            E = np.vstack([Ms.T, ds[None]])
-            f = np.zeros(E.shape[0])
-            f[-1] = 1.0
-            u, _ = nnls(E, f, maxiter=50 * E.shape[1])
-            r = E @ u - f
-            if abs(r[-1]) < 1e-14:
+            Gm = Ms @ Ms.T
+            L = np.linalg.cholesky(Gm + 1e-12 * np.trace(Gm) / len(Gm) * np.eye(len(Gm)))
+            mu, _ = nnls(L.T, solve_triangular(L, ds, lower=True), maxiter=50 * len(Gm))
+            y = Ms.T @ mu
+            if np.min(Ms @ y - ds) < -1e-6 * max(1.0, float(np.abs(ds).max())):
                 raise RuntimeError("passivity enforcement: the constraints are incompatible")
-            c = c0 + Rinv @ (-r[:-1] / r[-1])
+            c = c0 + np.concatenate([Ri @ y[sl] for sl, Ri in zip(sls, Rinv)])
         for e, k in enumerate(keys):
             fits[done[k]] = (fits[done[k]][0], c[offs[e]:offs[e + 1]])
         H = np.zeros((len(grid), nd, nd))
@@ -292,8 +330,78 @@ def fitted_impedance(ss: StateSpaceRadiation, omega) -> np.ndarray:
     return out
 
 
-def _realise(entries, poles, nd):
-    """Block-diagonal real realisation of the per-entry pole–residue models."""
+def _fit_common(entries, ZK, Z, band, n_om, dpk, s, w, orders, target, w_lo, w_hi, symmetrize,
+                labels):
+    """One pole set for all entries (vector fitting of the normalised matrix function): the
+    smallest order of ``orders`` with overall band error below ``target``, else the best.
+    Returns fits (poles, coef) per distinct entry (all sharing one poles list), orders, done."""
+    done = {}                                   # distinct entry -> its first place in entries
+    for e, (i, j) in enumerate(entries):
+        if not (symmetrize and (j, i) in done):
+            done[(i, j)] = e
+    keys = list(done)
+    norm = np.array([np.sqrt(dpk[i] * dpk[j]) for (i, j) in keys])
+    Fn = np.concatenate([np.zeros((1, len(keys))),
+                         np.stack([ZK[:, i, j] for (i, j) in keys], axis=1) / norm], axis=0)
+    Zb = np.stack([Z[band, i, j] for (i, j) in keys], axis=1) / norm
+    best = None
+    for n in orders:
+        poles, coef = _vf(s, Fn, w, n, w_lo, w_hi)
+        fit = _basis(1j * _band_omega(s, band, n_om), poles) @ coef
+        err = float(np.linalg.norm(fit - Zb) / np.linalg.norm(Zb))
+        if best is None or err < best[0]:
+            best = (err, poles, coef, n)
+        if err < target:
+            break
+    _, poles, coef, n = best
+    distinct = {k: (poles, coef[:, e] * norm[e]) for e, k in enumerate(keys)}
+    fits = [distinct[(i, j) if (i, j) in distinct else (j, i)] for (i, j) in entries]
+    used = {}
+    for (i, j) in entries:
+        used[(labels[i], labels[j])] = int(n)
+    return fits, used, done
+
+
+def _band_omega(s, band, n_om):
+    """The in-band ω of the fit grid s = [0, iω_0, …] (the first n_om after s = 0 are the BEM ω)."""
+    return s[1:1 + n_om].imag[band]
+
+
+def _pole_coef_rows(reps, coef):
+    """Per pole representative: (2×2 or 1×1 block, its B column, its C row) of the real form."""
+    k = 0
+    for a in reps:
+        if a.imag == 0:
+            yield np.array([[a.real]]), np.array([1.0]), np.array([coef[k]])
+            k += 1
+        else:
+            # z' = a z + u, y = r z + conj: with z = x1 + i x2, y = 2 (Re r x1 − Im r x2)
+            yield (np.array([[a.real, -a.imag], [a.imag, a.real]]), np.array([1.0, 0.0]),
+                   np.array([2 * coef[k], -2 * coef[k + 1]]))
+            k += 2
+
+
+def _realise(entries, poles, nd, shared=False):
+    """Block-diagonal real realisation of the per-entry pole–residue models. ``shared`` (one pole
+    set for all entries): one block of states per input dof j, read by every entry (i, j)."""
+    if shared and entries:
+        reps = poles[0][0]
+        ins = sorted({j for _, j in entries})
+        blk = [b for b, _, _ in _pole_coef_rows(reps, poles[0][1])]
+        m = sum(b.shape[0] for b in blk)
+        A = np.zeros((m * len(ins), m * len(ins)))
+        B = np.zeros((m * len(ins), nd))
+        C = np.zeros((nd, m * len(ins)))
+        for q, j in enumerate(ins):
+            o = q * m
+            for b, bb, _ in _pole_coef_rows(reps, poles[0][1]):
+                A[o:o + len(bb), o:o + len(bb)] = b
+                B[o:o + len(bb), j] = bb
+                o += len(bb)
+        for (i, j), (_, coef) in zip(entries, poles):
+            o = ins.index(j) * m
+            C[i, o:o + m] = np.concatenate([cc for _, _, cc in _pole_coef_rows(reps, coef)])
+        return A, B, C
     blocks = []
     for (i, j), (reps, coef) in zip(entries, poles):
         k = 0
@@ -322,12 +430,13 @@ def _realise(entries, poles, nd):
 
 
 def fit_state_space(db: xr.Dataset, *, order="auto", method: str = "vf",
-                    omega_fit=(0.2, 2.0), max_order: int = 12, target: float = 0.005,
+                    omega_fit=(0.2, 2.0), max_order: int | None = None, target: float = 0.005,
                     drop_tol: float = 1e-2, symmetrize: bool = True, weight_outside: float = 0.1,
                     fit_added_mass_inf: bool = True, passivity_omega=None,
                     passivity_tol: float = 1e-6, irf_dt: float = 0.02, irf_tmax: float = 150.0,
                     tail: str = "extrapolate", passive_target: bool = True,
-                    enforce_passivity: bool = True) -> StateSpaceRadiation:
+                    enforce_passivity: bool = True, dofs=None,
+                    pole_sharing: str = "entry") -> StateSpaceRadiation:
     """Fit a state-space radiation model to `db` (added_mass, radiation_damping, added_mass_inf).
 
     Target. K(t) from B(ω) (hydro.radiation.impulse_response, `tail` beyond the last BEM
@@ -336,8 +445,15 @@ def fit_state_space(db: xr.Dataset, *, order="auto", method: str = "vf",
     to the database B in band, and defined beyond the BEM range (fitted up to 3 ω_max with
     weight `weight_outside`, which keeps spurious poles out of the unmeasured range).
     order: int (poles per entry, same for all) or "auto": per entry the smallest even order
-        2, 4, …, max_order whose relative error over `omega_fit` is below `target` (and, for a
-        diagonal entry, whose Re K̂_ii ≥ −1e-3 · band max on 0 … 100 ω_max).
+        2, 4, …, max_order (default 12) whose relative error over `omega_fit` is below `target`
+        (and, for a diagonal entry, whose Re K̂_ii ≥ −1e-3 · band max on 0 … 100 ω_max).
+    pole_sharing: "entry" (each entry its own poles and states: few poles each, but the states
+        grow with the number of entries, O(n_dof²)) or "common" (one pole set for all entries,
+        vector fitting of the whole matrix, each entry normalised by √(D_i D_j), D the band
+        maxima of the diagonal; the states are shared by the entries of one input dof:
+        O(n_dof · order), what many-body systems need, M4 134: 24 dofs, 300 distinct entries).
+        With "common", order "auto" is the smallest of 8, 12, …, max_order (default 40) whose
+        overall error is below `target`, else the best.
     method: "vf" (vector fitting of K(iω)) or "era" (Hankel SVD of K(t)); module docstring.
     omega_fit: (ω_lo, ω_hi) rad/s, the band of weight 1 and of the reported errors.
     symmetrize: fit (K + Kᵀ)/2 (reciprocity; a BEM asymmetry is discretisation error) — K_ij and
@@ -359,10 +475,15 @@ def fit_state_space(db: xr.Dataset, *, order="auto", method: str = "vf",
         a dof whose band damping is below 1e-6 of the largest (rotations divided by L², L the cube
         root of the largest displaced volume), e.g. yaw of an axisymmetric body, is dropped with
         all its entries.
+    dofs: the dofs to model, as labels or indices (default: all). A dof left out gets no entries
+        (its rows and columns of K̂ are 0): pass the dofs the mechanics can move, e.g. without the
+        sway, roll and yaw of a planar model, whose inputs ξ̇_j are always 0 and whose outputs
+        do no work (M4 134: 24 of 48 dofs, a quarter of the entries).
     Report (read-only mapping):
         entry_error {(dof_i, dof_j): relative L2 error over the band against the database
             impedance B + iω(A − A_inf) taken about the model's added_mass_inf};
-        overall_error: ||K̂ − K||_F / ||K||_F, the same over all entries (dropped ones included);
+        overall_error: ||K̂ − K||_F / ||K||_F, the same over all entries of the modelled dofs
+            (dropped ones included);
         added_mass_inf_correction_max: (dof_i, dof_j, ΔA, ΔA / sqrt(A∞_ii A∞_jj));
         dropped, drop_tol, n_states, orders, max_real_eig (max Re eig(A); < 0: stable);
         passivity_min_eig: min over ω of the smallest eigenvalue of the Hermitian part of
@@ -398,6 +519,15 @@ def fit_state_space(db: xr.Dataset, *, order="auto", method: str = "vf",
     L = float(np.cbrt(np.max(db["displaced_volume"].values))) if "displaced_volume" in db else 1.0
     cmp_ = np.where(rot, bpk / L ** 2, bpk)
     dof_ok = cmp_ > 1e-6 * cmp_.max()
+    if dofs is not None:
+        chosen = np.zeros(nd, dtype=bool)
+        for d in dofs:
+            k = labels.index(str(d)) if str(d) in labels else d
+            if not isinstance(k, (int, np.integer)) or not 0 <= k < nd:
+                raise ValueError(f"dofs: {d!r} is neither a dof label of the database ({labels[:3]} "
+                                 f"…) nor an index in [0, {nd})")
+            chosen[k] = True
+        dof_ok &= chosen
     db_t = db
     if passive_target and symmetrize:
         # nearest PSD damping per frequency (normalised by the band diagonal): BEM B matrices of
@@ -439,10 +569,22 @@ def fit_state_space(db: xr.Dataset, *, order="auto", method: str = "vf",
         T_K = memory_length(K, t, rtol=1e-3)
         n_t = int(np.searchsorted(t, max(2.0 * T_K, 20.0)))
 
-    orders = [order] if order != "auto" else list(range(2, max_order + 1, 2))
+    if pole_sharing not in ("entry", "common"):
+        raise ValueError(f"pole_sharing={pole_sharing!r}; accepted: 'entry', 'common'")
+    if method == "era" and pole_sharing == "common":
+        raise ValueError("pole_sharing='common' needs method='vf' (ERA fits one entry at a time)")
+    if pole_sharing == "common":
+        max_order = 40 if max_order is None else max_order
+        orders = [order] if order != "auto" else list(range(8, max_order + 1, 4))
+    else:
+        max_order = 12 if max_order is None else max_order
+        orders = [order] if order != "auto" else list(range(2, max_order + 1, 2))
     w_chk = np.concatenate([np.linspace(0.0, om[-1], 200)[1:], om[-1] * np.geomspace(1.0, 100.0, 30)[1:]])
     fits, errs, used, done = [], {}, {}, {}
-    for (i, j) in entries:
+    if pole_sharing == "common":
+        fits, used, done = _fit_common(entries, ZK, Z, band, len(om), dpk, s, w, orders, target,
+                                       w_lo, w_hi, symmetrize, labels)
+    for (i, j) in (entries if pole_sharing == "entry" else ()):
         if symmetrize and (j, i) in done:               # same model, its own states
             fits.append(fits[done[(j, i)]])
             used[(labels[i], labels[j])] = used[(labels[j], labels[i])]
@@ -477,13 +619,14 @@ def fit_state_space(db: xr.Dataset, *, order="auto", method: str = "vf",
     if enforce_passivity and symmetrize and done:
         n_enforce = _enforce_passivity(fits, done, nd, dpk, dof_ok, s, w, om[-1])
         fits = [fits[done[(i, j)] if (i, j) in done else done[(j, i)]] for (i, j) in entries]
-    Am, Bm, Cm = _realise(entries, fits, nd)
+    Am, Bm, Cm = _realise(entries, fits, nd, shared=pole_sharing == "common")
     P_all, R_all = zip(*[_pole_residue(p, c) for p, c in fits]) if fits else ((), ())
     ss = StateSpaceRadiation(Am, Bm, Cm, Ainf_fit, tuple(labels), tuple(entries), tuple(P_all),
                              tuple(R_all), MappingProxyType({}))
     # report
     Zf = fitted_impedance(ss, om)
-    overall = float(np.linalg.norm((Zf - Z)[band]) / np.linalg.norm(Z[band]))
+    blk = np.ix_(np.flatnonzero(band), np.flatnonzero(dof_ok), np.flatnonzero(dof_ok))
+    overall = float(np.linalg.norm((Zf - Z)[blk]) / np.linalg.norm(Z[blk]))
     errs = {(labels[i], labels[j]): float(np.linalg.norm((Zf - Z)[band, i, j])
                                           / np.linalg.norm(Z[band, i, j])) for (i, j) in entries}
     dA_rel = np.abs(dA) / np.sqrt(np.abs(np.outer(np.diag(Ainf_fit), np.diag(Ainf_fit))) + 1e-300)
@@ -508,7 +651,8 @@ def fit_state_space(db: xr.Dataset, *, order="auto", method: str = "vf",
         "symmetrized": bool(symmetrize),
         "added_mass_inf_correction_max": (labels[k_dA[0]], labels[k_dA[1]], float(dA[k_dA]),
                                           float(dA_rel[k_dA])),
-        "orders": used, "dropped": dropped, "drop_tol": drop_tol,
+        "orders": used, "dropped": dropped, "drop_tol": drop_tol, "pole_sharing": pole_sharing,
+        "modelled_dofs": tuple(labels[k] for k in np.flatnonzero(dof_ok)),
         "n_states": int(Am.shape[0]), "max_real_eig": max_re, "stable": bool(max_re < 0),
         "passivity_min_eig": float(lam.min()),
         "passivity_min_eig_omega": float(passivity_omega[int(np.argmin(lam))]),

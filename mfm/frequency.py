@@ -96,7 +96,7 @@ def linearise(model: Model, q0=None):
     return np.asarray(q0), M0, K, C, H0
 
 
-def _radiation_at(spec, omega, radiation="database"):
+def _radiation_at(spec, omega, radiation="database", state_space_options=None):
     """A(ω), B(ω) (n_ω, 6K, 6K) of one of the radiation models:
 
     "database": the BEM values, linearly interpolated on the database grid;
@@ -127,20 +127,20 @@ def _radiation_at(spec, omega, radiation="database"):
         return (np.asarray(added_mass_from_irf(K, t, spec.added_mass_inf(), omega)),
                 np.asarray(damping_from_irf(K, t, omega)))
     if radiation == "state_space":
-        ss = spec.state_space()
+        ss = spec.state_space(**(state_space_options or {}))
         Z = ss.impedance(omega)
         A_inf = np.asarray(ss.added_mass_inf) * spec.mask
         return A_inf[None] + Z.imag / omega[:, None, None], Z.real
     raise ValueError(f"radiation={radiation!r}; accepted: 'database', 'convolution', 'state_space'")
 
 
-def _hydro_at(spec, omega, heading, radiation="database"):
+def _hydro_at(spec, omega, heading, radiation="database", state_space_options=None):
     """A(ω), B(ω) (n_ω, 6K, 6K) (see :func:`_radiation_at`) and X(ω, β) (n_ω, 6K)."""
     from hydro.excitation import excitation_coefficients
     from hydro.waves import WaveComponents, wavenumber
 
     db = spec.database()
-    A, B = _radiation_at(spec, omega, radiation)
+    A, B = _radiation_at(spec, omega, radiation, state_space_options)
     comps = WaveComponents(omega=omega, amplitude=np.ones_like(omega), phase=np.zeros_like(omega),
                            heading=np.full_like(omega, heading),
                            wavenumber=wavenumber(omega, spec.water_depth, spec.g),
@@ -150,13 +150,14 @@ def _hydro_at(spec, omega, heading, radiation="database"):
 
 
 def frequency_response(model: Model, omega, heading: float = 0.0, *, q0=None,
-                       radiation: str = "database") -> xr.Dataset:
+                       radiation: str = "database", state_space_options: dict | None = None) -> xr.Dataset:
     """Complex RAOs (per metre of wave amplitude, x(t) = Re[x̂ e^{−iωt}]) of every coordinate,
     body (CoM displacement and small rotation, inertial axes), hydro dof and PTO, with the absorbed
     power per unit wave amplitude squared, from the model linearised about its equilibrium.
 
     radiation: which A(ω), B(ω): "database" (the BEM values), or exactly those of the time-domain
-    models, "convolution" or "state_space" (see :func:`_radiation_at`).
+    models, "convolution" or "state_space" (see :func:`_radiation_at`); ``state_space_options``
+    as given to :func:`mfm.simulate` (the same options give the same fit).
 
     Returns an xarray.Dataset: ``rao`` (omega, coordinate), ``body_rao`` (omega, body, dof) with
     dof = x, y, z, rx, ry, rz, ``xi_rao`` (omega, hydro_dof), ``pto_rao`` and ``pto_power``
@@ -167,7 +168,7 @@ def frequency_response(model: Model, omega, heading: float = 0.0, *, q0=None,
                          "config with a [hydro] table (and mfm.load(..., hydro=True))")
     omega = np.atleast_1d(np.asarray(omega, dtype=float))
     q0, M0, K, C, H0 = linearise(model, q0)
-    A, B, X = _hydro_at(model.hydro, omega, heading, radiation)
+    A, B, X = _hydro_at(model.hydro, omega, heading, radiation, state_space_options)
     F = np.einsum("ai,wa->wi", H0, X)
     Aq = np.einsum("ai,wab,bj->wij", H0, A, H0)
     Bq = np.einsum("ai,wab,bj->wij", H0, B, H0)

@@ -443,3 +443,104 @@ def _version() -> str:
         return version("mfm")
     except Exception:  # not installed (running from a source tree)
         return "unknown"
+
+
+def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
+                   radiation: str = "state_space", state_space_options: dict | None = None,
+                   memory: float | None = None, save_every: int = 1, t0: float = 0.0,
+                   q0=None, qd0=None) -> xr.Dataset:
+    """Many runs of one topology in one compiled, ``jax.vmap``-ed call: a sweep over sea states,
+    time steps and model parameters (a power matrix, a T_p sweep at dt = T_p/200, a hinge-height
+    study) without retracing.
+
+    model: a :class:`Model`, or a sequence of Models of one topology (parameters differ, e.g.
+        made with ``equinox.tree_at``; their ``hydro`` must be the same object).
+    seas: a sea state or a sequence of them (``hydro.waves``; None for still water).
+    dt, ramp: s, a number or one per case. Every case runs ``n_steps`` steps (so a sweep at
+        dt = T_p/200 over 100 T_p is one shape: 20,000 steps).
+    radiation: "state_space" (default; its arrays have one shape whatever dt), "none", or
+        "convolution" (only when every case has the same number of lags, e.g. one dt).
+    Sequences of length > 1 must agree in length B; length-1 arguments are broadcast.
+
+    Returns an :class:`xarray.Dataset` with dimensions (case, step, coordinate): ``time``
+    (case, step), ``q``, ``qd``, ``pto_power`` (case, step, pto) of the joint dampers, ``eta``
+    (case, step) the undisturbed elevation at the origin, and ``dt`` (case).
+    Raises :class:`SimulationError` naming the first case that goes non-finite.
+    """
+    models = list(model) if isinstance(model, (list, tuple)) else [model]
+    seas = list(seas) if isinstance(seas, (list, tuple)) else [seas]
+    dts = np.atleast_1d(np.asarray(dt, dtype=float))
+    ramps = np.atleast_1d(np.asarray(ramp, dtype=float))
+    sizes = {"model": len(models), "seas": len(seas), "dt": dts.size, "ramp": ramps.size}
+    B = max(sizes.values())
+    bad = {k: v for k, v in sizes.items() if v not in (1, B)}
+    if bad:
+        raise ValueError(f"simulate_batch: the batched arguments must have one length or 1; got "
+                         f"{sizes}")
+    if not (np.all(dts > 0) and np.all(np.isfinite(dts))):
+        raise ValueError(f"dt: {dts} must be positive numbers of seconds")
+    if n_steps < 1 or n_steps % save_every:
+        raise ValueError(f"n_steps: {n_steps} must be ≥ 1 and a multiple of save_every={save_every}")
+    pick = lambda seq, i: seq[i if len(seq) > 1 else 0]  # noqa: E731
+    structure = {m_.coordinates for m_ in models}
+    if len(structure) > 1 or len({id(m_.hydro) for m_ in models}) > 1:
+        raise ValueError("model: the models of a batch must share one topology and one hydro "
+                         "spec (make them from one Model with equinox.tree_at)")
+    integ = _integrators.get(integrator)
+    loads = [model_loads(pick(models, i), pick(seas, i), dt=float(pick(dts, i)),
+                         duration=n_steps * float(pick(dts, i)), t0=t0, ramp=float(pick(ramps, i)),
+                         radiation=radiation, memory=memory,
+                         state_space_options=state_space_options) for i in range(B)]
+    defs = {jax.tree_util.tree_structure(ld) for ld in loads}
+    if len(defs) > 1:
+        raise ValueError("simulate_batch: the cases' loads differ in structure (with "
+                         "radiation='convolution' the number of lags follows dt: give every case "
+                         "the same dt and memory, or use radiation='state_space')")
+    stack = lambda items: jax.tree_util.tree_map(lambda *a: jnp.stack(a), *items)  # noqa: E731
+    m0 = models[0]
+    q0 = jnp.asarray(_initial_vector(m0, q0, "q0"))
+    qd0 = jnp.asarray(_initial_vector(m0, qd0, "qd0"))
+    parts = [ld.initial_state(m0) for ld in loads[0]]
+    z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
+    batched_model = stack([pick(models, i) for i in range(B)]) if len(models) > 1 else m0
+
+    def one(m_, lds, d):
+        return _rollout_jit(m_, lds, q0, qd0, z0, jnp.asarray(t0, jnp.float64), d, n_steps=int(n_steps),
+                            integrator=integ, save_every=int(save_every), record=False)
+
+    out = jax.vmap(one, in_axes=(0 if len(models) > 1 else None, 0, 0))(
+        batched_model, stack(loads), jnp.asarray(np.broadcast_to(dts, (B,)).copy()))
+    t, q, qd = (np.asarray(a) for a in out[:3])
+    for i in range(B):
+        if not (np.isfinite(q[i]).all() and np.isfinite(qd[i]).all()):
+            k = int(np.argmax(~np.isfinite(q[i]).all(axis=1) | ~np.isfinite(qd[i]).all(axis=1)))
+            raise SimulationError(f"simulate_batch: case {i} went non-finite at t = {t[i, k]:.6g} s "
+                                  f"(dt = {pick(dts, i):.4g} s); run it alone with mfm.simulate "
+                                  "for the diagnosis")
+    coords = {"case": np.arange(B), "coordinate": list(m0.coordinates)}
+    ds = xr.Dataset(
+        {"time": (("case", "step"), t, {"units": "s"}),
+         "q": (("case", "step", "coordinate"), q, {"long_name": "generalised coordinates",
+                                                   "units": "m or rad"}),
+         "qd": (("case", "step", "coordinate"), qd, {"long_name": "generalised velocities",
+                                                     "units": "m/s or rad/s"}),
+         "dt": (("case",), np.broadcast_to(dts, (B,)).copy(), {"units": "s"})},
+        coords=coords,
+        attrs={"title": f"mfm batch of {B} runs of {m0.name}", "model": m0.name,
+               "integrator": integ.name, "radiation": radiation, "n_steps": int(n_steps),
+               "save_every": int(save_every), "mfm_version": _version(),
+               "jax_version": jax.__version__,
+               "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")})
+    damping = np.stack([np.asarray(pick(models, i).damping) for i in range(B)])
+    damped = [k for k in range(m0.n_coordinates) if np.any(damping[:, k] > 0)]
+    if damped:
+        ds = ds.assign_coords(pto=[m0.coordinates[k] for k in damped])
+        ds["pto_power"] = (("case", "step", "pto"), damping[:, None, damped] * qd[:, :, damped] ** 2,
+                           {"long_name": "power absorbed by each joint damper, c q̇²", "units": "W"})
+    water = [ld for ld in loads[0] if hasattr(ld, "eta_values")]
+    if water:
+        k = loads[0].index(water[0])
+        eta = np.stack([np.asarray(loads[i][k].eta_values)[::2 * save_every][:t.shape[1]]
+                        for i in range(B)])
+        ds["eta"] = (("case", "step"), eta, {"long_name": "wave elevation at the origin", "units": "m"})
+    return ds
