@@ -186,8 +186,8 @@ def test_wave_power_and_energy_period():
     P = wec.wave_power(2.0, 8.0)
     assert P == pytest.approx(1000 * 9.81 ** 2 * 4 * 8 / (64 * math.pi), rel=1e-12)
     assert wec.wave_power(2.0, 8.0, water_depth=1000.0) == pytest.approx(P, rel=1e-6)
-    # shallow water: c_g → √(g h)
-    assert wec.wave_power(0.1, 30.0, water_depth=1.0) == pytest.approx(1000 * 9.81 * 0.01 / 16 * math.sqrt(9.81), rel=2e-3)
+    # shallow water: c_g → √(g h) (1 − (kh)²/2 + …): kh = 0.02 at T = 100 s in 1 m, 2e-4 below
+    assert wec.wave_power(0.1, 100.0, water_depth=1.0) == pytest.approx(1000 * 9.81 * 0.01 / 16 * math.sqrt(9.81), rel=1e-3)
     # a regular wave of height H carries twice the power of a sea of H_s = H at T_e = T
     assert wec.wave_power(1.0, 6.0, regular=True) == pytest.approx(2 * wec.wave_power(1.0, 6.0), rel=1e-12)
     # Pierson–Moskowitz: T_e / T_p = Γ(5/4) / (5/4)^{1/4} = 0.8572 (m₋₁/m₀ in closed form)
