@@ -360,7 +360,8 @@ class HydroSpec:
 
         W = ∫ K(τ) φ(τ) dτ with φ the hat functions of those knots (product integration: exact for
         the interpolated velocity, however sharp K is near τ = 0). K is sampled ``subdivisions``
-        times per step. Returns (W_c (3, 6K, 6K), W (3, N, 6K, 6K)), N = ceil(T_K/dt) + 1.
+        times per step. Returns (W_c (3, n, n), W (3, N, n, n)), N = ceil(T_K/dt) + 1, over the
+        n dofs the model moves (:attr:`moving`, in that order).
         """
         T_K = self.memory() if memory is None else float(memory)
         n = max(int(math.ceil(T_K / dt)), 2) + 1
@@ -371,7 +372,8 @@ class HydroSpec:
             check_grid(self.database(), (n - 1) * dt, on_fail="warn")
             h = dt / subdivisions
             tau = np.arange((n + 1) * subdivisions + 1) * h     # up to s + (N−1) dt + … ≤ (N+1) dt
-            K = self.impulse_response(tau)
+            mv = np.asarray(self.moving)
+            K = self.impulse_response(tau)[:, mv][:, :, mv]
             wq = np.full(len(tau), h)
             wq[0] = wq[-1] = 0.5 * h
             Wc, W = [], []
@@ -380,14 +382,13 @@ class HydroSpec:
                 knots = s + np.arange(n) * dt                 # history knots
                 if r:
                     knots = np.concatenate([[0.0], knots])      # the current velocity at τ = 0
-                phi = np.zeros((len(knots), len(tau)))
                 inside = tau <= knots[-1] + 1e-12
                 k = np.clip(np.searchsorted(knots, tau[inside], side="right") - 1, 0, len(knots) - 2)
                 frac = (tau[inside] - knots[k]) / (knots[k + 1] - knots[k])
-                cols = np.flatnonzero(inside)
-                np.add.at(phi, (k, cols), 1.0 - frac)
-                np.add.at(phi, (k + 1, cols), frac)
-                Wk = np.einsum("kf,f,fab->kab", phi, wq, K)
+                Kw = K[inside] * wq[inside][:, None, None]
+                # each sample feeds its two hat functions (k sorted: sums by segments, no dense φ)
+                Wk = (_segment_sums(k, Kw * (1.0 - frac)[:, None, None], len(knots))
+                      + _segment_sums(k + 1, Kw * frac[:, None, None], len(knots)))
                 if r:
                     Wc.append(Wk[0])
                     W.append(Wk[1:])
@@ -433,9 +434,7 @@ def build_water(model: Model, spec: HydroSpec, sea, *, dt: float, duration: floa
         ss_p, ss_C = np.stack([P.real, P.imag], 1), np.stack([C.real, C.imag], -1)
         A_inf = np.asarray(ss.added_mass_inf) * spec.mask
     elif radiation == "convolution":
-        W_current, W_lag = spec.kernel(dt, memory)
-        mv = np.asarray(spec.moving)
-        W_current, W_lag = W_current[:, mv][:, :, mv], W_lag[:, :, mv][:, :, :, mv]
+        W_current, W_lag = spec.kernel(dt, memory)          # over the moved dofs
         n_lags = W_lag.shape[1]
     geometry = BodyPoints(body_index=spec.body_index, d_ref=jnp.asarray(spec.d_ref),
                           ref0=jnp.asarray(spec.ref0))
@@ -447,6 +446,15 @@ def build_water(model: Model, spec: HydroSpec, sea, *, dt: float, duration: floa
                  exc_values=f64(exc), eta_values=f64(eta), radiation=radiation, n_lags=n_lags,
                  added_mass=added_mass, conv_dofs=tuple(spec.moving),
                  dofs=spec.dofs)
+
+
+def _segment_sums(idx, vals, n_out):
+    """out[i] = Σ vals[j] over j with idx[j] = i, for non-decreasing idx."""
+    out = np.zeros((n_out,) + vals.shape[1:])
+    if len(idx):
+        starts = np.flatnonzero(np.r_[True, np.diff(idx) != 0])
+        out[idx[starts]] = np.add.reduceat(vals, starts, axis=0)
+    return out
 
 
 def modal_form(ss):
