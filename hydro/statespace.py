@@ -387,14 +387,14 @@ def _realise(entries, poles, nd, shared=False):
     if shared and entries:
         reps = poles[0][0]
         ins = sorted({j for _, j in entries})
-        blk = [b for b, _, _ in _pole_coef_rows(reps, poles[0][1])]
-        m = sum(b.shape[0] for b in blk)
+        rows = list(_pole_coef_rows(reps, poles[0][1]))
+        m = sum(len(bb) for _, bb, _ in rows)
         A = np.zeros((m * len(ins), m * len(ins)))
         B = np.zeros((m * len(ins), nd))
         C = np.zeros((nd, m * len(ins)))
         for q, j in enumerate(ins):
             o = q * m
-            for b, bb, _ in _pole_coef_rows(reps, poles[0][1]):
+            for b, bb, _ in rows:
                 A[o:o + len(bb), o:o + len(bb)] = b
                 B[o:o + len(bb), j] = bb
                 o += len(bb)
@@ -402,19 +402,8 @@ def _realise(entries, poles, nd, shared=False):
             o = ins.index(j) * m
             C[i, o:o + m] = np.concatenate([cc for _, _, cc in _pole_coef_rows(reps, coef)])
         return A, B, C
-    blocks = []
-    for (i, j), (reps, coef) in zip(entries, poles):
-        k = 0
-        for a in reps:
-            if a.imag == 0:
-                blocks.append((np.array([[a.real]]), np.array([1.0]), np.array([coef[k]]), i, j))
-                k += 1
-            else:
-                # z' = a z + u, y = r z + conj: with z = x1 + i x2, y = 2 (Re r x1 − Im r x2)
-                blk = np.array([[a.real, -a.imag], [a.imag, a.real]])
-                blocks.append((blk, np.array([1.0, 0.0]), np.array([2 * coef[k], -2 * coef[k + 1]]),
-                               i, j))
-                k += 2
+    blocks = [(blk, bb, cc, i, j) for (i, j), (reps, coef) in zip(entries, poles)
+              for blk, bb, cc in _pole_coef_rows(reps, coef)]
     nx = sum(b[0].shape[0] for b in blocks)
     A = np.zeros((nx, nx))
     B = np.zeros((nx, nd))
@@ -584,36 +573,37 @@ def fit_state_space(db: xr.Dataset, *, order="auto", method: str = "vf",
     if pole_sharing == "common":
         fits, used, done = _fit_common(entries, ZK, Z, band, len(om), dpk, s, w, orders, target,
                                        w_lo, w_hi, symmetrize, labels)
-    for (i, j) in (entries if pole_sharing == "entry" else ()):
-        if symmetrize and (j, i) in done:               # same model, its own states
-            fits.append(fits[done[(j, i)]])
-            used[(labels[i], labels[j])] = used[(labels[j], labels[i])]
-            continue
-        done[(i, j)] = len(fits)
-        fs = np.abs(ZK[:len(om)][band, i, j]).max()
-        fn = np.concatenate([[0.0], ZK[:, i, j] / fs])
-        zb = Z[band, i, j] / fs
-        best = None
-        for n in orders:
-            if method == "vf":
-                poles, coef = _vf(s, fn, w, n, w_lo, w_hi)
-            else:
-                poles, coef = _era_fit(t[:n_t], K[:n_t, i, j] / fs, dt_era, n)
-            P, R = _pole_residue(poles, coef)
-            fit = (1.0 / (1j * om[band][:, None] - P[None])) @ R
-            err = np.linalg.norm(fit - zb) / np.linalg.norm(zb)
-            # a diagonal entry must itself be passive (Re K̂_ii ≥ 0) everywhere, not only in band
-            pas = True
-            if i == j:
-                pas = bool(((1.0 / (1j * w_chk[:, None] - P[None])) @ R).real.min() > -1e-3)
-            key = (not pas, err)
-            if best is None or key < best[0]:
-                best = (key, poles, coef, n)
-            if err < target and pas:
-                break
-        _, poles, coef, n = best
-        fits.append((poles, coef * fs))
-        used[(labels[i], labels[j])] = int(n)
+    else:
+        for (i, j) in entries:
+            if symmetrize and (j, i) in done:               # same model, its own states
+                fits.append(fits[done[(j, i)]])
+                used[(labels[i], labels[j])] = used[(labels[j], labels[i])]
+                continue
+            done[(i, j)] = len(fits)
+            fs = np.abs(ZK[:len(om)][band, i, j]).max()
+            fn = np.concatenate([[0.0], ZK[:, i, j] / fs])
+            zb = Z[band, i, j] / fs
+            best = None
+            for n in orders:
+                if method == "vf":
+                    poles, coef = _vf(s, fn, w, n, w_lo, w_hi)
+                else:
+                    poles, coef = _era_fit(t[:n_t], K[:n_t, i, j] / fs, dt_era, n)
+                P, R = _pole_residue(poles, coef)
+                fit = (1.0 / (1j * om[band][:, None] - P[None])) @ R
+                err = np.linalg.norm(fit - zb) / np.linalg.norm(zb)
+                # a diagonal entry must itself be passive (Re K̂_ii ≥ 0) everywhere, not only in band
+                pas = True
+                if i == j:
+                    pas = bool(((1.0 / (1j * w_chk[:, None] - P[None])) @ R).real.min() > -1e-3)
+                key = (not pas, err)
+                if best is None or key < best[0]:
+                    best = (key, poles, coef, n)
+                if err < target and pas:
+                    break
+            _, poles, coef, n = best
+            fits.append((poles, coef * fs))
+            used[(labels[i], labels[j])] = int(n)
 
     n_enforce = 0
     if enforce_passivity and symmetrize and done:

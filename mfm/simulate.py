@@ -417,16 +417,25 @@ def _dataset(model, integ, dt, t, q, qd, qdd, iters, rec) -> xr.Dataset:
                            "the CoM, parallel to inertial at q = 0",
         },
     )
-    damped = [k for k in range(model.n_coordinates) if float(model.damping[k]) > 0]
+    damped, power = _damper_power(np.asarray(model.damping), qd)
     if damped:
-        c = np.asarray(model.damping)[damped]
         ds = ds.assign_coords(pto=[model.coordinates[k] for k in damped])
-        ds["pto_power"] = (("time", "pto"), c * qd[:, damped] ** 2,
-                           {"long_name": "power absorbed by each joint damper, c q̇²", "units": "W"})
+        ds["pto_power"] = (("time", "pto"), power, _PTO_POWER_ATTRS)
         ds["pto_displacement"] = (("time", "pto"), q[:, damped],
                                   {"long_name": "joint coordinate of each damper (relative angle or "
                                    "stroke)", "units": "rad or m"})
     return ds
+
+
+_PTO_POWER_ATTRS = {"long_name": "power absorbed by each joint damper, c q̇²", "units": "W"}
+
+
+def _damper_power(damping, qd):
+    """The coordinates with a joint damper (c > 0 in any case) and the power c q̇² of each:
+    damping (n_q,) or (case, n_q), qd (…, time, n_q) → (indices, (…, time, n_damped))."""
+    damped = [int(k) for k in np.flatnonzero(np.any(np.atleast_2d(damping) > 0, axis=0))]
+    c = damping[..., damped]
+    return damped, (c[..., None, :] if c.ndim > 1 else c) * qd[..., damped] ** 2
 
 
 def _coordinate_unit(model: Model, name: str) -> str:
@@ -531,15 +540,12 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
                "save_every": int(save_every), "mfm_version": _version(),
                "jax_version": jax.__version__,
                "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")})
-    damping = np.stack([np.asarray(pick(models, i).damping) for i in range(B)])
-    damped = [k for k in range(m0.n_coordinates) if np.any(damping[:, k] > 0)]
+    damped, power = _damper_power(np.stack([np.asarray(pick(models, i).damping) for i in range(B)]), qd)
     if damped:
         ds = ds.assign_coords(pto=[m0.coordinates[k] for k in damped])
-        ds["pto_power"] = (("case", "step", "pto"), damping[:, None, damped] * qd[:, :, damped] ** 2,
-                           {"long_name": "power absorbed by each joint damper, c q̇²", "units": "W"})
-    water = [ld for ld in loads[0] if hasattr(ld, "eta_values")]
-    if water:
-        k = loads[0].index(water[0])
+        ds["pto_power"] = (("case", "step", "pto"), power, _PTO_POWER_ATTRS)
+    k = next((k for k, ld in enumerate(loads[0]) if hasattr(ld, "eta_values")), None)
+    if k is not None:
         eta = np.stack([np.asarray(loads[i][k].eta_values)[::2 * save_every][:t.shape[1]]
                         for i in range(B)])
         ds["eta"] = (("case", "step"), eta, {"long_name": "wave elevation at the origin", "units": "m"})

@@ -52,8 +52,8 @@ class Water(Load):
     ``ss_p``, ``ss_C`` the radiation state space in modal form: one complex state per pole and
     input dof j (shared by the entries (i, j) fitted with the same poles; conjugate pairs folded),
     ż = p z + ξ̇_j, F_i = −Σ_k Re(C_ik z_k) (no dense A: O(n_x) per evaluation for the states); ``W_current``
-    (3, 6K, 6K) and ``W_lag`` (3, N, 6K, 6K) the convolution weights per stage offset 0, dt/2, dt
-    (:meth:`HydroSpec.kernel`); the excitation
+    (3, n, n) and ``W_lag`` (3, N, n, n) the convolution weights per stage offset 0, dt/2, dt over
+    the n dofs ``conv_dofs`` (:meth:`HydroSpec.kernel`); the excitation
     ``exc_values`` (n, 6K) on the grid ``exc_t0 + j·exc_step`` and the wave elevation at the
     origin ``eta_values`` (n,) on the same grid.
     Static: ``radiation`` ("convolution" | "state_space" | "none"), ``n_lags``, ``conv_dofs``
