@@ -35,7 +35,7 @@ def row(model, T, H, radiation, label):
     raw = mfm.frequency_response(model, [w])
     ds = mfm.simulate(model, hydro.Regular(height=H, period=T), duration=60 * T, dt=T / 100,
                       ramp=5 * T, radiation=radiation)
-    wn = mfm.natural_frequencies(model)["eigen"]
+    wn = mfm.natural_frequencies(model)["eigen"].values
     wn = wn[np.abs(wn - w) > 0.1 * w]
     t = ds.time.values
     sel = t > t[-1] - 10 * T

@@ -27,3 +27,8 @@ from hydro.radiation import (  # noqa: E402,F401
     added_mass_from_irf, check_grid, damping_from_irf, impulse_response, memory_length,
 )
 from hydro.statespace import StateSpaceRadiation, fit_state_space, fitted_impedance  # noqa: E402,F401
+
+# a database made ready for both domains (symmetry, A∞, K(t), fits, convolution weights), and one
+# function that opens any database file by its type
+from hydro import prepare  # noqa: E402,F401
+from hydro.prepare import HydroSpec, open_any_database  # noqa: E402,F401

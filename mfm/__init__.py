@@ -9,17 +9,18 @@ import jax
 
 jax.config.update("jax_enable_x64", True)
 
-from . import config, integrators, loads, se3, water, wec  # noqa: E402
+from . import config, integrators, loads, results, se3, water, wec  # noqa: E402
+from .build import compile_tree, load  # noqa: E402
 from .frequency import equilibrium, frequency_response, natural_frequencies  # noqa: E402
 from .dynamics import (coriolis_matrix, energies, evaluate, forward_dynamics,  # noqa: E402
                        mass_matrix, reaction_loads)
 from .kinematics import b_matrix, b_matrix_dot, body_poses, kinematics  # noqa: E402
-from .model import Model, compile_tree, load  # noqa: E402
-from .simulate import SimulationError, StabilityWarning, rollout, simulate, simulate_batch  # noqa: E402
+from .model import Model  # noqa: E402
+from .simulate import AccuracyWarning, SimulationError, StabilityWarning, rollout, simulate, simulate_batch  # noqa: E402
 from .tree import ConfigError  # noqa: E402
 
-__all__ = ["ConfigError", "Model", "SimulationError", "b_matrix", "b_matrix_dot", "body_poses",
+__all__ = ["AccuracyWarning", "ConfigError", "Model", "SimulationError", "b_matrix", "b_matrix_dot", "body_poses",
            "compile_tree", "config", "coriolis_matrix", "energies", "equilibrium", "evaluate",
            "forward_dynamics", "frequency_response", "natural_frequencies", "water",
            "integrators", "kinematics", "load", "loads", "mass_matrix", "reaction_loads",
-           "rollout", "se3", "simulate", "simulate_batch", "StabilityWarning", "wec"]
+           "results", "rollout", "se3", "simulate", "simulate_batch", "StabilityWarning", "wec"]

@@ -257,8 +257,8 @@ def _sha256(path) -> str:
 def _check_database(path: Path, config_path: Path, options: dict, bodies) -> None:
     """Load ``path`` the way ``mfm.load(config)`` does (open_any_database → from_capytaine →
     schema checks → the config's bodies on the tree)."""
-    from .model import compile_tree
-    from .water import load_hydro_spec
+    from .build import compile_tree
+    from .loads.water import load_hydro_spec
 
     model = compile_tree(bodies, name=options["name"], gravity=options["gravity"])
     hyd = dict(options.get("hydro") or {})

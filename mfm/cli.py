@@ -119,16 +119,16 @@ def cmd_rao(args):
     ds = mfm.frequency_response(model, omega, heading=float(np.deg2rad(args.heading)),
                                 radiation=args.radiation)
     nat = mfm.natural_frequencies(model)
-    ds["natural_frequency"] = (("mode",), nat["eigen"], {"units": "rad/s",
+    ds["natural_frequency"] = (("mode",), nat["eigen"].values, {"units": "rad/s",
                                                          "long_name": "undamped, generalised eigenproblem"})
-    ds.attrs["natural_frequencies_min_det"] = np.array2string(nat["min_det"], precision=5)
+    ds.attrs["natural_frequencies_min_det"] = np.array2string(nat["min_det"].values, precision=5)
     ds.attrs["config"] = str(args.config)
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     split_complex(ds).to_netcdf(out)
     print(f"{model.name}: RAOs at {args.n} frequencies {args.omega_min}–{args.omega_max} rad/s -> {out}")
-    print(f"  natural frequencies (eigen): {np.round(nat['eigen'], 4).tolist()} rad/s")
-    print(f"  natural frequencies (min |det|): {np.round(nat['min_det'], 4).tolist()} rad/s")
+    print(f"  natural frequencies (eigen): {np.round(nat['eigen'].values, 4).tolist()} rad/s")
+    print(f"  natural frequencies (min |det|): {np.round(nat['min_det'].values, 4).tolist()} rad/s")
     for c in model.coordinates:
         a = np.abs(ds.rao.sel(coordinate=c).values)
         print(f"  {c:>24s}: peak |RAO| {a.max():.4g} at {omega[a.argmax()]:.4g} rad/s")

@@ -35,40 +35,22 @@ from typing import Any
 
 import numpy as np
 
+from .loads.registry import TABLES as LOAD_TABLES
+from .loads.registry import load_class
+from .parsing import number as _number
+from .parsing import unknown as _unknown
+from .parsing import vector as _vector
 from .tree import (JOINT_KINDS, PLANAR_DOFS, ROOT_DOFS, BodySpec, ConfigError, JointSpec,
                    check_inertia, tree_order)
 
-TOP_KEYS = {"model", "bodies", "hydro", "moorings", "ptos"}
-PTO_KEYS = {"name", "kind", "body", "point", "anchor_body", "anchor", "mu", "beta", "kappa", "notes"}
+# the tables of loads (moorings, ptos, ...) come from the load registry (mfm.loads.registry)
+TOP_KEYS = {"model", "bodies", "hydro"} | set(LOAD_TABLES)
 HYDRO_KEYS = {"database", "names", "body_coupling", "added_mass_inf", "rho", "g", "bem", "notes"}
 BODY_HYDRO_KEYS = {"body", "drag_coefficient", "drag_area", "notes"}
-MOORING_KEYS = {"name", "body", "point", "stiffness", "notes"}
 MODEL_KEYS = {"name", "gravity", "description"}
 BODY_KEYS = {"name", "mass", "com", "inertia", "principal_inertia", "radii_of_gyration", "parent",
              "joint", "hydro", "geometry", "notes"}
 JOINT_KEYS = {"type", "axis", "point", "dofs", "damping", "stiffness", "rest", "locked", "notes"}
-
-
-def _unknown(keys, allowed, where):
-    bad = sorted(set(keys) - set(allowed))
-    if bad:
-        raise ConfigError(f"{where}: unknown key(s) {bad}; accepted keys: {sorted(allowed)}")
-
-
-def _vector(value, n, where, what="numbers"):
-    try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{where}: {value!r} is not a list of {n} {what}") from None
-    if arr.shape != (n,) or not np.all(np.isfinite(arr)):
-        raise ConfigError(f"{where}: {value!r} is not a list of {n} finite {what}")
-    return arr
-
-
-def _number(value, where):
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
-        raise ConfigError(f"{where}: {value!r} is not a finite number")
-    return float(value)
 
 
 def _per_coordinate(value, n, where):
@@ -212,66 +194,6 @@ def _parse_hydro(raw, source):
     return out
 
 
-def _tables(raw, section, keys):
-    """(where, table) for each table of an array of tables ``[[section]]``, keys checked."""
-    if not isinstance(raw, list):
-        raise ConfigError(f"{section}: expected [[{section}]] tables")
-    for i, table in enumerate(raw):
-        where = f"{section}[{i}]"
-        if not isinstance(table, dict):
-            raise ConfigError(f"{where}: expected a table")
-        _unknown(table, keys, where)
-        yield where, table
-
-
-def _body_ref(table, key, where, names):
-    if table.get(key) not in names:
-        raise ConfigError(f"{where}.{key}: {table.get(key)!r} is not a body; known bodies: {names}")
-    return table[key]
-
-
-def _parse_ptos(raw, names):
-    out = []
-    for i, (where, p) in enumerate(_tables(raw, "ptos", PTO_KEYS)):
-        if p.get("kind", "hydraulic") != "hydraulic":
-            raise ConfigError(f"{where}.kind: {p.get('kind')!r}; accepted: 'hydraulic' (joint "
-                              "spring–dampers are set on the joint itself: damping, stiffness)")
-        _body_ref(p, "body", where, names)
-        anchor_body = p.get("anchor_body")
-        if anchor_body is not None and anchor_body not in names:
-            raise ConfigError(f"{where}.anchor_body: {anchor_body!r} is not a body; known bodies: "
-                              f"{names} (leave it out to anchor in the inertial frame)")
-        for key in ("point", "anchor"):
-            if key not in p:
-                raise ConfigError(f"{where}.{key}: missing; a point [x, y, z] in m at q = 0")
-        vals = {}
-        for key in ("mu", "beta", "kappa"):
-            vals[key] = _number(p.get(key, 0.0), f"{where}.{key}")
-            if vals[key] < 0:
-                raise ConfigError(f"{where}.{key}: {vals[key]} is negative; give a value ≥ 0")
-        point, anchor = _vector(p["point"], 3, f"{where}.point"), _vector(p["anchor"], 3, f"{where}.anchor")
-        if np.linalg.norm(point - anchor) < 1e-9:
-            raise ConfigError(f"{where}: point and anchor coincide; a piston needs a length")
-        out.append({"name": str(p.get("name", f"pto{i}")), "body": p["body"], "point": point,
-                    "anchor_body": anchor_body, "anchor": anchor, **vals})
-    return out
-
-
-def _parse_moorings(raw, names):
-    out = []
-    for i, (where, m) in enumerate(_tables(raw, "moorings", MOORING_KEYS)):
-        body = _body_ref(m, "body", where, names)
-        k = _vector(m.get("stiffness"), 3, f"{where}.stiffness") if "stiffness" in m else None
-        if k is None or np.any(k < 0):
-            raise ConfigError(f"{where}.stiffness: {m.get('stiffness')!r}; give [kx, ky, kz] ≥ 0 in "
-                              "N/m (inertial axes)")
-        if "point" not in m:
-            raise ConfigError(f"{where}.point: missing; the attachment point [x, y, z] (m, q = 0)")
-        out.append({"name": str(m.get("name", f"mooring{i}")), "body": body,
-                    "point": _vector(m["point"], 3, f"{where}.point"), "stiffness": k})
-    return out
-
-
 def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodySpec]]:
     """Validate a parsed TOML document. Returns (model options, bodies in tree order)."""
     _unknown(data, TOP_KEYS, source)
@@ -325,8 +247,9 @@ def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodyS
     ordered = tree_order(bodies)
     if "hydro" in data:
         options["hydro"] = _parse_hydro(data["hydro"], source)
-    options["moorings"] = _parse_moorings(data.get("moorings", []), [b.name for b in bodies])
-    options["ptos"] = _parse_ptos(data.get("ptos", []), [b.name for b in bodies])
+    # each load table is checked by its own load (mfm.loads): one place per idea
+    options["loads"] = {table: load_class(table).parse_table(data[table], [b.name for b in bodies])
+                        for table in LOAD_TABLES if table in data}
     return options, ordered
 
 

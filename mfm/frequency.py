@@ -1,58 +1,92 @@
 """Frequency domain: static equilibrium, linearisation of the same model, RAOs, natural frequencies.
 
-The model of :func:`mfm.simulate` is linearised about its static equilibrium q₀ (DESIGN §4): jax
-gives the stiffness ``K = −∂G/∂q`` of the static generalised load G(q) (gravity, buoyancy at the
-centre of buoyancy, water-plane stiffness, moorings, joint springs), ``M₀ = M*(q₀)`` and
-``H₀ = H(q₀)``. With the complex-amplitude convention of the hydro databases, x(t) = Re[x̂ e^{−iωt}]:
+The model of :func:`mfm.simulate`, with exactly the loads it carries (its water, its config's
+loads, and any ``loads=``), is linearised about its static equilibrium q₀ (DESIGN §4). With Q(q, q̇)
+the generalised loads other than inertia (gravity, the loads at rest in still water —
+:meth:`~mfm.loads.base.Load.static_load` — and the joint spring–dampers), jax gives
 
-    Z(ω) x̂ = H₀ᵀ X(ω, β),   Z(ω) = −ω² (M₀ + H₀ᵀ A(ω) H₀) − iω (H₀ᵀ B(ω) H₀ + C) + K,
+    K = −∂Q/∂q,   C = −∂Q/∂q̇   at (q₀, 0),   M = M*(q₀) + Σ (acceleration-proportional loads),
 
-C the joint dampers. x̂ per metre of wave amplitude is the RAO of every coordinate; bodies, hydro
-dofs and PTOs follow from the same Jacobians. Quadratic drag is not linearised (it is left out).
+and each load adds what has memory or comes from the waves (:meth:`Load.frequency_terms`): the
+water its radiation impedance −ω² Hᵀ(A(ω) − A∞)H − iω HᵀB(ω)H and its wave force Hᵀ X(ω, β).
+With x(t) = Re[x̂ e^{−iωt}] (the hydro databases' convention):
+
+    Z(ω) x̂ = F(ω),   Z(ω) = −ω² M − iω C + K + Σ Z_load(ω).
+
+x̂ per metre of wave amplitude is the RAO of every coordinate; bodies, hydro dofs, PTOs and named
+points follow from the same Jacobians. Quadratic drag has zero slope at rest (it drops out).
 """
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
 import numpy as np
-import xarray as xr
 
+from . import results
 from .dynamics import gravity_loads, joint_loads, mass_matrix
 from .kinematics import kinematics
 from .model import Model
 
 
-def _static_loads(model: Model):
-    from .simulate import applied_loads, model_loads
+def _as_loads(loads):
+    from .simulate import _as_loads as as_loads
 
-    # still water, no radiation: the static loads (gravity, buoyancy, water plane, moorings, PTOs)
-    loads = model_loads(model, None, dt=1.0, duration=1.0, radiation="none")
-    mems = tuple(ld.init_memory(model, 0.0, jnp.zeros(model.n_coordinates),
-                                jnp.zeros(model.n_coordinates), 1.0) for ld in loads)
-    nz = sum(ld.n_states for ld in loads)
+    return as_loads(loads)
 
-    def G(q):
-        qd = jnp.zeros_like(q)
+
+def system_loads(model: Model, loads=None) -> tuple:
+    """The loads of the linearisation: the model's water in still water (no radiation memory: the
+    frequency domain adds its radiation as an impedance), the config's loads and ``loads``."""
+    from .simulate import model_loads
+
+    return model_loads(model, None, dt=1.0, duration=1.0, radiation="none") + _as_loads(loads)
+
+
+def _static_functions(model: Model, loads):
+    """Q(q, q̇) (generalised loads other than inertia) and the acceleration-proportional matrix of
+    the loads at rest, M_loads(q)."""
+    from .simulate import applied_loads
+
+    static = tuple(s for s in (ld.static_load() for ld in loads) if s is not None)
+    zero = jnp.zeros(model.n_coordinates)
+    mems = tuple(ld.init_memory(model, 0.0, zero, zero, 1.0) for ld in static)
+    nz = sum(ld.n_states for ld in static)
+
+    def parts(q, qd):
         kin = kinematics(model, q, qd)
-        body, tau, _, _ = applied_loads(model, loads, 0.0, q, qd, jnp.zeros(nz), kin, mems)
+        body, tau, mass, _ = applied_loads(model, static, 0.0, q, qd, jnp.zeros(nz), kin, mems)
         F = gravity_loads(model) + (0.0 if body is None else body)
         out = jnp.einsum("nai,na->i", kin.B, F) + joint_loads(model, q, qd)
-        return out if tau is None else out + tau
+        return (out if tau is None else out + tau), mass
 
-    return G, loads
+    def Q(q, qd):
+        return parts(q, qd)[0]
+
+    def M_loads(q):
+        mass = parts(q, jnp.zeros_like(q))[1]
+        return jnp.zeros((model.n_coordinates,) * 2) if mass is None else mass
+
+    return Q, M_loads
 
 
-def equilibrium(model: Model, q_guess=None, *, tol: float = 1e-10, max_iter: int = 50):
-    """Static equilibrium q₀ with G(q₀) = 0 (Newton with the jax Jacobian; least squares where
-    nothing restores a coordinate, which then stays at its guess).
+def equilibrium(model: Model, q_guess=None, *, loads=None, tol: float = 1e-10, max_iter: int = 50):
+    """Static equilibrium q₀ with Q(q₀, 0) = 0 (Newton with the jax Jacobian; least squares where
+    nothing restores a coordinate, which then stays at its guess), under the model's own loads and
+    ``loads`` (e.g. a :class:`~mfm.loads.JointLoad` preload).
 
     Returns (q₀, info) with info = dict(residual, iterations, free: coordinates without
     stiffness). Raises ValueError when no equilibrium is found (a body that cannot float freely
     sinks or capsizes), naming the residual by coordinate.
     """
-    G, _ = _static_loads(model)
+    return _equilibrium(model, system_loads(model, loads), q_guess, tol, max_iter)
+
+
+def _equilibrium(model, loads, q_guess=None, tol=1e-10, max_iter=50):
+    Q, _ = _static_functions(model, loads)
+    G = lambda q: Q(q, jnp.zeros_like(q))  # noqa: E731
     Gj = jax.jit(G)
     Jj = jax.jit(jax.jacfwd(G))
     q = jnp.zeros(model.n_coordinates) if q_guess is None else jnp.asarray(q_guess, jnp.float64)
@@ -60,6 +94,7 @@ def equilibrium(model: Model, q_guess=None, *, tol: float = 1e-10, max_iter: int
     scale = max(float(jnp.max(jnp.abs(jnp.einsum("nai,na->i", kinematics(model, q).B,
                                                  gravity_loads(model))))),
                 float(jnp.max(model.mass)) * float(model.gravity))
+    it = 0
     for it in range(max_iter):
         g = np.asarray(Gj(q))
         if np.abs(g).max() < tol * scale:
@@ -71,7 +106,7 @@ def equilibrium(model: Model, q_guess=None, *, tol: float = 1e-10, max_iter: int
     J = np.asarray(Jj(q))
     free = [model.coordinates[k] for k in range(model.n_coordinates)
             if np.abs(J[:, k]).max() < 1e-12 * scale]
-    if np.abs(g).max() > 1e-6 * scale:
+    if not np.isfinite(g).all() or np.abs(g).max() > 1e-6 * scale:
         bad = {model.coordinates[k]: float(g[k]) for k in np.argsort(-np.abs(g))[:3]}
         raise ValueError(f"no static equilibrium of {model.name!r} found from the guess: residual "
                          f"generalised loads {bad} (N or N m). A body whose weight its buoyancy "
@@ -79,158 +114,163 @@ def equilibrium(model: Model, q_guess=None, *, tol: float = 1e-10, max_iter: int
     return np.asarray(q), {"residual": float(np.abs(g).max()), "iterations": it, "free": free}
 
 
-def linearise(model: Model, q0=None):
-    """(q₀, M₀, K, C, H₀): mass, stiffness and joint damping matrices (n_q, n_q) about the
-    equilibrium, and the hydro Jacobian H₀ (6K, n_q) (None without water)."""
+class LinearSystem(NamedTuple):
+    """The model linearised about q₀: M, K, C (n_q, n_q) (M with the loads' acceleration-
+    proportional terms, A∞ included), the kinematics at q₀ and the loads it was made from."""
+    q0: np.ndarray
+    M: np.ndarray
+    K: np.ndarray
+    C: np.ndarray
+    kin0: object
+    loads: tuple
+
+
+def linear_system(model: Model, q0=None, *, loads=None) -> LinearSystem:
+    """Linearise the model with its loads (:func:`system_loads`) about q₀ (default: the
+    equilibrium)."""
+    lds = system_loads(model, loads)
+    return _linear_system(model, lds, q0)
+
+
+def _linear_system(model, lds, q0=None):
     if q0 is None:
-        q0, _ = equilibrium(model)
+        q0, _ = _equilibrium(model, lds)
     q0 = jnp.asarray(q0, jnp.float64)
-    G, loads = _static_loads(model)
-    K = -np.asarray(jax.jacfwd(G)(q0))
-    M0 = np.asarray(mass_matrix(model, q0))
-    C = np.diag(np.asarray(model.damping))
-    H0 = None
-    if model.hydro is not None:
-        kin = kinematics(model, q0, jnp.zeros_like(q0))
-        H0 = np.asarray(loads[0].geometry.h_matrix(kin)[0])
-    return np.asarray(q0), M0, K, C, H0
+    Q, M_loads = _static_functions(model, lds)
+    zero = jnp.zeros_like(q0)
+    K = -np.asarray(jax.jacfwd(lambda q: Q(q, zero))(q0))
+    C = -np.asarray(jax.jacfwd(lambda v: Q(q0, v))(zero))
+    M = np.asarray(mass_matrix(model, q0)) + np.asarray(M_loads(q0))
+    return LinearSystem(np.asarray(q0), M, K, C, kinematics(model, q0, zero), lds)
 
 
-def _radiation_at(spec, omega, radiation="database", state_space_options=None):
-    """A(ω), B(ω) (n_ω, 6K, 6K) of one of the radiation models:
-
-    "database": the BEM values, linearly interpolated on the database grid;
-    "convolution": the time-domain model of ``simulate(radiation="convolution")``: A∞ (as used
-        there) − ∫K sin ωt dt/ω and ∫K cos ωt dt (Ogilvie), K from B(ω) with its tail;
-    "state_space": the fitted model of ``simulate(radiation="state_space")``: its A∞ and impedance
-        K̂(iω) = B + iω(A − A∞).
-    A database whose A(ω) and B(ω) are not Kramers–Kronig consistent (RM3's surge–pitch couplings
-    by 1–3 %) gives different "database" and "convolution" answers; the time domain can only be
-    the consistent one.
-    """
-    db = spec.database()
-    om_db = np.asarray(db["omega"].values)
-    if omega.min() < om_db[0] * (1 - 1e-9) or omega.max() > om_db[-1] * (1 + 1e-9):
-        raise ValueError(f"omega: [{omega.min():.4g}, {omega.max():.4g}] rad/s lies outside the "
-                         f"database's [{om_db[0]:.4g}, {om_db[-1]:.4g}] rad/s; choose frequencies "
-                         "inside it or regenerate the database")
-    if radiation == "database":
-        return db["added_mass"].interp(omega=omega).values, db["radiation_damping"].interp(omega=omega).values
-    if radiation == "convolution":
-        from hydro.radiation import added_mass_from_irf, damping_from_irf
-
-        # graded near τ = 0, where entries with slowly decaying damping have a narrow spike
-        step = min(0.02, np.pi / om_db.max() / 4)
-        t = np.concatenate([np.linspace(0.0, 25 * step, 2501)[:-1],
-                            np.arange(25 * step, max(4 * spec.memory(), 60.0), step)])
-        K = spec.impulse_response(t)
-        return (np.asarray(added_mass_from_irf(K, t, spec.added_mass_inf(), omega)),
-                np.asarray(damping_from_irf(K, t, omega)))
-    if radiation == "state_space":
-        ss = spec.state_space(**(state_space_options or {}))
-        Z = ss.impedance(omega)
-        A_inf = np.asarray(ss.added_mass_inf) * spec.mask
-        return A_inf[None] + Z.imag / omega[:, None, None], Z.real
-    raise ValueError(f"radiation={radiation!r}; accepted: 'database', 'convolution', 'state_space'")
+def linearise(model: Model, q0=None, *, loads=None):
+    """(q₀, M₀, K, C, H₀): the structural mass M*(q₀), stiffness and linear damping (n_q, n_q)
+    about the equilibrium, and the hydro Jacobian H₀ (6K, n_q) (None without water)."""
+    sys = linear_system(model, q0, loads=loads)
+    M0 = np.asarray(mass_matrix(model, jnp.asarray(sys.q0)))
+    water = _water(sys.loads)
+    H0 = None if water is None else np.asarray(water.geometry.h_matrix(sys.kin0)[0])
+    return sys.q0, M0, sys.K, sys.C, H0
 
 
-def _hydro_at(spec, omega, heading, radiation="database", state_space_options=None):
-    """A(ω), B(ω) (n_ω, 6K, 6K) (see :func:`_radiation_at`) and X(ω, β) (n_ω, 6K)."""
-    from hydro.excitation import excitation_coefficients
-    from hydro.waves import WaveComponents, wavenumber
+def _water(loads):
+    from .loads.water import Water
 
-    db = spec.database()
-    A, B = _radiation_at(spec, omega, radiation, state_space_options)
-    comps = WaveComponents(omega=omega, amplitude=np.ones_like(omega), phase=np.zeros_like(omega),
-                           heading=np.full_like(omega, heading),
-                           wavenumber=wavenumber(omega, spec.water_depth, spec.g),
-                           water_depth=spec.water_depth, g=spec.g)
-    X = excitation_coefficients(db, comps)
-    return A, B, X
+    return next((ld for ld in loads if isinstance(ld, Water)), None)
+
+
+def _terms(model, sys, omega, heading, options):
+    """Σ of the loads' impedances (n_ω, n_q, n_q) and wave forces (n_ω, n_q)."""
+    n = model.n_coordinates
+    Z = np.zeros((len(omega), n, n), dtype=complex)
+    F = np.zeros((len(omega), n), dtype=complex)
+    for ld in sys.loads:
+        t = ld.frequency_terms(model, sys.q0, sys.kin0, omega, heading, options)
+        if t.impedance is not None:
+            Z = Z + t.impedance
+        if t.force is not None:
+            F = F + t.force
+    return Z, F
 
 
 def frequency_response(model: Model, omega, heading: float = 0.0, *, q0=None,
-                       radiation: str = "database", state_space_options: dict | None = None) -> xr.Dataset:
+                       radiation: str = "database", state_space_options: dict | None = None,
+                       loads=None):
     """Complex RAOs (per metre of wave amplitude, x(t) = Re[x̂ e^{−iωt}]) of every coordinate,
     body (CoM displacement and small rotation, inertial axes), hydro dof and PTO, with the absorbed
-    power per unit wave amplitude squared, from the model linearised about its equilibrium.
+    power per unit wave amplitude squared, from the model linearised about its equilibrium with
+    every load it carries and ``loads``.
 
+    omega: rad/s, inside the database's range. heading: rad (direction the waves travel to,
+    from +x towards +y).
     radiation: which A(ω), B(ω): "database" (the BEM values), or exactly those of the time-domain
-    models, "convolution" or "state_space" (see :func:`_radiation_at`); ``state_space_options``
+    models, "convolution" or "state_space" (:mod:`mfm.loads.radiation`); ``state_space_options``
     as given to :func:`mfm.simulate` (the same options give the same fit).
 
     Returns an xarray.Dataset: ``rao`` (omega, coordinate), ``body_rao`` (omega, body, dof) with
     dof = x, y, z, rx, ry, rz, ``xi_rao`` (omega, hydro_dof), ``pto_rao`` and ``pto_power``
-    (omega, pto) (W/m², mean power ½ c ω² |x̂|²), ``equilibrium`` (coordinate).
+    (omega, pto) (W/m², mean power ½ c ω² |x̂|²), the loads' own outputs (``hydraulic_pto_power``,
+    ``point_rao``, …), ``equilibrium`` (coordinate).
     """
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: frequency_response needs a "
                          "config with a [hydro] table (and mfm.load(..., hydro=True))")
-    omega = np.atleast_1d(np.asarray(omega, dtype=float))
-    q0, M0, K, C, H0 = linearise(model, q0)
-    A, B, X = _hydro_at(model.hydro, omega, heading, radiation, state_space_options)
-    F = np.einsum("ai,wa->wi", H0, X)
-    Aq = np.einsum("ai,wab,bj->wij", H0, A, H0)
-    Bq = np.einsum("ai,wab,bj->wij", H0, B, H0)
+    try:
+        omega = np.atleast_1d(np.asarray(omega, dtype=float))
+    except (TypeError, ValueError):
+        raise ValueError(f"omega: {omega!r} is not an array of frequencies (rad/s)") from None
+    if omega.ndim != 1 or omega.size == 0 or not np.all(np.isfinite(omega)) or np.any(omega <= 0):
+        raise ValueError(f"omega: give positive, finite frequencies in rad/s (got {omega!r})")
+    heading = float(heading)
+    options = {"radiation": radiation, "state_space_options": state_space_options}
+    sys = linear_system(model, q0, loads=loads)
+    Zl, F = _terms(model, sys, omega, heading, options)
     w = omega[:, None, None]
-    Z = -w**2 * (M0[None] + Aq) - 1j * w * (Bq + C[None]) + K[None]
+    Z = -w**2 * sys.M[None] - 1j * w * sys.C[None] + sys.K[None] + Zl
     x = np.linalg.solve(Z, F[..., None])[..., 0]
-    kin = kinematics(model, jnp.asarray(q0), jnp.zeros_like(jnp.asarray(q0)))
-    Bm = np.asarray(kin.B)
-    R = np.asarray(kin.E[:, :3, :3])
-    body = np.concatenate([np.einsum("nai,wi->wna", Bm[:, :3], x),
-                           np.einsum("nab,nbi,wi->wna", R, Bm[:, 3:], x)], axis=2)
-    damped = [k for k in range(model.n_coordinates) if float(model.damping[k]) > 0]
-    c = np.asarray(model.damping)[damped]
-    ds = xr.Dataset(
-        {"rao": (("omega", "coordinate"), x, {"long_name": "coordinate RAO per metre of wave "
-                                             "amplitude, x(t) = Re[x e^{-i omega t}]", "units": "m/m or rad/m"}),
-         "body_rao": (("omega", "body", "dof"), body, {"long_name": "CoM displacement and small "
-                                                        "rotation of each body, inertial axes"}),
-         "xi_rao": (("omega", "hydro_dof"), np.einsum("ai,wi->wa", H0, x),
-                    {"long_name": "hydro coordinates (reference points) RAO"}),
-         "pto_rao": (("omega", "pto"), x[:, damped]),
-         "pto_power": (("omega", "pto"), 0.5 * c * omega[:, None] ** 2 * np.abs(x[:, damped]) ** 2,
-                       {"long_name": "mean absorbed power per unit wave amplitude squared", "units": "W/m2"}),
-         "equilibrium": (("coordinate",), q0, {"units": "m or rad"})},
-        coords={"omega": ("omega", omega, {"units": "rad/s"}), "coordinate": list(model.coordinates),
-                "body": list(model.body_names), "dof": ["x", "y", "z", "rx", "ry", "rz"],
-                "hydro_dof": list(model.hydro.dofs), "pto": [model.coordinates[k] for k in damped]},
-        attrs={"model": model.name, "heading": float(heading), "convention": "exp(-i omega t)",
-               "body_coupling": str(model.hydro.body_coupling), "source": model.hydro.source,
-               "radiation": radiation})
-    return ds
+    extra = [ld.frequency_outputs(model, sys.kin0, x, omega) for ld in sys.loads]
+    settings = {"radiation": radiation}
+    if state_space_options:
+        settings["state_space_options"] = repr(state_space_options)
+    return results.frequency(model, sys.loads, omega, x, sys.q0, sys.kin0, heading, settings,
+                             [e for e in extra if e])
 
 
-def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: int = 30):
-    """Undamped natural frequencies (rad/s) two ways.
+def _frequency_range(loads):
+    lo, hi = 0.0, math.inf
+    for ld in loads:
+        r = ld.frequency_range()
+        if r is not None:
+            lo, hi = max(lo, r[0]), min(hi, r[1])
+    return lo, hi
 
-    eigen: the generalised eigenproblem K v = ω² (M₀ + H₀ᵀ A(ω) H₀) v, iterated on ω for each mode
-        (A at that mode's own frequency); coordinates without stiffness have no mode.
-    min_det: local minima of |det Λ(ω)|, Λ = −ω²(M₀ + H₀ᵀ A(ω) H₀) + K, over ``omega_grid``
-        (seed 000 §2.10), refined parabolically.
-    Returns dict(eigen=array, min_det=array, modes=(n_q, n_modes)).
+
+def _mass_and_damping_at(model, sys, w, options):
+    """M(ω) = M + Re Σ Z_load(ω)/(−ω²) and the loads' damping −Im Σ Z_load(ω)/ω at ω clipped to
+    where every load is defined (A(ω) held at the ends of a database)."""
+    lo, hi = _frequency_range(sys.loads)
+    wc = np.clip(np.atleast_1d(w), lo, hi)
+    Z, _ = _terms(model, sys, wc, 0.0, dict(options, excitation=False))
+    return sys.M[None] + Z.real / (-wc[:, None, None] ** 2), -Z.imag / wc[:, None, None]
+
+
+def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: int = 30,
+                        loads=None, radiation: str = "database"):
+    """Natural frequencies (rad/s) and damping ratios, two ways.
+
+    eigen: the generalised eigenproblem K φ = ω² M(ω) φ, M(ω) = M + Hᵀ(A(ω) − A∞)H, iterated on ω
+        for each mode (A at that mode's own frequency); coordinates without stiffness have no mode.
+    min_det: local minima of |det Λ(ω)|, Λ = −ω² M(ω) + K, over ``omega_grid`` (seed 000 §2.10),
+        refined parabolically.
+    damping_ratio: φᵀ C φ / (2 ω φᵀ M(ω) φ) of each mode for the linear damping C (joint dampers,
+        hydraulic β, body matrices); radiation_damping_ratio the same with Hᵀ B(ω) H.
+
+    Returns an xarray.Dataset: ``eigen``, ``period``, ``damping_ratio``,
+    ``radiation_damping_ratio``, ``damped`` (mode), ``modes`` (coordinate, mode), ``min_det``
+    (root); it reads like the former dict (``nat["eigen"]``).
     """
     import scipy.linalg
 
-    q0, M0, K, C, H0 = linearise(model, q0)
-    spec = model.hydro
-    db = spec.database()
-    om_db = np.asarray(db["omega"].values)
-
-    def Aq(w):
-        A = db["added_mass"].interp(omega=np.clip(w, om_db[0], om_db[-1])).values
-        return H0.T @ A @ H0
-
+    options = {"radiation": radiation}
+    sys = linear_system(model, q0, loads=loads)
+    K = sys.K
+    lo, hi = _frequency_range(sys.loads)
     stiff = [k for k in range(model.n_coordinates) if np.abs(K[:, k]).max() > 1e-9 * np.abs(K).max()]
-    Ks = K[np.ix_(stiff, stiff)]
+    ix = np.ix_(stiff, stiff)
+    Ks = K[ix]
     n = len(stiff)
-    freqs, modes = [], []
-    lam0 = scipy.linalg.eigh(Ks, (M0 + Aq(om_db[-1]))[np.ix_(stiff, stiff)], eigvals_only=True)
+
+    def M_at(w):
+        return _mass_and_damping_at(model, sys, w, options)[0][0]
+
+    freqs, modes, zeta, zeta_rad = [], [], [], []
+    w_start = hi if math.isfinite(hi) else 1.0
+    lam0 = scipy.linalg.eigh(Ks, M_at(w_start)[ix], eigvals_only=True) if n else []
     for m in range(n):
         w = math.sqrt(max(lam0[m], 1e-30))
         for _ in range(iterations):
-            lam, vec = scipy.linalg.eigh(Ks, (M0 + Aq(w))[np.ix_(stiff, stiff)])
+            lam, vec = scipy.linalg.eigh(Ks, M_at(w)[ix])
             w_new = math.sqrt(max(lam[m], 1e-30))
             if abs(w_new - w) < 1e-10 * w:
                 break
@@ -239,8 +279,17 @@ def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: i
         v = np.zeros(model.n_coordinates)
         v[stiff] = vec[:, m]
         modes.append(v)
-    grid = np.linspace(om_db[0], om_db[-1], 2000) if omega_grid is None else np.asarray(omega_grid)
-    det = np.array([abs(np.linalg.det((-w**2 * (M0 + Aq(w)) + K)[np.ix_(stiff, stiff)])) for w in grid])
+        Mw, Cr = _mass_and_damping_at(model, sys, w, options)
+        mm = float(v @ Mw[0] @ v)
+        zeta.append(float(v @ sys.C @ v) / (2 * w * mm))
+        zeta_rad.append(float(v @ Cr[0] @ v) / (2 * w * mm))
+    if omega_grid is None:
+        top = hi if math.isfinite(hi) else 3.0 * max(freqs, default=1.0)
+        grid = np.linspace(lo if lo > 0 else top / 2000, top, 2000)
+    else:
+        grid = np.asarray(omega_grid, dtype=float)
+    Mg = _mass_and_damping_at(model, sys, grid, options)[0] if n else np.zeros((len(grid), 0, 0))
+    det = np.array([abs(np.linalg.det((-w**2 * Mg[i] + K)[ix])) for i, w in enumerate(grid)])
     mins = []
     for i in range(1, len(grid) - 1):
         if det[i] < det[i - 1] and det[i] <= det[i + 1]:
@@ -249,4 +298,42 @@ def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: i
             h = grid[i + 1] - grid[i]
             den = y0 - 2 * y1 + y2
             mins.append(grid[i] + (0.5 * h * (y0 - y2) / den if den > 0 else 0.0))
-    return {"eigen": np.array(freqs), "min_det": np.array(mins), "modes": np.array(modes).T}
+    modes = np.array(modes).T if modes else np.zeros((model.n_coordinates, 0))
+    return results.natural(model, sys.loads, np.array(freqs), modes, np.array(zeta),
+                           np.array(zeta_rad), np.array(mins), {"radiation": radiation})
+
+
+def critical_damping(model: Model, body: str, mode: str, ratio: float, *, point=None,
+                     loads=None, iterations: int = 30) -> float:
+    """The damping coefficient (N s/m or N m s/rad) that is ``ratio`` of critical for one
+    single-body mode of ``body`` (surge … yaw at ``point``, default its CoM), from the model's own
+    linearisation: with φ the least-norm coordinate motion that moves that dof of the point by one
+    unit, k = φᵀKφ, m(ω) = φᵀM(ω)φ (added mass at the mode's frequency, iterated), it is
+    c = 2 ζ √(k m). Used by ``[[body_matrices]] damping_ratio``."""
+    from .loads.base import MODES
+    from .points import BodyPoints
+
+    j = MODES.index(mode)
+    i = model.body_index(body)
+    pt = np.asarray(model.com[i]) if point is None else np.asarray(point, dtype=float)
+    sys = linear_system(model, loads=loads)
+    Hp = np.asarray(BodyPoints.on_bodies(model.com, [i], [pt]).h_matrix(sys.kin0)[0])
+    phi = np.linalg.pinv(Hp)[:, j]
+    moved = float((Hp @ phi)[j]) if phi.size else 0.0
+    if abs(moved) < 1e-9:
+        raise ValueError(f"damping_ratio.{mode} of body {body!r}: no coordinate of the model moves "
+                         f"that body in {mode}; give damping for the modes it has")
+    phi = phi / moved
+    k = float(phi @ sys.K @ phi)
+    if not k > 0:
+        raise ValueError(f"damping_ratio.{mode} of body {body!r}: the mode has no restoring "
+                         f"stiffness (φᵀKφ = {k:.4g}), so critical damping is undefined; give the "
+                         "damping in N s/m (or N m s/rad) instead")
+    w = math.sqrt(k / float(phi @ sys.M @ phi))
+    for _ in range(iterations):
+        m = float(phi @ _mass_and_damping_at(model, sys, w, {"radiation": "database"})[0][0] @ phi)
+        w_new = math.sqrt(k / m)
+        if abs(w_new - w) < 1e-12 * w:
+            break
+        w = w_new
+    return 2.0 * float(ratio) * math.sqrt(k * m)

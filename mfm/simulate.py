@@ -7,8 +7,8 @@ went non-finite, and returns an :class:`xarray.Dataset`.
 from __future__ import annotations
 
 import collections
-import datetime
 import math
+import numbers
 import warnings
 from typing import Sequence
 
@@ -18,10 +18,10 @@ import numpy as np
 import xarray as xr
 
 from . import integrators as _integrators
-from . import se3
-from .dynamics import energies, evaluate, mass_matrix, reaction_loads
+from . import results, se3
+from .dynamics import energies, evaluate, reaction_loads
 from .kinematics import kinematics
-from .loads import Load
+from .loads.base import Context, Load
 from .model import Model
 
 # How many times each compiled function was traced (a retrace means a recompilation); tests use it.
@@ -32,27 +32,53 @@ class StabilityWarning(UserWarning):
     """dt is beyond the integrator's stability limit for the model's shortest natural period."""
 
 
+class AccuracyWarning(UserWarning):
+    """dt is too coarse for the periods the sea excites: the expected period error is given."""
+
+
 class SimulationError(RuntimeError):
-    """The simulation went non-finite; the message gives the time, the state and the likely cause."""
+    """The simulation went non-finite; the message gives the time, the state and the likely cause.
+    ``dataset`` holds what was computed up to the last finite sample (attribute
+    ``complete = "false"``), or None."""
+
+    def __init__(self, message, dataset=None):
+        super().__init__(message)
+        self.dataset = dataset
 
 
 def model_loads(model: Model, sea=None, *, dt, duration, t0=0.0, ramp=0.0,
                 radiation="convolution", memory=None, state_space_options=None,
-                added_mass="lhs") -> tuple[Load, ...]:
-    """The loads a model carries itself: its moorings and, with a [hydro] config, its water for
-    this sea and time grid (see :func:`mfm.water.build_water`). Pass them to :func:`rollout`."""
+                added_mass="lhs", integrator="rk4") -> tuple[Load, ...]:
+    """The loads a model carries itself, ready for :func:`rollout`: with a [hydro] config its water
+    for this sea and time grid (:func:`mfm.loads.water.build_water`, prepared for the stage
+    times of ``integrator``), then the config's loads (``model.loads``: moorings, PTOs, …)."""
     out = []
     if model.hydro is not None:
-        from .water import build_water
+        from .loads.water import build_water
 
+        _check_sea(sea)
         out.append(build_water(model, model.hydro, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                                radiation=radiation, memory=memory,
-                               state_space_options=state_space_options, added_mass=added_mass))
-    if model.moorings is not None:
-        out.append(model.moorings)
-    if model.ptos is not None:
-        out.append(model.ptos)
-    return tuple(out)
+                               state_space_options=state_space_options, added_mass=added_mass,
+                               stage_offsets=_stage_offsets(integrator)))
+    return tuple(out) + tuple(model.loads)
+
+
+def _stage_offsets(integrator):
+    integ = _integrators.get(integrator)
+    offs = getattr(integ, "stage_offsets", None)
+    if offs is None:
+        raise TypeError(f"integrator {integ!r} declares no stage_offsets (the fractions of dt at "
+                        "which it evaluates the dynamics in a step, e.g. (0.0, 0.5, 1.0) for RK4); "
+                        "loads with memory need them")
+    return tuple(float(o) for o in offs)
+
+
+def _check_sea(sea):
+    if sea is not None and not hasattr(sea, "components"):
+        raise TypeError(f"sea: {sea!r} is not a sea state; give one of hydro.Regular(height=, "
+                        "period=), hydro.Jonswap(hs=, tp=), hydro.PiersonMoskowitz(hs=, tp=), "
+                        "hydro.UserSpectrum, hydro.MeasuredElevation, or None for still water")
 
 
 def _as_loads(loads) -> tuple[Load, ...]:
@@ -82,7 +108,8 @@ def applied_loads(model: Model, loads: Sequence[Load], t, q, qd, z, kin, memorie
     body = tau = mass = None
     zds, outs = [], []
     for k, ld in enumerate(loads):
-        out = ld(model, t, q, qd, z[offsets[k]:offsets[k + 1]], kin, memories[k], qdd_guess=qdd_guess)
+        out = ld.evaluate(Context(model, t, q, qd, z[offsets[k]:offsets[k + 1]], kin, memories[k],
+                                  qdd_guess))
         outs.append(out)
         if out.body is not None:
             body = out.body if body is None else body + out.body
@@ -132,11 +159,11 @@ def _record(model, loads, s, mem):
     F = None
     diag = {}
     for k, (ld, out) in enumerate(zip(loads, outs)):
-        zk = s.z[offs[k]:offs[k + 1]]
-        Fk = ld.reaction_loads(model, s.t, s.q, s.qd, ev.qdd, zk, kin, mem[k], out)
+        ctx = Context(model, s.t, s.q, s.qd, s.z[offs[k]:offs[k + 1]], kin, mem[k], s.qdd, ev.qdd)
+        Fk = ld.reaction_loads(ctx, out)
         if Fk is not None:
             F = Fk if F is None else F + Fk
-        diag.update(ld.diagnostics(model, s.t, s.q, s.qd, ev.qdd, zk, kin, mem[k], out))
+        diag.update(ld.diagnostics(ctx, out))
     ev_r = ev._replace(F=ev.F - (0.0 if body is None else body) + (0.0 if F is None else F))
     f_j, m_j = reaction_loads(model, ev_r)
     T, V = energies(model, s.q, s.qd)
@@ -185,6 +212,11 @@ def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=
     """
     loads = _as_loads(loads)
     integ = _integrators.get(integrator)
+    if isinstance(n_steps, bool) or not isinstance(n_steps, numbers.Integral) or n_steps < 1:
+        raise ValueError(f"n_steps: {n_steps!r}; give a positive whole number of steps")
+    if isinstance(save_every, bool) or not isinstance(save_every, numbers.Integral) or save_every < 1:
+        raise ValueError(f"save_every: {save_every!r}; give a positive whole number")
+    _check_concrete_positive(dt, "dt")
     q0 = jnp.asarray(q0, jnp.float64)
     qd0 = jnp.asarray(qd0, jnp.float64)
     if z0 is None:
@@ -194,6 +226,18 @@ def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=
                         jnp.asarray(t0, jnp.float64), jnp.asarray(dt, jnp.float64),
                         n_steps=int(n_steps), integrator=integ, save_every=int(save_every),
                         record=record)
+
+
+def _check_concrete_positive(value, what):
+    """A positive finite number of seconds, where the value is known (not a jax tracer)."""
+    if isinstance(value, jax.core.Tracer):
+        return
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what}: {value!r} is not a number; give a positive number of seconds") from None
+    if v.size == 0 or not (np.all(np.isfinite(v)) and np.all(v > 0)):
+        raise ValueError(f"{what}: {value!r}; give a positive, finite number of seconds")
 
 
 def _initial_vector(model: Model, value, what: str) -> np.ndarray:
@@ -208,12 +252,33 @@ def _initial_vector(model: Model, value, what: str) -> np.ndarray:
             except KeyError:
                 raise ValueError(f"{what}: {k!r} is not a coordinate of {model.name!r}; "
                                  f"coordinates: {list(model.coordinates)}") from None
-        return out
-    arr = np.asarray(value, dtype=float)
-    if arr.shape != (n,):
-        raise ValueError(f"{what}: shape {arr.shape} does not match the {n} coordinates "
-                         f"{list(model.coordinates)}; give an array of shape ({n},) or a dict")
-    return arr
+            except (TypeError, ValueError):
+                raise ValueError(f"{what}[{k!r}]: {v!r} is not a number") from None
+    else:
+        try:
+            out = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"{what}: {value!r} is not an array of numbers") from None
+        if out.shape != (n,):
+            raise ValueError(f"{what}: shape {out.shape} does not match the {n} coordinates "
+                             f"{list(model.coordinates)}; give an array of shape ({n},) or a dict")
+    bad = [model.coordinates[k] for k in np.flatnonzero(~np.isfinite(out))]
+    if bad:
+        raise ValueError(f"{what}: not finite for {bad}; give finite numbers (m, rad; m/s, rad/s)")
+    return out
+
+
+def _number(value, what, *, positive=False, nonnegative=False, allow_none=False):
+    """A finite float, with a message naming the argument when it is not."""
+    if value is None and allow_none:
+        return None
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+        raise ValueError(f"{what}: {value!r} is not a finite number")
+    if positive and not value > 0:
+        raise ValueError(f"{what}: {value!r} must be > 0")
+    if nonnegative and not value >= 0:
+        raise ValueError(f"{what}: {value!r} must be ≥ 0")
+    return float(value)
 
 
 @jax.jit
@@ -237,38 +302,27 @@ def shortest_natural_period(model: Model, q, loads=()) -> float:
     return math.inf if lam_max <= 0 else 2.0 * math.pi / math.sqrt(lam_max)
 
 
-def _raise_nonfinite(model, integ, t, q, qd, dt, loads):
-    bad = ~(np.isfinite(q).all(axis=1) & np.isfinite(qd).all(axis=1))
-    k = int(np.argmax(bad))
+def _nonfinite_message(model, integ, t, q, qd, dt, loads, k):
     coords = [model.coordinates[j] for j in range(model.n_coordinates)
               if not (np.isfinite(q[k, j]) and np.isfinite(qd[k, j]))]
     k_ok = max(k - 1, 0)
+    head = (f"the state went non-finite at t = {t[k]:.6g} s (first saved sample; last finite at "
+            f"t = {t[k_ok]:.6g} s) in coordinate(s) {coords}.")
     for ld in loads:
-        if getattr(ld, "added_mass", "lhs") == "rhs":
-            # the fixed-point iteration a ← M*⁻¹(F − Hᵀ A∞ H a) contracts only if the spectral
-            # radius of M*⁻¹ Hᵀ A∞ H is below 1
-            kin = kinematics(model, q[k_ok], qd[k_ok])
-            H = np.asarray(ld.geometry.h_matrix(kin)[0])
-            Ms = np.asarray(mass_matrix(model, q[k_ok]))
-            r = float(np.abs(np.linalg.eigvals(np.linalg.solve(Ms, H.T @ np.asarray(ld.A_inf) @ H))).max())
-            if r >= 1.0:
-                raise SimulationError(
-                    f"the state went non-finite at t = {t[k]:.6g} s in coordinate(s) {coords}. "
-                    f"Likely cause: added_mass='rhs' (the seed 001 iteration of A∞ ξ̈ on the "
-                    f"right-hand side) diverges here: the spectral radius of M*⁻¹ Hᵀ A∞ H is "
-                    f"{r:.3g} ≥ 1 (added mass larger than the structural mass). Use "
-                    "added_mass='lhs' (A∞ in M*, no iteration).")
-    T_min = shortest_natural_period(model, q[k_ok], loads)
-    lines = [f"the state went non-finite at t = {t[k]:.6g} s (first saved sample; last finite at "
-             f"t = {t[k_ok]:.6g} s) in coordinate(s) {coords}."]
+        cause = ld.describe_nonfinite(model, q[k_ok], qd[k_ok])
+        if cause:
+            return f"{head} {cause}"
+    # linearised at the start, as the stability warning is: the last finite state of a diverging
+    # run is itself far from any equilibrium
+    T_min = shortest_natural_period(model, q[0], loads)
+    lines = [head]
     if math.isfinite(T_min):
         ratio = 2 * math.pi * dt / T_min
         lines.append(f"Likely cause: dt = {dt:.4g} s against the shortest natural period "
                      f"{T_min:.4g} s (ω dt = {ratio:.3g}; {integ.name} is stable for ω dt < "
                      f"{integ.stability_limit:.3g}).")
         if ratio >= 0.5 * integ.stability_limit:
-            lines.append(f"Reduce dt below {T_min * integ.stability_limit / (4 * math.pi):.3g} s or "
-                         "use integrator='newmark'.")
+            lines.append(f"Reduce dt below {stable_dt(T_min, integ):.3g} s or use integrator='newmark'.")
         else:
             lines.append("dt is inside the stability limit, so look at the loads or the model: "
                          "large rotations of a free root near pitch = ±90° (Euler angle "
@@ -276,7 +330,34 @@ def _raise_nonfinite(model, integ, t, q, qd, dt, loads):
     else:
         lines.append("No restoring stiffness at the last finite state: look at the loads, a "
                      "parameter, or a free root near pitch = ±90° (Euler angle singularity).")
-    raise SimulationError(" ".join(lines))
+    return " ".join(lines)
+
+
+def _warn_accuracy(model, sea, dt, integ, tol=0.01):
+    """Warn when the shortest wave period with energy (amplitude ≥ 5 % of the largest component)
+    is resolved with a period error above ``tol`` by the integrator (its leading error term,
+    :func:`mfm.integrators.phase_error`)."""
+    comps = sea.components(water_depth=model.hydro.water_depth, g=model.hydro.g)
+    amp = np.abs(np.asarray(comps.amplitude, dtype=float))
+    if not amp.size or amp.max() <= 0:
+        return
+    w_hi = float(np.max(np.asarray(comps.omega)[amp >= 0.05 * amp.max()]))
+    err = _integrators.phase_error(integ, w_hi * dt)
+    if err > tol:
+        # the dt that brings the error to tol (phase_error is a power of ω dt)
+        p = 4 if getattr(integ, "order", 2) >= 4 else 2
+        dt_ok = dt * (tol / err) ** (1.0 / p)
+        warnings.warn(
+            f"dt = {dt:.4g} s is coarse for the sea: its shortest period with energy is "
+            f"{2 * math.pi / w_hi:.4g} s (ω dt = {w_hi * dt:.3g}), where {integ.name} makes a "
+            f"period (phase) error of about {100 * err:.2g} % per wave period, which accumulates "
+            f"into amplitudes and power. Use dt ≤ {dt_ok:.3g} s for {100 * tol:g} %.",
+            AccuracyWarning, stacklevel=3)
+
+
+def stable_dt(T_min: float, integ) -> float:
+    """The largest stable dt at the shortest natural period T_min: ω dt < the integrator's limit."""
+    return T_min * integ.stability_limit / (2 * math.pi)
 
 
 def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="rk4",
@@ -295,7 +376,8 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     integrator: ``"rk4"`` (default), ``"beeman"`` (seed 001 eq. 52), ``"semi_implicit"``,
         ``"newmark"``, or an instance from :mod:`mfm.integrators`.
     q0, qd0: initial coordinates and rates, arrays (n_q,) or dicts by coordinate name (others 0).
-    loads: an :class:`mfm.loads.Load` or a sequence of them (external loads).
+    loads: an :class:`mfm.loads.Load` or a sequence of them (external loads), added to the
+        model's own (its water and its config's loads).
     save_every: keep every k-th step in the output.
     ramp: s, the start-up ramp of the excitation (½(1 − cos πt/ramp)).
     radiation: ``"convolution"`` (direct, window T_K from the decay of K; ``memory`` overrides it,
@@ -314,26 +396,29 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     (time, body, axis): the load each body's joint transmits from the parent (inertial axes, moment
     about the joint point), ``kinetic_energy`` and ``potential_energy`` (time), ``iterations``
     (corrector iterations of the step), ``pto_power`` and ``pto_displacement`` (time, pto) for each
-    joint damper; with water also ``eta`` (time), ``xi`` (time, hydro_dof) and ``hydro_force``
-    (time, component, hydro_dof). Units and provenance are in the attributes.
+    joint damper and hydraulic PTO; with water also ``eta`` (time), ``xi`` (time, hydro_dof) and
+    ``hydro_force`` (time, component, hydro_dof); each load's own outputs (e.g. ``point_position``
+    of named body points). Units and provenance (config, database, sea state, settings, versions)
+    are in the attributes (:mod:`mfm.results`).
 
-    Raises :class:`SimulationError` when the state goes non-finite.
+    Raises :class:`SimulationError` when the state goes non-finite; its ``dataset`` holds the run
+    up to the last finite sample.
     """
     if sea is not None and model.hydro is None:
         raise ValueError("sea: this model has no hydrodynamics (no [hydro] table in its config, or "
                          "mfm.load(..., hydro=False)); pass sea=None")
-    if not (dt > 0 and math.isfinite(dt)):
-        raise ValueError(f"dt: {dt!r} must be a positive number of seconds")
-    if not (duration > 0 and math.isfinite(duration)):
-        raise ValueError(f"duration: {duration!r} must be a positive number of seconds")
+    dt = _number(dt, "dt", positive=True)
+    duration = _number(duration, "duration", positive=True)
+    t0 = _number(t0, "t0")
+    ramp = _number(ramp, "ramp", nonnegative=True)
+    memory = _number(memory, "memory", positive=True, allow_none=True)
     n_steps = int(round(duration / dt))
     if n_steps < 1:
         raise ValueError(f"duration = {duration} s is shorter than one step dt = {dt} s")
-    if save_every < 1 or n_steps % save_every:
-        raise ValueError(f"save_every: {save_every} must be a positive divisor of the {n_steps} "
+    if isinstance(save_every, bool) or not isinstance(save_every, numbers.Integral) \
+            or save_every < 1 or n_steps % save_every:
+        raise ValueError(f"save_every: {save_every!r} must be a positive divisor of the {n_steps} "
                          "steps")
-    if ramp < 0:
-        raise ValueError(f"ramp: {ramp!r} must be ≥ 0 s")
     integ = _integrators.get(integrator)
     if added_mass not in ("lhs", "rhs"):
         raise ValueError(f"added_mass={added_mass!r}; accepted: 'lhs' (A∞ in M*), 'rhs' (seed 001)")
@@ -343,7 +428,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                          "integrator='beeman' or added_mass='lhs'")
     loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp, radiation=radiation,
                         memory=memory, state_space_options=state_space_options,
-                        added_mass=added_mass) + _as_loads(loads)
+                        added_mass=added_mass, integrator=integ) + _as_loads(loads)
     q0 = _initial_vector(model, q0, "q0")
     qd0 = _initial_vector(model, qd0, "qd0")
     if check_stability and math.isfinite(integ.stability_limit):
@@ -353,111 +438,48 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                 f"dt = {dt:.4g} s is beyond the stability limit of {integ.name}: the shortest natural "
                 f"period of the model linearised at q0 is {T_min:.4g} s, ω dt = "
                 f"{2 * math.pi * dt / T_min:.3g} > {integ.stability_limit:.3g}. Use dt < "
-                f"{T_min * integ.stability_limit / (2 * math.pi):.3g} s or integrator='newmark'.",
+                f"{stable_dt(T_min, integ):.3g} s or integrator='newmark'.",
                 StabilityWarning, stacklevel=2)
+    if sea is not None:
+        _warn_accuracy(model, sea, dt, integ)
     out = rollout(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
                   save_every=save_every, t0=t0, record=True)
     t, q, qd, qdd, z, iters = (np.asarray(a) for a in out[:6])
-    if not (np.isfinite(q).all() and np.isfinite(qd).all()):
-        _raise_nonfinite(model, integ, t, q, qd, dt, loads)
     rec = {k: np.asarray(v) for k, v in out[6].items()}
-    ds = _dataset(model, integ, dt, t, q, qd, rec["qdd"], iters, rec)
-    for ld in loads:
-        ds = ld.annotate(ds, rec)
-    return ds
+    settings = dict(duration=duration, n_steps=n_steps, save_every=int(save_every), t0=t0,
+                    complete="true")
+    finite = np.isfinite(q).all(axis=1) & np.isfinite(qd).all(axis=1)
+    if not finite.all():
+        k = int(np.argmax(~finite))
+        message = _nonfinite_message(model, integ, t, q, qd, dt, loads, k)
+        partial = None
+        if k > 0:
+            keep = slice(0, k)
+            settings.update(complete="false", stopped=message)
+            partial = results.time_series(model, loads, integ, dt, t[keep], q[keep], qd[keep],
+                                          rec["qdd"][keep], iters[keep],
+                                          {n: v[keep] for n, v in rec.items()}, settings)
+        raise SimulationError(message + (f" The run up to t = {t[k - 1]:.6g} s is in this error's "
+                                         "`dataset`." if partial is not None else ""), partial)
+    return results.time_series(model, loads, integ, dt, t, q, qd, rec["qdd"], iters, rec, settings)
 
 
-def _dataset(model, integ, dt, t, q, qd, qdd, iters, rec) -> xr.Dataset:
-    pos, ang, f_j, m_j = (rec[k] for k in ("body_position", "body_rotation", "joint_force",
-                                           "joint_moment"))
-    T, V = rec["kinetic_energy"], rec["potential_energy"]
-    coords = {"time": ("time", t, {"units": "s"}),
-              "coordinate": list(model.coordinates),
-              "body": list(model.body_names),
-              "axis": ["x", "y", "z"],
-              "angle": ["roll", "pitch", "yaw"]}
-    units = [_coordinate_unit(model, c) for c in model.coordinates]
-    ds = xr.Dataset(
-        {
-            "q": (("time", "coordinate"), q, {"long_name": "generalised coordinates",
-                                              "units": "m or rad (see coordinate_unit)"}),
-            "qd": (("time", "coordinate"), qd, {"long_name": "generalised velocities",
-                                                "units": "m/s or rad/s"}),
-            "qdd": (("time", "coordinate"), qdd, {"long_name": "generalised accelerations",
-                                                  "units": "m/s2 or rad/s2"}),
-            "coordinate_unit": (("coordinate",), units),
-            "body_position": (("time", "body", "axis"), pos,
-                              {"long_name": "centre of mass position, inertial axes", "units": "m"}),
-            "body_rotation": (("time", "body", "angle"), ang,
-                              {"long_name": "body orientation as roll, pitch, yaw with "
-                               "R = Rz(yaw) Ry(pitch) Rx(roll)", "units": "rad"}),
-            "joint_force": (("time", "body", "axis"), f_j,
-                            {"long_name": "force the joint of each body transmits from its parent "
-                             "(or the inertial frame) to the body, inertial axes", "units": "N"}),
-            "joint_moment": (("time", "body", "axis"), m_j,
-                             {"long_name": "moment the joint of each body transmits, about the joint "
-                              "point, inertial axes", "units": "N m"}),
-            "kinetic_energy": (("time",), T, {"units": "J"}),
-            "potential_energy": (("time",), V, {"long_name": "gravity and joint springs",
-                                                "units": "J"}),
-            "iterations": (("time",), iters, {"long_name": "corrector iterations of the step"}),
-        },
-        coords=coords,
-        attrs={
-            "title": f"mfm simulation of {model.name}",
-            "model": model.name,
-            "integrator": integ.name,
-            "integrator_settings": repr(integ),
-            "dt": float(dt),
-            "dt_units": "s",
-            "mfm_version": _version(),
-            "jax_version": jax.__version__,
-            "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-            "conventions": "inertial frame: origin on the still-water line, z up; body frames at "
-                           "the CoM, parallel to inertial at q = 0",
-        },
-    )
-    damped, power = _damper_power(np.asarray(model.damping), qd)
-    if damped:
-        ds = ds.assign_coords(pto=[model.coordinates[k] for k in damped])
-        ds["pto_power"] = (("time", "pto"), power, _PTO_POWER_ATTRS)
-        ds["pto_displacement"] = (("time", "pto"), q[:, damped],
-                                  {"long_name": "joint coordinate of each damper (relative angle or "
-                                   "stroke)", "units": "rad or m"})
-    return ds
-
-
-_PTO_POWER_ATTRS = {"long_name": "power absorbed by each joint damper, c q̇²", "units": "W"}
-
-
-def _damper_power(damping, qd):
-    """The coordinates with a joint damper (c > 0 in any case) and the power c q̇² of each:
-    damping (n_q,) or (case, n_q), qd (…, time, n_q) → (indices, (…, time, n_damped))."""
-    damped = [int(k) for k in np.flatnonzero(np.any(np.atleast_2d(damping) > 0, axis=0))]
-    c = damping[..., damped]
-    return damped, (c[..., None, :] if c.ndim > 1 else c) * qd[..., damped] ** 2
-
-
-def _coordinate_unit(model: Model, name: str) -> str:
-    for i, motions in enumerate(model.motions):
-        for kind, k in motions:
-            if model.coordinates[k] == name:
-                return "rad" if kind == "R" else "m"
-    return ""
-
-
-def _version() -> str:
-    try:
-        from importlib.metadata import version
-        return version("mfm")
-    except Exception:  # not installed (running from a source tree)
-        return "unknown"
+def _sea_labels(seas):
+    """Per-case labels of a batch's sea states (Hs, Tp, H, T, gamma, heading) where every sea has
+    the attribute."""
+    units = {"hs": "m", "tp": "s", "height": "m", "period": "s", "gamma": "1", "heading": "rad"}
+    out = {}
+    for name, u in units.items():
+        vals = [getattr(s, name, None) for s in seas]
+        if all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in vals):
+            out[f"sea_{name}"] = (np.asarray(vals, dtype=float), {"units": u})
+    return out
 
 
 def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
                    radiation: str = "state_space", state_space_options: dict | None = None,
                    memory: float | None = None, save_every: int = 1, t0: float = 0.0,
-                   q0=None, qd0=None) -> xr.Dataset:
+                   q0=None, qd0=None, loads=None) -> xr.Dataset:
     """Many runs of one topology in one compiled, ``jax.vmap``-ed call: a sweep over sea states,
     time steps and model parameters (a power matrix, a T_p sweep at dt = T_p/200, a hinge-height
     study) without retracing.
@@ -469,17 +491,23 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
         dt = T_p/200 over 100 T_p is one shape: 20,000 steps).
     radiation: "state_space" (default; its arrays have one shape whatever dt), "none", or
         "convolution" (only when every case has the same number of lags, e.g. one dt).
+    loads: extra loads for every case (as in :func:`simulate`).
     Sequences of length > 1 must agree in length B; length-1 arguments are broadcast.
 
     Returns an :class:`xarray.Dataset` with dimensions (case, step, coordinate): ``time``
     (case, step), ``q``, ``qd``, ``pto_power`` (case, step, pto) of the joint dampers, ``eta``
-    (case, step) the undisturbed elevation at the origin, and ``dt`` (case).
+    (case, step) the undisturbed elevation at the origin, ``dt`` (case), and the sea states'
+    parameters as coordinates on ``case`` (``sea_hs``, ``sea_tp``, …).
     Raises :class:`SimulationError` naming the first case that goes non-finite.
     """
     models = list(model) if isinstance(model, (list, tuple)) else [model]
     seas = list(seas) if isinstance(seas, (list, tuple)) else [seas]
-    dts = np.atleast_1d(np.asarray(dt, dtype=float))
-    ramps = np.atleast_1d(np.asarray(ramp, dtype=float))
+    try:
+        dts = np.atleast_1d(np.asarray(dt, dtype=float))
+        ramps = np.atleast_1d(np.asarray(ramp, dtype=float))
+    except (TypeError, ValueError):
+        raise ValueError(f"dt, ramp: {dt!r}, {ramp!r}; give numbers of seconds (one, or one per "
+                         "case)") from None
     sizes = {"model": len(models), "seas": len(seas), "dt": dts.size, "ramp": ramps.size}
     B = max(sizes.values())
     bad = {k: v for k, v in sizes.items() if v not in (1, B)}
@@ -488,18 +516,26 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
                          f"{sizes}")
     if not (np.all(dts > 0) and np.all(np.isfinite(dts))):
         raise ValueError(f"dt: {dts} must be positive numbers of seconds")
-    if n_steps < 1 or n_steps % save_every:
-        raise ValueError(f"n_steps: {n_steps} must be ≥ 1 and a multiple of save_every={save_every}")
+    if not (np.all(ramps >= 0) and np.all(np.isfinite(ramps))):
+        raise ValueError(f"ramp: {ramps} must be numbers of seconds ≥ 0")
+    if isinstance(n_steps, bool) or not isinstance(n_steps, numbers.Integral) or n_steps < 1 \
+            or n_steps % save_every:
+        raise ValueError(f"n_steps: {n_steps!r} must be a whole number ≥ 1 and a multiple of "
+                         f"save_every={save_every}")
+    t0 = _number(t0, "t0")
+    memory = _number(memory, "memory", positive=True, allow_none=True)
     pick = lambda seq, i: seq[i if len(seq) > 1 else 0]  # noqa: E731
     structure = {m_.coordinates for m_ in models}
     if len(structure) > 1 or len({id(m_.hydro) for m_ in models}) > 1:
         raise ValueError("model: the models of a batch must share one topology and one hydro "
                          "spec (make them from one Model with equinox.tree_at)")
     integ = _integrators.get(integrator)
+    extra = _as_loads(loads)
     loads = [model_loads(pick(models, i), pick(seas, i), dt=float(pick(dts, i)),
                          duration=n_steps * float(pick(dts, i)), t0=t0, ramp=float(pick(ramps, i)),
                          radiation=radiation, memory=memory,
-                         state_space_options=state_space_options) for i in range(B)]
+                         state_space_options=state_space_options, integrator=integ) + extra
+             for i in range(B)]
     defs = {jax.tree_util.tree_structure(ld) for ld in loads}
     if len(defs) > 1:
         raise ValueError("simulate_batch: the cases' loads differ in structure (with "
@@ -526,27 +562,8 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
             raise SimulationError(f"simulate_batch: case {i} went non-finite at t = {t[i, k]:.6g} s "
                                   f"(dt = {pick(dts, i):.4g} s); run it alone with mfm.simulate "
                                   "for the diagnosis")
-    coords = {"case": np.arange(B), "coordinate": list(m0.coordinates)}
-    ds = xr.Dataset(
-        {"time": (("case", "step"), t, {"units": "s"}),
-         "q": (("case", "step", "coordinate"), q, {"long_name": "generalised coordinates",
-                                                   "units": "m or rad"}),
-         "qd": (("case", "step", "coordinate"), qd, {"long_name": "generalised velocities",
-                                                     "units": "m/s or rad/s"}),
-         "dt": (("case",), np.broadcast_to(dts, (B,)).copy(), {"units": "s"})},
-        coords=coords,
-        attrs={"title": f"mfm batch of {B} runs of {m0.name}", "model": m0.name,
-               "integrator": integ.name, "radiation": radiation, "n_steps": int(n_steps),
-               "save_every": int(save_every), "mfm_version": _version(),
-               "jax_version": jax.__version__,
-               "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")})
-    damped, power = _damper_power(np.stack([np.asarray(pick(models, i).damping) for i in range(B)]), qd)
-    if damped:
-        ds = ds.assign_coords(pto=[m0.coordinates[k] for k in damped])
-        ds["pto_power"] = (("case", "step", "pto"), power, _PTO_POWER_ATTRS)
-    k = next((k for k, ld in enumerate(loads[0]) if hasattr(ld, "eta_values")), None)
-    if k is not None:
-        eta = np.stack([np.asarray(loads[i][k].eta_values)[::2 * save_every][:t.shape[1]]
-                        for i in range(B)])
-        ds["eta"] = (("case", "step"), eta, {"long_name": "wave elevation at the origin", "units": "m"})
-    return ds
+    settings = dict(radiation=radiation, n_steps=int(n_steps), t0=t0,
+                    ramp_s=repr(ramps.tolist()), seas=repr(seas))
+    labels = _sea_labels(seas) if len(seas) == B else {}
+    return results.batch(m0, [pick(models, i) for i in range(B)], loads, integ, t, q, qd, dts,
+                         settings, save_every, labels)

@@ -74,7 +74,7 @@ def harmonic_amplitude(t, y, omega: float, extra_omegas=()):
     modes) do not bias it."""
     t = np.asarray(t, dtype=float)
     cols = [np.ones_like(t), t, np.cos(omega * t), np.sin(omega * t)]
-    for wn in extra_omegas:
+    for wn in np.asarray(extra_omegas, dtype=float).ravel():
         cols += [np.cos(wn * t), np.sin(wn * t), t * np.cos(wn * t), t * np.sin(wn * t)]
     c = np.linalg.lstsq(np.stack(cols, 1), np.asarray(y, dtype=float), rcond=None)[0]
     # y = a cos ωt + b sin ωt = Re[(a + i b) e^{−iωt}]

@@ -78,7 +78,7 @@ def td_vs_fd(model, T, H, radiation, periods=60):
     fr_db = frequency_response(model, [w])
     ds = mfm.simulate(model, hydro.Regular(height=H, period=T), duration=periods * T, dt=T / 100,
                       ramp=5 * T, radiation=radiation)
-    wn = natural_frequencies(model)["eigen"]
+    wn = natural_frequencies(model)["eigen"].values
     wn = wn[np.abs(wn - w) > 0.1 * w]
     t = ds.time.values
     sel = t > t[-1] - 10 * T

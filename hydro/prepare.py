@@ -1,0 +1,294 @@
+"""Hydro preparation: a database made ready for both domains, apart from the mechanics.
+
+:class:`HydroSpec` restricts a database to the wet bodies of a model (in model order), symmetrises
+A(ω), B(ω), A∞ (reciprocity), applies the body-coupling mask, corrects A∞ to be consistent with
+A(ω) and B(ω), and computes on demand (cached) the impulse response K(t), its memory length, the
+convolution weights of a time step and the passive state-space fit. :func:`modal_form` realises a
+fit in modal form; :func:`open_any_database` opens any database file by its type. Nothing here
+imports :mod:`mfm`: the mechanics hands in where each body's reference point sits (``com0``,
+``body_index``) and which dofs its joints move (``moving``).
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+import xarray as xr
+
+
+class HydroSpec:
+    """Host-side description of a model's water, made by :func:`mfm.load` from the config's
+    ``[hydro]`` table: the database restricted to the config's bodies (in config order), where
+    each hydro body sits on the tree, drag, and the options. Impulse responses and state-space fits
+    are computed on demand and cached here (per dt and per radiation option).
+
+    ``body_index``: the model index of each hydro body (the mechanics' bookkeeping, carried along);
+    ``com0`` (K, 3): each body's centre of mass at q = 0; ``drag`` (K, 3): C_D A per inertial axis
+    (m²); ``moving``: the hydro dofs the mechanics can move (radiation is modelled on these).
+
+    Identity-hashed on purpose: it rides on the Model as static metadata, so a Model keeps one
+    compiled simulation as long as it keeps its HydroSpec.
+    """
+
+    def __init__(self, db: xr.Dataset, body_index: Sequence[int], config_names: Sequence[str],
+                 com0: np.ndarray, drag: np.ndarray, *, body_coupling: bool = True,
+                 added_mass_inf: str = "consistent", source: str = "", moving=None):
+        from .database import validate
+
+        self.db_names = [str(b) for b in db["body"].values]
+        self.config_names = list(config_names)
+        self.body_index = tuple(int(i) for i in body_index)
+        self.body_coupling = bool(body_coupling)
+        self.source = source
+        validate(db)
+        self.rho = float(db.attrs["rho"])
+        self.g = float(db.attrs["g"])
+        self.water_depth = float(db.attrs.get("water_depth", math.inf))
+        nb = len(self.db_names)
+        mask = np.kron(np.eye(nb), np.ones((6, 6))) if not body_coupling else np.ones((6 * nb, 6 * nb))
+        self.mask = mask
+        self.db = db
+        self.dofs = tuple(str(d) for d in db["influenced_dof"].values)
+        # the dofs the mechanics can move (:func:`moving_dofs`); radiation is modelled on these
+        self.moving = tuple(range(len(self.dofs))) if moving is None else tuple(int(k) for k in moving)
+        ref = np.asarray(db["reference_point"].values, dtype=float)
+        self.ref0 = ref
+        self.d_ref = ref - com0
+        self.d_cob = np.asarray(db["center_of_buoyancy"].values, dtype=float) - com0
+        self.volume = np.asarray(db["displaced_volume"].values, dtype=float)
+        self.C_wp = np.asarray(db["waterplane_stiffness"].values, dtype=float)
+        self.drag = 0.5 * self.rho * np.asarray(drag, dtype=float)
+        A_inf = np.asarray(db["added_mass_inf"].values, dtype=float)
+        self.A_inf_db = 0.5 * (A_inf + A_inf.T) * mask
+        if added_mass_inf not in ("consistent", "database"):
+            raise ValueError(f"hydro.added_mass_inf: {added_mass_inf!r}; accepted: 'consistent' "
+                             "(A∞ corrected to agree with A(ω) and B(ω)), 'database'")
+        self.added_mass_inf_option = added_mass_inf
+        self._cache = {}
+
+    def provenance(self) -> dict:
+        """Where the data came from and how they are used, for a result's attributes."""
+        if "sha256" not in self._cache:
+            import hashlib
+
+            h = hashlib.sha256()
+            p = Path(self.source)
+            files = [p] if p.suffix == ".nc" else sorted(p.parent.glob(p.stem + ".*"))
+            for f in files:
+                if f.is_file():
+                    h.update(f.read_bytes())
+            self._cache["sha256"] = h.hexdigest() if files else ""
+        return {"database": self.source, "database_sha256": self._cache["sha256"],
+                "body_coupling": str(self.body_coupling),
+                "added_mass_inf": self.added_mass_inf_option, "rho": self.rho, "g": self.g,
+                "water_depth": self.water_depth}
+
+    # -- radiation
+    def database(self) -> xr.Dataset:
+        """The database as both domains use it: A(ω), B(ω), A∞ symmetrized (reciprocity: an
+        asymmetry is BEM discretisation error, and RM3's asymmetric surge–pitch tails give K(t)
+        spikes no time step resolves) and, without body coupling, cross-body blocks zeroed."""
+        if "db" in self._cache:
+            return self._cache["db"]
+        db = self.db.copy()
+        mask = xr.DataArray(self.mask, dims=("influenced_dof", "radiating_dof"))
+        for v in ("added_mass", "radiation_damping", "added_mass_inf"):
+            da = db[v]
+            swapped = da.rename(influenced_dof="radiating_dof", radiating_dof="influenced_dof")
+            db[v] = (0.5 * (da + swapped.transpose(*da.dims).values) * mask).transpose(*da.dims)
+            db[v].attrs = self.db[v].attrs
+        self._cache["db"] = db
+        return db
+
+    def impulse_response(self, t):
+        from .radiation import impulse_response
+
+        return np.asarray(impulse_response(self.database(), np.asarray(t)).values)
+
+    def memory(self, rtol: float = 1e-3) -> float:
+        """Memory length T_K (s): where |K| stays below rtol·max|K| (from the decay of K, not Tp)."""
+        if "memory" not in self._cache:
+            from .radiation import memory_length
+
+            t = np.arange(0.0, 400.0, 0.05)
+            self._cache["memory"] = memory_length(self.impulse_response(t), t, rtol=rtol)
+        return self._cache["memory"]
+
+    def added_mass_inf(self) -> np.ndarray:
+        """A∞ used in the time domain. 'consistent': the database's plus the constant (the median
+        over :meth:`radiation_band`) that makes A∞ − ∫K sin ωt dt/ω agree with the database A(ω)
+        (a BEM A∞ can be off by a constant: RM3's spar pitch by 2.7 %; outside the band the data
+        are too noisy to weigh); 'database': as given."""
+        if self.added_mass_inf_option == "database":
+            return self.A_inf_db
+        if "A_inf" not in self._cache:
+            from .radiation import added_mass_from_irf
+
+            db = self.database()
+            om = np.asarray(db["omega"].values)
+            t = np.arange(0.0, max(2 * self.memory(), 60.0), min(0.02, np.pi / om.max() / 4))
+            K = self.impulse_response(t)
+            A_rebuilt = np.asarray(added_mass_from_irf(K, t, self.A_inf_db, om))
+            lo, hi = self.radiation_band()
+            sel = (om >= lo) & (om <= hi)
+            # the median: robust to the stretches of a BEM grid where A(ω) is noisy or irregular
+            delta = np.median(np.asarray(db["added_mass"].values)[sel] - A_rebuilt[sel], axis=0)
+            delta = delta * self.mask
+            self._cache["A_inf"] = self.A_inf_db + 0.5 * (delta + delta.T)
+            self._cache["A_inf_band"] = (lo, hi)
+        return self._cache["A_inf"]
+
+    def radiation_band(self, fraction: float = 0.05):
+        """(ω_lo, ω_hi): where some diagonal damping B_ii(ω) is at least ``fraction`` of its own
+        peak: the band where radiation matters and the BEM data are meaningful (above it, BEM
+        damping is numerical noise; CAPYTAINE.md). Diagonals below 1e-6 of the largest (by
+        dimension group) are ignored."""
+        db = self.database()
+        om = np.asarray(db["omega"].values)
+        B = np.asarray(db["radiation_damping"].values)
+        diag = np.einsum("wii->wi", B)
+        peak = np.abs(diag).max(axis=0)
+        active = np.zeros(len(om), dtype=bool)
+        for i in range(diag.shape[1]):
+            group = [j for j in range(diag.shape[1]) if (j % 6 < 3) == (i % 6 < 3)]
+            if peak[i] > 1e-6 * peak[group].max():
+                active |= diag[:, i] >= fraction * peak[i]
+        idx = np.flatnonzero(active)
+        return float(om[idx[0]]), float(om[idx[-1]])
+
+    def state_space(self, **options):
+        """The passive state-space fit of :mod:`hydro.statespace` (cached per options). The fit
+        band defaults to (0.2 ω_c, 2 ω_c) with the Froude frequency ω_c = √(g/L), L the cube root
+        of the largest displaced volume: RM3's (0.2, 2.0) rad/s at full scale, 1.2–12 rad/s for the
+        M4 model, so each database is fitted where its waves act (clipped to its grid). Only the
+        dofs the model moves are fitted (:attr:`moving`), with one common pole set when more
+        than two bodies are coupled (``pole_sharing``, :func:`hydro.statespace.fit_state_space`)."""
+        options.setdefault("dofs", tuple(self.dofs[k] for k in self.moving))
+        # many coupled bodies: one pole set for all entries (states O(n_dof · order) instead of
+        # the per-entry fit's O(n_dof² · order))
+        many = self.body_coupling and len(self.db_names) > 2
+        options.setdefault("pole_sharing", "common" if many else "entry")
+        if "omega_fit" not in options:
+            om = np.asarray(self.db["omega"].values)
+            wc = math.sqrt(self.g / float(np.max(self.volume)) ** (1.0 / 3.0))
+            options["omega_fit"] = (max(0.2 * wc, float(om[0])), min(2.0 * wc, float(om[-1])))
+        key = ("ss", tuple(sorted(options.items())))
+        if key not in self._cache:
+            from .statespace import fit_state_space
+
+            self._cache[key] = fit_state_space(self.database(), **options)
+        return self._cache[key]
+
+    def kernel(self, dt: float, memory: float | None = None, subdivisions: int = 16,
+               offsets=(0.0, 0.5, 1.0)):
+        """Convolution weights for the stage offsets s of a step (``offsets``: fractions of dt in
+        [0, 1], those of the integrator; RK4's are 0, ½, 1).
+
+        The velocity history is piecewise linear between its samples (at τ = 0 the current
+        velocity, at τ = s + j·dt the step-start samples j = 0 … N−1), so
+
+            ∫₀^{T_K} K(τ) ξ̇(t − τ) dτ = W_c ξ̇(t) + Σ_j W_j ξ̇(t_n − j dt),
+
+        W = ∫ K(τ) φ(τ) dτ with φ the hat functions of those knots (product integration: exact for
+        the interpolated velocity, however sharp K is near τ = 0). K is sampled ``subdivisions``
+        times per step. Returns (W_c (3, n, n), W (3, N, n, n)), N = ceil(T_K/dt) + 1, over the
+        n dofs the model moves (:attr:`moving`, in that order).
+        """
+        T_K = self.memory() if memory is None else float(memory)
+        n = max(int(math.ceil(T_K / dt)), 2) + 1
+        offsets = tuple(float(o) for o in offsets)
+        if not all(0.0 <= o <= 1.0 for o in offsets):
+            raise ValueError(f"stage offsets {offsets}: each must lie in [0, 1] (fractions of dt)")
+        key = ("W", float(dt), n, subdivisions, offsets)
+        if key not in self._cache:
+            from .radiation import check_grid
+
+            check_grid(self.database(), (n - 1) * dt, on_fail="warn")
+            h = dt / subdivisions
+            tau = np.arange((n + 1) * subdivisions + 1) * h     # up to s + (N−1) dt + … ≤ (N+1) dt
+            mv = np.asarray(self.moving)
+            K = self.impulse_response(tau)[:, mv][:, :, mv]
+            wq = np.full(len(tau), h)
+            wq[0] = wq[-1] = 0.5 * h
+            Wc, W = [], []
+            for off in offsets:
+                s = off * dt
+                knots = s + np.arange(n) * dt                 # history knots
+                if s > 0:
+                    knots = np.concatenate([[0.0], knots])      # the current velocity at τ = 0
+                inside = tau <= knots[-1] + 1e-12
+                k = np.clip(np.searchsorted(knots, tau[inside], side="right") - 1, 0, len(knots) - 2)
+                frac = (tau[inside] - knots[k]) / (knots[k + 1] - knots[k])
+                Kw = K[inside] * wq[inside][:, None, None]
+                # each sample feeds its two hat functions (k sorted: sums by segments, no dense φ)
+                Wk = (_segment_sums(k, Kw * (1.0 - frac)[:, None, None], len(knots))
+                      + _segment_sums(k + 1, Kw * frac[:, None, None], len(knots)))
+                if s > 0:
+                    Wc.append(Wk[0])
+                    W.append(Wk[1:])
+                else:
+                    Wc.append(np.zeros_like(Wk[0]))
+                    W.append(Wk)
+            self._cache[key] = (np.stack(Wc), np.stack(W))
+        return self._cache[key]
+
+
+def _segment_sums(idx, vals, n_out):
+    """out[i] = Σ vals[j] over j with idx[j] = i, for non-decreasing idx."""
+    out = np.zeros((n_out,) + vals.shape[1:])
+    if len(idx):
+        starts = np.flatnonzero(np.r_[True, np.diff(idx) != 0])
+        out[idx[starts]] = np.add.reduceat(vals, starts, axis=0)
+    return out
+
+
+def modal_form(ss):
+    """The modal realisation of a state-space fit: poles P (n_x,) complex, one per input dof j and
+    pole of the entries (i, j) fitted with the same pole set (Im p ≥ 0 representatives: a pair's
+    conjugate is folded into the residue × 2); output residues C (n_out, n_x); the input dof of
+    each state; the output dofs (rows of C)."""
+    groups = {}                                       # (j, poles) -> [(i, residues)]
+    for (i, j), P, R in zip(ss.entries, ss.poles, ss.residues):
+        keep = P.imag >= 0.0
+        key = (j, P[keep].tobytes())
+        groups.setdefault(key, (P[keep], []))[1].append((i, R[keep] * np.where(P[keep].imag > 0, 2.0, 1.0)))
+    outs = tuple(sorted({i for i, _ in ss.entries}))
+    poles, ins, cols = [], [], []
+    for (j, _), (P, members) in groups.items():
+        C = np.zeros((len(outs), len(P)), dtype=complex)
+        for i, r in members:
+            C[outs.index(i)] += r
+        poles.append(P)
+        cols.append(C)
+        ins += [j] * len(P)
+    if not poles:
+        return np.zeros(0, complex), np.zeros((0, 0), complex), (), ()
+    return np.concatenate(poles), np.concatenate(cols, axis=1), tuple(ins), outs
+
+
+def open_any_database(path: Path, *, names=None, rho=None, g=None) -> xr.Dataset:
+    """Open a hydro database: our NetCDF, a capytaine NetCDF (converted), or WAMIT output."""
+    from . import bem
+    from .database import from_capytaine, open_database
+    from .wamit import read_wamit
+
+    path = Path(path)
+    if path.suffix == ".nc":
+        if not path.exists():
+            raise FileNotFoundError(f"hydro.database: {str(path)!r} not found; generate it with "
+                                    "`mfm hydro CONFIG` or fix the path (relative to the config)")
+        with xr.open_dataset(path) as raw:
+            ours = "added_mass_inf" in raw.data_vars
+        return open_database(path) if ours else from_capytaine(bem.load(path))
+    stem = path.with_suffix("") if path.suffix in (".out", ".1", ".3", ".hst") else path
+    if not stem.with_suffix(".out").exists():
+        raise FileNotFoundError(f"hydro.database: {str(path)!r}: no WAMIT output {stem}.out and not "
+                                "a .nc file; accepted: a NetCDF database or a WAMIT .out/.1/.3/.hst set")
+    kw = {}
+    if rho is not None:
+        kw["rho"] = float(rho)
+    if g is not None:
+        kw["g"] = float(g)
+    return read_wamit(stem, body_names=names, **kw)

@@ -1,0 +1,23 @@
+"""Loads as plug-ins: one module per load, one base (:mod:`mfm.loads.base`), one registry of config
+tables (:mod:`mfm.loads.registry`). Each load serves the time domain, the equilibrium and the
+frequency domain from one definition.
+
+- :class:`~mfm.loads.water.Water`: Cummins hydrodynamics (built per sea state by
+  :func:`mfm.simulate.model_loads`), radiation as a strategy (:mod:`mfm.loads.radiation`);
+- :class:`PointSprings` (``[[moorings]]``), :class:`HydraulicPTO` (``[[ptos]]``),
+  :class:`LinearBodyMatrix` (``[[body_matrices]]``), :class:`JointLoad` (``[[joint_loads]]``),
+  :class:`BodyPointOutputs` (``[[points]]``);
+- :class:`BodyWrench`, :class:`CoordinateForceSeries`: loads given directly (``loads=``).
+"""
+from .base import Context, FrequencyTerms, Load, LoadOutput
+from .body_matrix import LinearBodyMatrix
+from .generic import BodyWrench, CoordinateForceSeries
+from .hydraulic_pto import HydraulicPTO
+from .joint_load import JointLoad
+from .mooring import PointSprings
+from .probes import BodyPointOutputs
+from .registry import TABLES, load_class
+
+__all__ = ["BodyPointOutputs", "BodyWrench", "Context", "CoordinateForceSeries", "FrequencyTerms",
+           "HydraulicPTO", "JointLoad", "LinearBodyMatrix", "Load", "LoadOutput", "PointSprings",
+           "TABLES", "load_class"]

@@ -1,0 +1,149 @@
+"""The load protocol: one definition serves the time domain, the equilibrium and the frequency domain.
+
+A load is an immutable pytree (``equinox.Module``). The runner hands it a :class:`Context` (the
+model, the time, the state, the kinematics, its own states and memory) and it returns a
+:class:`LoadOutput`: Cartesian body loads ``body`` (n, 6: force in inertial axes, moment about the
+CoM in body axes), generalised loads ``tau`` (n_q), the derivative ``zd`` of its own first-order
+states, and an acceleration-proportional matrix ``mass`` (n_q, n_q) that the solver moves to the
+left-hand side. Loads enter the equations of motion as ``Bᵀ body + tau`` (seed 001 eq. 46).
+
+From the same definition the frequency domain takes, about a static equilibrium q₀:
+
+- the static load G(q) and the stiffness −∂G/∂q from :meth:`Load.static_load` (the load at rest,
+  in still water: by default the load itself; a wave load drops its excitation and memory),
+- the damping −∂Q/∂q̇ and the mass (``mass`` at q₀) by differentiating :meth:`Load.evaluate`,
+- what cannot come from a derivative at one instant, :meth:`Load.frequency_terms`: a frequency-
+  dependent impedance (radiation memory) and a harmonic force per unit wave amplitude.
+
+So ``equilibrium``, ``frequency_response`` and ``natural_frequencies`` see exactly the loads the
+time domain sees. A load records outputs (:meth:`Load.diagnostics` with their dims and units in
+:meth:`Load.outputs`) and is read from a config table through the registry
+(:mod:`mfm.loads.registry`).
+"""
+from __future__ import annotations
+
+from typing import Any, NamedTuple
+
+import equinox as eqx
+import jax.numpy as jnp
+
+# the six modes of a body point (its hydro dofs): translations then rotations, inertial axes
+MODES = ("surge", "sway", "heave", "roll", "pitch", "yaw")
+
+
+class Context(NamedTuple):
+    """Where a load is evaluated. ``kin``: the :class:`~mfm.kinematics.Kinematics` at (q, q̇);
+    ``z``: the load's own states; ``memory``: its discrete memory of the current step (read-only
+    within a step); ``qdd_guess``: the acceleration iterate of a predictor–corrector integrator
+    (Beeman) or None; ``qdd``: the accelerations, known only when outputs are recorded."""
+    model: Any
+    t: Any
+    q: Any
+    qd: Any
+    z: Any
+    kin: Any
+    memory: Any = ()
+    qdd_guess: Any = None
+    qdd: Any = None
+
+
+class LoadOutput(NamedTuple):
+    body: jnp.ndarray | None = None
+    tau: jnp.ndarray | None = None
+    zd: jnp.ndarray | None = None
+    mass: jnp.ndarray | None = None
+
+
+class FrequencyTerms(NamedTuple):
+    """A load's frequency-dependent part about q₀, for x(t) = Re[x̂ e^{−iωt}] (hydro convention):
+    ``impedance`` (n_ω, n_q, n_q) complex, added to Z(ω) = −ω² M − iω C + K; ``force``
+    (n_ω, n_q) complex per metre of wave amplitude; either may be None."""
+    impedance: Any = None
+    force: Any = None
+
+
+class Load(eqx.Module):
+    """Base class. Override :meth:`evaluate` (or, the older form, ``__call__(model, t, q, qd, z,
+    kin, memory=(), qdd_guess=None)``); the rest has defaults for a load without states, memory,
+    outputs or frequency dependence."""
+
+    @property
+    def n_states(self) -> int:
+        return 0
+
+    def initial_state(self, model) -> jnp.ndarray:
+        return jnp.zeros(self.n_states)
+
+    def init_memory(self, model, t0, q0, qd0, dt):
+        """Discrete memory at the start of a run (default: none)."""
+        return ()
+
+    def update_memory(self, model, t, q, qd, kin, memory):
+        """Memory after a step that ended at (t, q, q̇) (default: unchanged)."""
+        return memory
+
+    def evaluate(self, ctx: Context) -> LoadOutput:
+        if type(self).__call__ is Load.__call__:
+            raise NotImplementedError(f"{type(self).__name__} defines neither evaluate(ctx) nor "
+                                      "__call__(model, t, q, qd, z, kin, memory, qdd_guess)")
+        return self(ctx.model, ctx.t, ctx.q, ctx.qd, ctx.z, ctx.kin, ctx.memory,
+                    qdd_guess=ctx.qdd_guess)
+
+    def __call__(self, model, t, q, qd, z, kin, memory=(), qdd_guess=None) -> LoadOutput:
+        return self.evaluate(Context(model, t, q, qd, z, kin, memory, qdd_guess))
+
+    def reaction_loads(self, ctx: Context, out: LoadOutput):
+        """Cartesian loads (n, 6) this load puts on the bodies, for the joint reactions: by default
+        ``out.body``; a load with acceleration-proportional terms adds them (``ctx.qdd``)."""
+        return out.body
+
+    def diagnostics(self, ctx: Context, out: LoadOutput) -> dict:
+        """Named arrays recorded at every saved sample (``ctx.qdd`` is known)."""
+        return {}
+
+    def outputs(self) -> dict:
+        """What :meth:`diagnostics` records: name → (dims after "time", attrs with "units"), and
+        the coordinate values of those dims under the key ``"coords"``."""
+        return {}
+
+    def annotate(self, ds, records: dict):
+        """Add this load's recorded diagnostics to a result dataset (default: by :meth:`outputs`)."""
+        spec = dict(self.outputs())
+        coords = spec.pop("coords", {})
+        if spec:
+            ds = ds.assign_coords({k: v for k, v in coords.items() if k not in ds.coords})
+        for name, (dims, attrs) in spec.items():
+            ds[name] = (("time",) + tuple(dims), records[name], dict(attrs))
+        return ds
+
+    def batch_outputs(self, save_every: int, n_saved: int) -> dict:
+        """Outputs a batched run (no per-sample record) can take from the load itself:
+        name → (array (n_saved,), attrs)."""
+        return {}
+
+    # -- linearisation
+    def static_load(self) -> "Load | None":
+        """The load at rest in still water, for the equilibrium and the stiffness (default: the
+        load itself; None: nothing static)."""
+        return self
+
+    def frequency_terms(self, model, q0, kin0, omega, heading: float, options: dict) -> FrequencyTerms:
+        """Frequency-dependent impedance and wave force about q₀ (default: none)."""
+        return FrequencyTerms()
+
+    def frequency_range(self):
+        """(ω_lo, ω_hi) rad/s where :meth:`frequency_terms` is defined, or None (everywhere)."""
+        return None
+
+    def frequency_outputs(self, model, kin0, x, omega) -> dict:
+        """Outputs of a frequency response from the complex coordinate amplitudes x (n_ω, n_q):
+        name → (dims after "omega", array, attrs), plus "coords" (default: none)."""
+        return {}
+
+    def provenance(self) -> dict:
+        """Settings that made this load, for the result's attributes."""
+        return {}
+
+    def describe_nonfinite(self, model, q, qd) -> str | None:
+        """A likely cause specific to this load when a run went non-finite at (q, q̇), or None."""
+        return None

@@ -1,0 +1,222 @@
+"""Radiation memory as a strategy of the water load: each gives its time-domain force and the
+A(ω), B(ω) it amounts to, so the frequency domain uses the time domain's radiation by construction.
+
+    F_rad(t) = −∫₀^{T_K} K(τ) ξ̇(t − τ) dτ            (Cummins; K from B(ω))
+
+- :class:`Convolution`: product integration of the piecewise-linear velocity history against K
+  (weights per stage offset that the integrator declares, :meth:`hydro.prepare.HydroSpec.kernel`);
+  its A(ω), B(ω) by Ogilvie from the same K: A∞ − ∫K sin ωτ dτ/ω and ∫K cos ωτ dτ.
+- :class:`StateSpace`: the passive fit (:mod:`hydro.statespace`) in modal form, ż = p z + ξ̇_j,
+  F_i = −Σ Re(C_ik z_k); its A(ω) = A∞ + Im K̂(iω)/ω, B(ω) = Re K̂(iω).
+- :class:`NoRadiation`: A∞ only (A(ω) = A∞, B = 0).
+- :class:`DatabaseRadiation`: the BEM A(ω), B(ω) as given: frequency domain only (a database
+  whose A and B are not Kramers–Kronig consistent has no exact time-domain counterpart).
+
+Every strategy acts on the hydro dofs the joints can move (:attr:`HydroSpec.moving`); the others
+have zero velocity and their loads do no work.
+"""
+from __future__ import annotations
+
+from fractions import Fraction
+from typing import ClassVar
+
+import equinox as eqx
+import jax.numpy as jnp
+import numpy as np
+
+STRATEGIES = ("convolution", "state_space", "none")
+
+
+class NoRadiation(eqx.Module):
+    name: ClassVar[str] = "none"
+
+    @property
+    def n_states(self):
+        return 0
+
+    def init_memory(self, v, t0):
+        return ()
+
+    def update_memory(self, v, t, memory):
+        return memory
+
+    def force(self, t, v, z, memory):
+        return jnp.zeros_like(v), None
+
+    def added_mass_inf(self, spec):
+        return spec.added_mass_inf()
+
+    def coefficients(self, spec, omega):
+        A_inf = self.added_mass_inf(spec)
+        return np.broadcast_to(A_inf, (len(omega),) + A_inf.shape), np.zeros((len(omega),) + A_inf.shape)
+
+    def provenance(self):
+        return {"radiation": self.name}
+
+
+class DatabaseRadiation(NoRadiation):
+    """The database's A(ω), B(ω) (frequency domain only)."""
+    name: ClassVar[str] = "database"
+
+    def force(self, t, v, z, memory):  # pragma: no cover - refused when the water is built
+        raise ValueError("radiation='database' exists in the frequency domain only")
+
+    def coefficients(self, spec, omega):
+        db = spec.database()
+        return (db["added_mass"].interp(omega=omega).values,
+                db["radiation_damping"].interp(omega=omega).values)
+
+
+class Convolution(NoRadiation):
+    """Direct convolution. ``W_current`` (S, n, n), ``W_lag`` (S, N, n, n): the weights of the
+    current velocity and of the N step-start samples for each of the S stage offsets
+    ``stage_offsets`` (fractions of dt, from the integrator) over the moved dofs ``dofs``.
+    Memory: (t_n, history (N, n) newest first)."""
+    W_current: jnp.ndarray
+    W_lag: jnp.ndarray
+    dt: jnp.ndarray
+    memory_length: float = eqx.field(static=True)
+    stage_offsets: tuple[float, ...] = eqx.field(static=True)
+    dofs: tuple[int, ...] = eqx.field(static=True)
+    n_lags: int = eqx.field(static=True)
+    name: ClassVar[str] = "convolution"
+
+    def init_memory(self, v, t0):
+        v = v[np.asarray(self.dofs)]
+        return (jnp.asarray(t0, jnp.float64), jnp.zeros((self.n_lags, v.shape[0])).at[0].set(v))
+
+    def update_memory(self, v, t, memory):
+        return (t, jnp.concatenate([v[np.asarray(self.dofs)][None], memory[1][:-1]], axis=0))
+
+    def force(self, t, v, z, memory):
+        t_n, hist = memory
+        # the stage of the step: the nearest of the offsets the integrator declared
+        offs = jnp.asarray(self.stage_offsets)
+        r = jnp.argmin(jnp.abs((t - t_n) / self.dt - offs))
+        idx = np.asarray(self.dofs)
+        F = self.W_current[r] @ v[idx] + jnp.einsum("jab,jb->a", self.W_lag[r], hist)
+        return -jnp.zeros_like(v).at[idx].set(F), None
+
+    def coefficients(self, spec, omega):
+        from hydro.radiation import added_mass_from_irf, damping_from_irf
+
+        om_db = np.asarray(spec.database()["omega"].values)
+        # graded near τ = 0, where entries with slowly decaying damping have a narrow spike
+        step = min(0.02, np.pi / om_db.max() / 4)
+        t = np.concatenate([np.linspace(0.0, 25 * step, 2501)[:-1],
+                            np.arange(25 * step, max(4 * spec.memory(), 60.0), step)])
+        K = spec.impulse_response(t)
+        return (np.asarray(added_mass_from_irf(K, t, spec.added_mass_inf(), omega)),
+                np.asarray(damping_from_irf(K, t, omega)))
+
+    def provenance(self):
+        return {"radiation": self.name, "memory_length_s": self.memory_length,
+                "convolution_lags": self.n_lags}
+
+    @classmethod
+    def build(cls, spec, dt, memory, stage_offsets):
+        W_current, W_lag = spec.kernel(dt, memory, offsets=stage_offsets)
+        T_K = spec.memory() if memory is None else float(memory)
+        return cls(W_current=jnp.asarray(W_current), W_lag=jnp.asarray(W_lag),
+                   dt=jnp.asarray(dt, jnp.float64), memory_length=float(T_K),
+                   stage_offsets=tuple(float(s) for s in stage_offsets),
+                   dofs=tuple(spec.moving), n_lags=W_lag.shape[1])
+
+
+class StateSpace(NoRadiation):
+    """The modal state space: ``p`` (n_x, 2) complex poles as (re, im), ``C`` (n_out, n_x, 2)
+    output residues (conjugate pairs folded, × 2), ``inputs`` the input dof of each state,
+    ``outputs`` the output dofs, ``A_inf`` the fit's corrected A∞; ``options`` the fit options
+    (static, so the frequency domain refits nothing: the fit is cached on the HydroSpec)."""
+    p: jnp.ndarray
+    C: jnp.ndarray
+    A_inf: jnp.ndarray
+    inputs: tuple[int, ...] = eqx.field(static=True)
+    outputs: tuple[int, ...] = eqx.field(static=True)
+    options: tuple = eqx.field(static=True, default=())
+    report: tuple = eqx.field(static=True, default=())
+    name: ClassVar[str] = "state_space"
+
+    @property
+    def n_states(self):
+        return 2 * len(self.inputs)
+
+    def force(self, t, v, z, memory):
+        n = len(self.inputs)
+        zr, zi = z[:n], z[n:]
+        pr, pi = self.p[:, 0], self.p[:, 1]
+        u = v[np.asarray(self.inputs)]
+        zd = jnp.concatenate([pr * zr - pi * zi + u, pr * zi + pi * zr])
+        F = self.C[..., 0] @ zr - self.C[..., 1] @ zi
+        return -jnp.zeros_like(v).at[np.asarray(self.outputs)].set(F), zd
+
+    def added_mass_inf(self, spec):
+        return np.asarray(self.A_inf)
+
+    def coefficients(self, spec, omega):
+        ss = spec.state_space(**dict(self.options))
+        Z = ss.impedance(omega)
+        return np.asarray(self.A_inf)[None] + Z.imag / omega[:, None, None], Z.real
+
+    def provenance(self):
+        return {"radiation": self.name, "state_space_options": repr(dict(self.options)),
+                "state_space_states": self.n_states, **{f"fit_{k}": v for k, v in self.report}}
+
+    @classmethod
+    def build(cls, spec, options):
+        from hydro.prepare import modal_form
+
+        import inspect
+
+        from hydro.statespace import fit_state_space
+
+        if options is not None and not isinstance(options, dict):
+            raise ValueError(f"state_space_options: {options!r}; give a dict of options of "
+                             "hydro.statespace.fit_state_space")
+        options = dict(options or {})
+        accepted = [p for p in inspect.signature(fit_state_space).parameters if p != "db"]
+        bad = sorted(set(options) - set(accepted))
+        if bad:
+            raise ValueError(f"state_space_options: unknown option(s) {bad}; accepted: {accepted} "
+                             "(see hydro.statespace.fit_state_space)")
+        ss = spec.state_space(**options)
+        P, C, ins, outs = modal_form(ss)
+        report = tuple((k, v) for k, v in (getattr(ss, "report", None) or {}).items()
+                       if isinstance(v, (int, float, str)))
+        return cls(p=jnp.asarray(np.stack([P.real, P.imag], 1).reshape(-1, 2)),
+                   C=jnp.asarray(np.stack([C.real, C.imag], -1).reshape(len(outs), len(P), 2)),
+                   A_inf=jnp.asarray(np.asarray(ss.added_mass_inf) * spec.mask),
+                   inputs=tuple(ins), outputs=tuple(outs),
+                   options=tuple(sorted(options.items())), report=report)
+
+
+def strategy(spec, name, *, dt=None, memory=None, state_space_options=None, stage_offsets=(0.0, 0.5, 1.0),
+             frequency_domain=False):
+    """The radiation strategy ``name`` for a model's :class:`~hydro.prepare.HydroSpec`."""
+    accepted = STRATEGIES + (("database",) if frequency_domain else ())
+    if name not in accepted:
+        raise ValueError(f"radiation={name!r}; accepted: {', '.join(map(repr, accepted))}")
+    if name == "state_space":
+        return StateSpace.build(spec, state_space_options)
+    if name == "convolution":
+        if frequency_domain:
+            # the coefficients need only K(t) and the memory, not the weights of a time step
+            return Convolution(W_current=jnp.zeros((1, 0, 0)), W_lag=jnp.zeros((1, 1, 0, 0)),
+                               dt=jnp.asarray(1.0), memory_length=spec.memory(),
+                               stage_offsets=(0.0,), dofs=(), n_lags=1)
+        return Convolution.build(spec, dt, memory, stage_offsets)
+    if name == "database":
+        return DatabaseRadiation()
+    return NoRadiation()
+
+
+def grid_subdivisions(stage_offsets) -> int:
+    """The smallest m such that every stage offset is a multiple of 1/m (the excitation is
+    tabulated at dt/m, so every stage falls on a sample)."""
+    m = 1
+    for s in stage_offsets:
+        f = Fraction(float(s)).limit_denominator(64)
+        if abs(float(f) - s) > 1e-12:
+            raise ValueError(f"stage offset {s} of the integrator is not a simple fraction of dt")
+        m = m * f.denominator // np.gcd(m, f.denominator)
+    return int(m)

@@ -1,0 +1,358 @@
+"""The water: Cummins hydrodynamics through Bᵀ F, the one load that joins `mfm` to `hydro`.
+
+Hydro coordinates (DESIGN §3). The BEM data of hydro body k are 6 modes about its reference point
+r_k (inertial axes). Its small-motion vector ξ_k = (displacement of r_k, rotation vector) has the
+velocity ``ξ̇ = H(q) q̇`` with ``H_k = T_k B_i``,
+
+    T_k = [[I, −ρ̂ R], [0, R]],   ρ = R d_k,   d_k = r_k(0) − c_i(0),
+
+which moves the CoM velocity of body i to the reference point and turns its body-axis angular
+velocity into inertial axes. A hydro load F (force at r_k and moment about r_k, inertial axes)
+does the virtual power Fᵀ ξ̇ = (Hᵀ F)ᵀ q̇; it is applied as the equivalent body wrench (force, and
+moment about the CoM in body axes Rᵀ(m + ρ × f)), so Bᵀ of it is exactly Hᵀ F and the joint
+reactions see it.
+
+Cummins equation for all hydro bodies together:
+
+    F_hyd = F_exc(t) − A∞ ξ̈ − ∫₀^{T_K} K(τ) ξ̇(t − τ) dτ − C_wp ξ + ρ g V ẑ (at the CoB) − F_drag
+
+- A∞ is acceleration-proportional: ``M* += Hᵀ A∞ H`` and its velocity part ``−Hᵀ A∞ Ḣ q̇`` is a
+  load (Ḣ q̇ from the tree walk's velocity-product accelerations). ``added_mass="rhs"`` instead
+  puts −A∞ ξ̈ on the right-hand side with the corrector's acceleration iterate (seed 001 §5).
+- Buoyancy is the constant force ρgV ẑ at the centre of buoyancy (a point fixed in the body), plus
+  the linear water-plane stiffness C_wp about r_k (the database's ``waterplane_stiffness``: no
+  ρgV z_B, no m g z_G, so gravity and buoyancy are not counted twice). Weights act exactly (mfm).
+- Radiation memory by a strategy (:mod:`mfm.loads.radiation`): convolution, state space or none.
+- Quadratic drag −½ ρ C_D A |u| u per inertial axis on the velocity of r_k (no current, no wave
+  velocity); it is not linearised in the frequency domain (zero slope at rest).
+
+In the frequency domain the same load gives, about q₀, the impedance −ω² Hᵀ(A(ω) − A∞)H
+− iω HᵀB(ω)H of its radiation strategy (A∞ H itself is in the mass, from ``mass``) and the wave
+force Hᵀ X(ω, β).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import equinox as eqx
+import jax.numpy as jnp
+import numpy as np
+
+from ..points import BodyPoints
+from .base import FrequencyTerms, Load, LoadOutput
+from .radiation import NoRadiation, grid_subdivisions, strategy
+
+MODES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
+HYDRO_COMPONENTS = ("excitation", "radiation", "added_mass", "hydrostatic", "buoyancy", "drag")
+
+
+class Water(Load):
+    """The hydrodynamic load of a model. Build with :func:`build_water`.
+
+    Arrays (float64): ``A_inf`` (6K, 6K); ``C_wp`` (6K, 6K); ``buoyancy`` (K,) = ρ g V, N;
+    ``d_cob`` (K, 3) CoB − CoM at q = 0; ``drag`` (K, 3) = ½ ρ C_D A per inertial axis; the
+    excitation ``exc_values`` (n, 6K) on the grid ``exc_t0 + j·exc_step`` and the wave elevation
+    at the origin ``eta_values`` (n,) on the same grid; ``rad`` the radiation strategy.
+    Static: ``spec`` (the :class:`~hydro.prepare.HydroSpec`), ``dofs``, ``added_mass``, ``sea``
+    (a description of the sea state for the results).
+    """
+    geometry: BodyPoints
+    A_inf: jnp.ndarray
+    C_wp: jnp.ndarray
+    buoyancy: jnp.ndarray
+    d_cob: jnp.ndarray
+    drag: jnp.ndarray
+    exc_t0: jnp.ndarray
+    exc_step: jnp.ndarray
+    exc_values: jnp.ndarray
+    eta_values: jnp.ndarray
+    rad: NoRadiation
+    dofs: tuple[str, ...] = eqx.field(static=True)
+    added_mass: str = eqx.field(static=True, default="lhs")
+    spec: object = eqx.field(static=True, default=None)
+    settings: tuple = eqx.field(static=True, default=())
+    grid_m: int = eqx.field(static=True, default=2)   # excitation samples per step
+
+    # the older names, kept for code that reads them
+    @property
+    def radiation(self) -> str:
+        return self.rad.name
+
+    @property
+    def n_lags(self) -> int:
+        return getattr(self.rad, "n_lags", 1)
+
+    @property
+    def conv_dofs(self) -> tuple[int, ...]:
+        return getattr(self.rad, "dofs", ())
+
+    @property
+    def n_states(self) -> int:
+        return self.rad.n_states
+
+    def init_memory(self, model, t0, q0, qd0, dt):
+        from ..kinematics import kinematics
+
+        v, _ = self.geometry.velocity_and_bias(kinematics(model, q0, qd0))
+        return self.rad.init_memory(v, t0)
+
+    def update_memory(self, model, t, q, qd, kin, memory):
+        v, _ = self.geometry.velocity_and_bias(kin)
+        return self.rad.update_memory(v, t, memory)
+
+    def _series(self, values, t):
+        s = (t - self.exc_t0) / self.exc_step
+        n = values.shape[0]
+        k = jnp.clip(jnp.floor(s), 0, n - 2).astype(int)
+        w = jnp.clip(s - k, 0.0, 1.0)
+        return (1.0 - w) * values[k] + w * values[k + 1]
+
+    def radiation_force(self, t, v, z, memory):
+        """−∫K ξ̇ and the state derivative, by the radiation strategy."""
+        return self.rad.force(t, v, z, memory)
+
+    def _forces(self, t, kin, z, memory):
+        g = self.geometry
+        xi = g.xi(kin)
+        v, hbias = g.velocity_and_bias(kin)
+        exc = self._series(self.exc_values, t)
+        rad, zd = self.radiation_force(t, v, z, memory)
+        hyd_stat = -(self.C_wp @ xi)
+        vv = v.reshape(-1, 6)[:, :3]
+        drag = jnp.zeros_like(v).reshape(-1, 6).at[:, :3].set(-self.drag * jnp.abs(vv) * vv).reshape(-1)
+        return dict(excitation=exc, radiation=rad, hydrostatic=hyd_stat, drag=drag,
+                    added_mass_bias=-(self.A_inf @ hbias)), zd, v, hbias
+
+    def _buoyancy(self, kin):
+        """ρgV ẑ at each centre of buoyancy: as loads at r_k (6K,) and the CoB lever (K, 3)."""
+        R = kin.E[np.asarray(self.geometry.body_index), :3, :3]
+        lever = jnp.einsum("kab,kb->ka", R, self.d_cob)
+        f = jnp.zeros_like(lever).at[:, 2].set(self.buoyancy)
+        return f, lever
+
+    def _buoyancy_wrench(self, kin, n_bodies):
+        f, lever = self._buoyancy(kin)
+        F = jnp.concatenate([f, jnp.zeros_like(f)], axis=1).reshape(-1)
+        return self.geometry.to_body_wrench(F, kin, n_bodies, point_offset=lever)
+
+    def evaluate(self, ctx):
+        model, kin = ctx.model, ctx.kin
+        comps, zd, _, _ = self._forces(ctx.t, kin, ctx.z, ctx.memory)
+        F = sum(comps.values())
+        H, _, _ = self.geometry.h_matrix(kin)
+        rhs = self.added_mass == "rhs" and ctx.qdd_guess is not None
+        if rhs:
+            # seed 001 §5: −A∞ ξ̈ on the right-hand side with the corrector's acceleration iterate.
+            # Without an iterate (start of a run, linearisation) the iteration's converged value
+            # is used instead: A∞ on the left.
+            F = F - self.A_inf @ (H @ ctx.qdd_guess)
+        body = self.geometry.to_body_wrench(F, kin, model.n_bodies) + self._buoyancy_wrench(kin, model.n_bodies)
+        mass = None if rhs else H.T @ self.A_inf @ H
+        return LoadOutput(body=body, zd=zd, mass=mass)
+
+    def reaction_loads(self, ctx, out):
+        # out.body holds −A∞ Ḣq̇; add −A∞ H q̈ so that the bodies feel the whole −A∞ ξ̈ (with
+        # added_mass="rhs" out.body already holds −A∞ H q̈ of the recorded iterate)
+        if self.added_mass == "rhs" and out.mass is None:
+            return out.body
+        H, _, _ = self.geometry.h_matrix(ctx.kin)
+        return out.body + self.geometry.to_body_wrench(-(self.A_inf @ (H @ ctx.qdd)), ctx.kin,
+                                                       ctx.model.n_bodies)
+
+    def diagnostics(self, ctx, out):
+        kin = ctx.kin
+        comps, _, v, hbias = self._forces(ctx.t, kin, ctx.z, ctx.memory)
+        H, _, _ = self.geometry.h_matrix(kin)
+        comps["added_mass"] = -(self.A_inf @ (H @ ctx.qdd + hbias))
+        comps.pop("added_mass_bias")
+        f, lever = self._buoyancy(kin)
+        rho = self.geometry._frames(kin)[2]
+        buoy = jnp.concatenate([f, jnp.cross(lever - rho, f)], axis=1)
+        comps["buoyancy"] = buoy.reshape(-1)
+        return {"eta": self._series(self.eta_values, ctx.t), "xi": self.geometry.xi(kin),
+                "hydro_force": jnp.stack([comps[c] for c in HYDRO_COMPONENTS])}
+
+    def outputs(self):
+        return {"coords": {"hydro_dof": list(self.dofs), "component": list(HYDRO_COMPONENTS)},
+                "eta": ((), {"long_name": "wave elevation at the origin", "units": "m"}),
+                "xi": (("hydro_dof",), {"long_name": "hydro coordinates: displacement of each "
+                                        "body's reference point (m) and rotation vector (rad), "
+                                        "inertial axes", "units": "m or rad"}),
+                "hydro_force": (("component", "hydro_dof"),
+                                {"long_name": "hydrodynamic loads on each body's reference point, "
+                                 "inertial axes", "units": "N or N m"})}
+
+    def annotate(self, ds, rec):
+        ds = super().annotate(ds, rec)
+        ds.attrs["radiation"] = self.radiation
+        ds.attrs["added_mass"] = self.added_mass
+        return ds
+
+    def batch_outputs(self, save_every, n_saved):
+        eta = np.asarray(self.eta_values)[::self.grid_m * save_every][:n_saved]
+        return {"eta": (eta, {"long_name": "wave elevation at the origin", "units": "m"})}
+
+    def provenance(self):
+        out = {"added_mass": self.added_mass, **self.rad.provenance(), **dict(self.settings)}
+        if self.spec is not None:
+            out.update(self.spec.provenance())
+        return out
+
+    def describe_nonfinite(self, model, q, qd):
+        if self.added_mass != "rhs":
+            return None
+        from ..dynamics import mass_matrix
+        from ..kinematics import kinematics
+
+        # the fixed-point iteration a ← M*⁻¹(F − Hᵀ A∞ H a) contracts only if the spectral radius
+        # of M*⁻¹ Hᵀ A∞ H is below 1
+        H = np.asarray(self.geometry.h_matrix(kinematics(model, q, qd))[0])
+        Ms = np.asarray(mass_matrix(model, q))
+        r = float(np.abs(np.linalg.eigvals(np.linalg.solve(Ms, H.T @ np.asarray(self.A_inf) @ H))).max())
+        if r < 1.0:
+            return None
+        return (f"Likely cause: added_mass='rhs' (the seed 001 iteration of A∞ ξ̈ on the right-hand "
+                f"side) diverges here: the spectral radius of M*⁻¹ Hᵀ A∞ H is {r:.3g} ≥ 1 (added "
+                "mass larger than the structural mass). Use added_mass='lhs' (A∞ in M*, no "
+                "iteration).")
+
+    # -- linearisation
+    def static_load(self):
+        """Still water, no memory: buoyancy, water-plane stiffness, A∞ (in the mass)."""
+        return eqx.tree_at(lambda w: (w.exc_values, w.eta_values, w.rad),
+                           self, (jnp.zeros_like(self.exc_values), jnp.zeros_like(self.eta_values),
+                                  NoRadiation()))
+
+    def frequency_terms(self, model, q0, kin0, omega, heading, options):
+        """−ω² Hᵀ(A(ω) − A∞)H − iω HᵀB(ω)H (A∞ is in the mass already) and Hᵀ X(ω, β), with A and
+        B those of ``options["radiation"]`` ("database", or a time-domain strategy's)."""
+        from hydro.excitation import excitation_coefficients
+        from hydro.waves import WaveComponents, wavenumber
+
+        spec = self.spec
+        rad = strategy(spec, options.get("radiation", "database"), frequency_domain=True,
+                       state_space_options=options.get("state_space_options"))
+        om_db = np.asarray(spec.database()["omega"].values)
+        if omega.min() < om_db[0] * (1 - 1e-9) or omega.max() > om_db[-1] * (1 + 1e-9):
+            raise ValueError(f"omega: [{omega.min():.4g}, {omega.max():.4g}] rad/s lies outside the "
+                             f"database's [{om_db[0]:.4g}, {om_db[-1]:.4g}] rad/s; choose frequencies "
+                             "inside it or regenerate the database")
+        A, B = rad.coefficients(spec, omega)
+        H0 = np.asarray(self.geometry.h_matrix(kin0)[0])
+        A_rel = np.asarray(A) - np.asarray(self.A_inf)[None]
+        w = omega[:, None, None]
+        Z = np.einsum("ai,wab,bj->wij", H0, -w**2 * A_rel - 1j * w * np.asarray(B), H0)
+        comps = WaveComponents(omega=omega, amplitude=np.ones_like(omega), phase=np.zeros_like(omega),
+                               heading=np.full_like(omega, heading),
+                               wavenumber=wavenumber(omega, spec.water_depth, spec.g),
+                               water_depth=spec.water_depth, g=spec.g)
+        if not options.get("excitation", True):
+            return FrequencyTerms(impedance=Z)
+        X = excitation_coefficients(spec.database(), comps)
+        return FrequencyTerms(impedance=Z, force=np.einsum("ai,wa->wi", H0, X))
+
+    def frequency_range(self):
+        om = np.asarray(self.spec.database()["omega"].values)
+        return float(om[0]), float(om[-1])
+
+    def frequency_outputs(self, model, kin0, x, omega):
+        H0 = np.asarray(self.geometry.h_matrix(kin0)[0])
+        return {"xi_rao": (("hydro_dof",), np.einsum("ai,wi->wa", H0, x),
+                           {"long_name": "hydro coordinates (reference points) RAO",
+                            "units": "m/m or rad/m"}),
+                "coords": {"hydro_dof": list(self.dofs)}}
+
+
+def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0,
+                ramp: float = 0.0, radiation: str = "convolution", memory: float | None = None,
+                state_space_options: dict | None = None, added_mass: str = "lhs",
+                stage_offsets=(0.0, 0.5, 1.0)) -> Water:
+    """The :class:`Water` load of ``model`` for one sea state and time grid.
+
+    sea: a ``hydro.waves`` sea state (Regular, Jonswap, …) or None for still water.
+    radiation: "convolution" (direct, over the memory length from the decay of K), "state_space"
+    (the passive fit of hydro.statespace; its corrected A∞), or "none" (A∞ only).
+    stage_offsets: the integrator's stage times as fractions of dt (RK4: 0, ½, 1): the excitation
+    is tabulated so that each stage falls on a sample, and the convolution has weights per stage.
+    """
+    from hydro.excitation import excitation_time_series
+    from hydro.waves import elevation
+
+    rad = strategy(spec, radiation, dt=dt, memory=memory, state_space_options=state_space_options,
+                   stage_offsets=stage_offsets)
+    nd = len(spec.dofs)
+    m = grid_subdivisions(stage_offsets)
+    # excitation and elevation on the stage grid, one step past the end
+    n_grid = int(round(duration / dt)) * m + m + 1
+    step = dt / m
+    t_grid = t0 + step * np.arange(n_grid)
+    if sea is None:
+        exc = np.zeros((n_grid, nd))
+        eta = np.zeros(n_grid)
+    else:
+        comps = sea.components(water_depth=spec.water_depth, g=spec.g)
+        exc = excitation_time_series(spec.database(), comps, t_grid, ramp_duration=ramp)
+        eta = np.asarray(elevation(comps, t_grid, ramp_duration=ramp)).reshape(-1)
+    geometry = BodyPoints(body_index=spec.body_index, d_ref=jnp.asarray(spec.d_ref),
+                          ref0=jnp.asarray(spec.ref0))
+    f64 = lambda a: jnp.asarray(a, dtype=jnp.float64)  # noqa: E731
+    settings = (("ramp_s", float(ramp)), ("sea", "still water" if sea is None else repr(sea)))
+    return Water(geometry=geometry, A_inf=f64(rad.added_mass_inf(spec)), C_wp=f64(spec.C_wp),
+                 buoyancy=f64(spec.rho * spec.g * spec.volume), d_cob=f64(spec.d_cob),
+                 drag=f64(spec.drag), exc_t0=f64(t0), exc_step=f64(step), exc_values=f64(exc),
+                 eta_values=f64(eta), rad=rad, dofs=spec.dofs, added_mass=added_mass, spec=spec,
+                 settings=settings, grid_m=int(m))
+
+
+def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_coupling: bool | None = None):
+    """Build a model's :class:`~hydro.prepare.HydroSpec` from the parsed ``[hydro]`` table."""
+    from hydro.database import select_bodies
+    from hydro.prepare import HydroSpec, open_any_database
+
+    path = Path(options["database"])
+    if not path.is_absolute():
+        path = Path(config_dir) / path
+    db = open_any_database(path, names=options.get("names"), rho=options.get("rho"), g=options.get("g"))
+    available = [str(b) for b in db["body"].values]
+    tagged = [(b.name, b.extra["hydro"]) for b in bodies if "hydro" in b.extra]
+    if tagged:
+        wet = [(name, h["body"], h["drag"]) for name, h in tagged]
+    else:
+        wet = [(b.name, b.name, np.zeros(3)) for b in bodies if b.name in available]
+    if not wet:
+        raise ValueError(f"hydro: no config body is in the database {str(path)!r} (database bodies "
+                         f"{available}, config bodies {[b.name for b in bodies]}); give each wet "
+                         "body a [bodies.hydro] table with body = \"<database name>\"")
+    missing = [db_name for _, db_name, _ in wet if db_name not in available]
+    if missing:
+        raise ValueError(f"hydro: database bodies {missing} named by the config are not in "
+                         f"{str(path)!r}; available: {available}")
+    db = select_bodies(db, [db_name for _, db_name, _ in wet])
+    idx = [model.body_index(name) for name, _, _ in wet]
+    com0 = np.asarray(model.com)[idx]
+    coupling = options.get("body_coupling", True) if body_coupling is None else body_coupling
+    if not isinstance(coupling, bool):
+        raise ValueError(f"body_coupling: {coupling!r}; accepted: True, False or None (the config's "
+                         "hydro.body_coupling)")
+    return HydroSpec(db, idx, [name for name, _, _ in wet], com0, np.stack([d for _, _, d in wet]),
+                     body_coupling=coupling, added_mass_inf=options.get("added_mass_inf", "consistent"),
+                     source=str(path), moving=moving_dofs(model, idx, np.asarray(db["reference_point"].values) - com0))
+
+
+def moving_dofs(model, body_index, d_ref, n_samples: int = 3, seed: int = 0) -> np.ndarray:
+    """Indices of the hydro dofs (6 per wet body: the velocity of its reference point and its
+    angular velocity, inertial axes) that the model's joints can move: the rows of H(q) in
+    ξ̇ = H q̇ that are not 0 at ``n_samples`` random configurations (|q| ≤ 0.3). A structural zero
+    (a planar model has no sway, roll or yaw) is 0 at every q; a row that is 0 by accident at
+    three random q is not generic. Radiation is modelled on these dofs only."""
+    from ..kinematics import kinematics
+
+    geo = BodyPoints(body_index=tuple(int(i) for i in body_index), d_ref=jnp.asarray(d_ref),
+                     ref0=jnp.zeros((len(body_index), 3)))
+    rng = np.random.default_rng(seed)
+    peak = 0.0
+    for _ in range(n_samples):
+        q = jnp.asarray(rng.uniform(-0.3, 0.3, model.n_coordinates))
+        H = np.abs(np.asarray(geo.h_matrix(kinematics(model, q, jnp.zeros_like(q)))[0]))
+        peak = np.maximum(peak, H.max(axis=1))
+    return np.flatnonzero(peak > 1e-12 * max(float(np.max(peak)), 1e-300))

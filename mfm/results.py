@@ -1,0 +1,294 @@
+"""One module builds every result: labelled ``xarray.Dataset``s with units on every variable, PTO
+power defined once, and provenance (config and database with their SHA-256, sea state, ramp,
+radiation settings and fit report, integrator, dt, versions, git commit), whichever front door
+(:func:`mfm.simulate`, :func:`mfm.simulate_batch`, :func:`mfm.frequency_response`,
+:func:`mfm.natural_frequencies`) made them.
+"""
+from __future__ import annotations
+
+import datetime
+import functools
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+CONVENTIONS = ("inertial frame: origin on the still-water line, z up; body frames at the CoM, "
+               "parallel to inertial at q = 0")
+PTO_POWER_ATTRS = {"long_name": "absorbed power: c q̇² (joint dampers), β ẇ² (hydraulic)", "units": "W"}
+
+
+# ------------------------------------------------------------------------------- provenance
+def version() -> str:
+    try:
+        from importlib.metadata import version as v
+        return v("mfm")
+    except Exception:  # not installed (running from a source tree)
+        return "unknown"
+
+
+@functools.lru_cache(maxsize=1)
+def git_commit() -> str:
+    """The commit of the source tree mfm runs from, with "+dirty" if it has changes; "" if none."""
+    root = Path(__file__).resolve().parent.parent
+    try:
+        head = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True,
+                              text=True, timeout=5)
+        if head.returncode:
+            return ""
+        dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, timeout=5).stdout.strip()
+        return head.stdout.strip() + ("+dirty" if dirty else "")
+    except (OSError, subprocess.SubprocessError):
+        return ""
+
+
+def _attr(v):
+    """NetCDF attributes take str, numbers and arrays of numbers: anything else as its repr."""
+    if isinstance(v, (str, int, float, np.integer, np.floating)) and not isinstance(v, bool):
+        return v
+    if isinstance(v, bool):
+        return str(v)
+    if v is None:
+        return "none"
+    return repr(v)
+
+
+def provenance(model, loads=(), **settings) -> dict:
+    """The attributes every result carries: model, config (path, SHA-256), the loads' own
+    settings (database, sea state, ramp, radiation, fit report), the run's settings, versions."""
+    import jax
+
+    out = {"model": model.name, "config": getattr(model, "source", "") or "none",
+           "config_sha256": getattr(model, "source_sha256", "") or "none"}
+    if model.hydro is not None:
+        out.update(model.hydro.provenance())
+    for ld in loads:
+        out.update(ld.provenance())
+    out.update(settings)
+    out.update({"mfm_version": version(), "git_commit": git_commit() or "none",
+                "jax_version": jax.__version__, "numpy_version": np.__version__,
+                "xarray_version": xr.__version__,
+                "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+                "conventions": CONVENTIONS})
+    return {k: _attr(v) for k, v in out.items()}
+
+
+# ------------------------------------------------------------------------------- units
+def coordinate_units(model) -> list[str]:
+    """"rad" for a rotation coordinate, "m" for a translation, per coordinate of q."""
+    units = [""] * model.n_coordinates
+    for motions in model.motions:
+        for kind, k in motions:
+            units[k] = "rad" if kind == "R" else "m"
+    return units
+
+
+def _rate(u, n):
+    return {"rad": "rad/s", "m": "m/s"}[u] if n == 1 else {"rad": "rad/s2", "m": "m/s2"}[u]
+
+
+def _coordinate_attrs(model, what, n=0):
+    units = coordinate_units(model)
+    kinds = sorted(set(units))
+    u = kinds[0] if len(kinds) == 1 else None
+    label = {0: "generalised coordinates", 1: "generalised velocities", 2: "generalised accelerations"}[n]
+    if u is not None:
+        return {"long_name": label, "units": u if n == 0 else _rate(u, n)}
+    return {"long_name": label, "units": {0: "m or rad", 1: "m/s or rad/s", 2: "m/s2 or rad/s2"}[n]
+            + " (per coordinate: coordinate_unit)"}
+
+
+def _coordinate_coords(model):
+    return {"coordinate": ("coordinate", list(model.coordinates)),
+            "coordinate_unit": ("coordinate", coordinate_units(model))}
+
+
+# ------------------------------------------------------------------------------- PTO power
+def absorbed_power(c, rate):
+    """The power a linear damper absorbs, P = c v² (W): joint dampers (c q̇²) and hydraulic
+    pistons (β ẇ²) alike."""
+    return c * rate**2
+
+
+def mean_absorbed_power(c, omega, amplitude):
+    """Its mean over a period for a harmonic motion of complex amplitude x̂ at ω: ½ c ω² |x̂|²."""
+    return 0.5 * c * omega**2 * np.abs(amplitude) ** 2
+
+
+def damper_power(damping, qd):
+    """The coordinates with a joint damper (c > 0 in any case) and the power c q̇² of each:
+    damping (n_q,) or (case, n_q), qd (…, time, n_q) → (indices, (…, time, n_damped))."""
+    damped = [int(k) for k in np.flatnonzero(np.any(np.atleast_2d(damping) > 0, axis=0))]
+    c = damping[..., damped]
+    return damped, absorbed_power(c[..., None, :] if c.ndim > 1 else c, qd[..., damped])
+
+
+def add_ptos(ds, names, power, displacement, force=None, dim="time"):
+    """Append PTOs (names, power (…, time, P), displacement (…, time, P)) to ``pto_power`` and
+    ``pto_displacement`` of ``ds`` (joint dampers first); ``force`` as ``pto_force``."""
+    lead = tuple(d for d in ("case", "step", "time") if d in ds.dims and d in (dim, "case"))
+    lead = lead if lead else (dim,)
+    power = xr.DataArray(power, dims=lead + ("pto",), coords={"pto": list(names)})
+    disp = xr.DataArray(displacement, dims=lead + ("pto",), coords={"pto": list(names)})
+    if "pto" in ds.dims:
+        power = xr.concat([ds.pto_power, power], dim="pto")
+        disp = xr.concat([ds.pto_displacement, disp], dim="pto")
+        ds = ds.drop_vars(["pto_power", "pto_displacement", "pto"])
+    ds = ds.assign(pto_power=power, pto_displacement=disp)
+    ds["pto_power"].attrs = dict(PTO_POWER_ATTRS)
+    ds["pto_displacement"].attrs = {"long_name": "joint coordinate (relative angle or stroke) or "
+                                    "piston stroke", "units": "rad or m"}
+    if force is not None:
+        ds["pto_force"] = (lead + ("hydraulic_pto",), force,
+                           {"long_name": "hydraulic piston force μẅ + βẇ + κw", "units": "N"})
+        ds = ds.assign_coords(hydraulic_pto=list(names))
+    return ds
+
+
+def _joint_dampers(ds, model, damping, q, qd, dim):
+    damped, power = damper_power(np.asarray(damping), qd)
+    if not damped:
+        return ds
+    names = [model.coordinates[k] for k in damped]
+    units = coordinate_units(model)
+    ds = add_ptos(ds, names, power, q[..., damped], dim=dim)
+    kinds = {units[k] for k in damped}
+    if len(kinds) == 1:
+        ds["pto_displacement"].attrs["units"] = kinds.pop()
+    return ds
+
+
+# ------------------------------------------------------------------------------- time domain
+def time_series(model, loads, integ, dt, t, q, qd, qdd, iters, rec, settings) -> xr.Dataset:
+    """The dataset of one run (:func:`mfm.simulate`)."""
+    ds = xr.Dataset(
+        {
+            "q": (("time", "coordinate"), q, _coordinate_attrs(model, "q", 0)),
+            "qd": (("time", "coordinate"), qd, _coordinate_attrs(model, "qd", 1)),
+            "qdd": (("time", "coordinate"), qdd, _coordinate_attrs(model, "qdd", 2)),
+            "body_position": (("time", "body", "axis"), rec["body_position"],
+                              {"long_name": "centre of mass position, inertial axes", "units": "m"}),
+            "body_rotation": (("time", "body", "angle"), rec["body_rotation"],
+                              {"long_name": "body orientation as roll, pitch, yaw with "
+                               "R = Rz(yaw) Ry(pitch) Rx(roll)", "units": "rad"}),
+            "joint_force": (("time", "body", "axis"), rec["joint_force"],
+                            {"long_name": "force the joint of each body transmits from its parent "
+                             "(or the inertial frame) to the body, inertial axes", "units": "N"}),
+            "joint_moment": (("time", "body", "axis"), rec["joint_moment"],
+                             {"long_name": "moment the joint of each body transmits, about the joint "
+                              "point, inertial axes", "units": "N m"}),
+            "kinetic_energy": (("time",), rec["kinetic_energy"], {"units": "J"}),
+            "potential_energy": (("time",), rec["potential_energy"],
+                                 {"long_name": "gravity and joint springs", "units": "J"}),
+            "iterations": (("time",), iters, {"long_name": "corrector iterations of the step",
+                                              "units": "1"}),
+        },
+        coords={"time": ("time", t, {"units": "s"}), **_coordinate_coords(model),
+                "body": list(model.body_names), "axis": ["x", "y", "z"],
+                "angle": ["roll", "pitch", "yaw"]},
+        attrs={"title": f"mfm simulation of {model.name}",
+               **provenance(model, loads, integrator=integ.name, integrator_settings=repr(integ),
+                            dt=float(dt), dt_units="s", **settings)},
+    )
+    ds = _joint_dampers(ds, model, model.damping, q, qd, "time")
+    for ld in loads:
+        ds = ld.annotate(ds, rec)
+    return ds
+
+
+def batch(model, models, loads, integ, t, q, qd, dts, settings, save_every, labels=None) -> xr.Dataset:
+    """The dataset of :func:`mfm.simulate_batch`: (case, step, …); ``labels`` per-case values
+    (e.g. each sea state's Hs, Tp) as coordinates on ``case``."""
+    B = q.shape[0]
+    ds = xr.Dataset(
+        {"time": (("case", "step"), t, {"units": "s"}),
+         "q": (("case", "step", "coordinate"), q, _coordinate_attrs(model, "q", 0)),
+         "qd": (("case", "step", "coordinate"), qd, _coordinate_attrs(model, "qd", 1)),
+         "dt": (("case",), np.broadcast_to(dts, (B,)).copy(), {"units": "s"})},
+        coords={"case": np.arange(B), **_coordinate_coords(model)},
+        attrs={"title": f"mfm batch of {B} runs of {model.name}",
+               **provenance(model, loads[0], integrator=integ.name, save_every=int(save_every),
+                            **settings)})
+    for name, (values, attrs) in (labels or {}).items():
+        ds = ds.assign_coords({name: ("case", np.asarray(values), attrs)})
+    damping = np.stack([np.asarray(m.damping) for m in models])
+    ds = _joint_dampers(ds, model, damping, q, qd, "step")
+    per_case = [{} for _ in range(B)]
+    for i in range(B):
+        for ld in loads[i]:
+            per_case[i].update(ld.batch_outputs(save_every, q.shape[1]))
+    for name, (_, attrs) in per_case[0].items():
+        ds[name] = (("case", "step"), np.stack([per_case[i][name][0] for i in range(B)]), attrs)
+    return ds
+
+
+# ------------------------------------------------------------------------------- frequency domain
+def frequency(model, loads, omega, x, q0, kin0, heading, settings, extra) -> xr.Dataset:
+    """The dataset of :func:`mfm.frequency_response` from the coordinate amplitudes x (n_ω, n_q)."""
+    Bm = np.asarray(kin0.B)
+    R = np.asarray(kin0.E[:, :3, :3])
+    body = np.concatenate([np.einsum("nai,wi->wna", Bm[:, :3], x),
+                           np.einsum("nab,nbi,wi->wna", R, Bm[:, 3:], x)], axis=2)
+    damped = [k for k in range(model.n_coordinates) if float(model.damping[k]) > 0]
+    c = np.asarray(model.damping)[damped]
+    units = coordinate_units(model)
+    ds = xr.Dataset(
+        {"rao": (("omega", "coordinate"), x, {"long_name": "coordinate RAO per metre of wave "
+                                             "amplitude, x(t) = Re[x e^{-i omega t}]",
+                                             "units": "m/m or rad/m (per coordinate: coordinate_unit + /m)"}),
+         "body_rao": (("omega", "body", "dof"), body, {"long_name": "CoM displacement and small "
+                                                        "rotation of each body, inertial axes",
+                                                        "units": "m/m (x, y, z), rad/m (rx, ry, rz)"}),
+         "pto_rao": (("omega", "pto"), x[:, damped], {"long_name": "joint damper coordinate RAO",
+                                                      "units": "rad/m or m/m"}),
+         "pto_power": (("omega", "pto"), mean_absorbed_power(c, omega[:, None], x[:, damped]),
+                       {"long_name": "mean absorbed power per unit wave amplitude squared, ½ c ω² |x|²",
+                        "units": "W/m2"}),
+         "equilibrium": (("coordinate",), q0, {"long_name": "static equilibrium about which the "
+                                               "model is linearised", "units": "m or rad"})},
+        coords={"omega": ("omega", omega, {"units": "rad/s"}), **_coordinate_coords(model),
+                "body": list(model.body_names), "dof": ["x", "y", "z", "rx", "ry", "rz"],
+                "pto": [model.coordinates[k] for k in damped]},
+        attrs={"title": f"mfm frequency response of {model.name}",
+               **provenance(model, loads, heading=float(heading), heading_units="rad",
+                            convention="exp(-i omega t)", **settings)})
+    if model.hydro is not None:
+        ds.attrs["source"] = model.hydro.source
+    del units
+    for out in extra:
+        out = dict(out)
+        coords = out.pop("coords", {})
+        ds = ds.assign_coords({k: v for k, v in coords.items() if k not in ds.coords})
+        for name, (dims, values, attrs) in out.items():
+            ds[name] = (("omega",) + tuple(dims), values, attrs)
+    return ds
+
+
+def natural(model, loads, freqs, modes, zeta, zeta_rad, min_det, settings) -> xr.Dataset:
+    """The dataset of :func:`mfm.natural_frequencies`."""
+    n = len(freqs)
+    with np.errstate(invalid="ignore"):
+        damped = np.asarray(freqs) * np.sqrt(np.clip(1.0 - np.asarray(zeta) ** 2, 0.0, None))
+    return xr.Dataset(
+        {"eigen": (("mode",), np.asarray(freqs), {"long_name": "undamped natural frequency, "
+                                                  "generalised eigenproblem with A(omega_n)",
+                                                  "units": "rad/s"}),
+         "period": (("mode",), 2 * np.pi / np.asarray(freqs), {"long_name": "undamped natural period",
+                                                               "units": "s"}),
+         "damping_ratio": (("mode",), np.asarray(zeta),
+                           {"long_name": "modal damping ratio of the linear damping C (joint "
+                            "dampers, PTOs, body matrices; radiation excluded)", "units": "1"}),
+         "radiation_damping_ratio": (("mode",), np.asarray(zeta_rad),
+                                     {"long_name": "modal damping ratio of the radiation damping "
+                                      "B(omega_n)", "units": "1"}),
+         "damped": (("mode",), damped, {"long_name": "damped natural frequency ω_n √(1 − ζ²) of "
+                                        "the linear damping", "units": "rad/s"}),
+         "modes": (("coordinate", "mode"), np.asarray(modes).reshape(model.n_coordinates, n),
+                   {"long_name": "mode shapes (coordinates)"}),
+         "min_det": (("root",), np.asarray(min_det), {"long_name": "local minima of |det Λ(ω)| "
+                                                      "(seed 000 §2.10)", "units": "rad/s"})},
+        coords={"mode": np.arange(n), **_coordinate_coords(model)},
+        attrs={"title": f"mfm natural frequencies of {model.name}",
+               **provenance(model, loads, **settings)})
