@@ -41,13 +41,13 @@ class Hand:
     H, and the frequency-domain impedance at q = 0."""
 
     def __init__(self, n_q, point, angle, bodies, db, wet, g=9.81, joint_k=None, joint_c=None,
-                 joint_rest=None):
+                 joint_rest=None, q_lin=None):
         self.n_q, self.point, self.angle, self.bodies, self.db, self.wet, self.g = (
             n_q, point, angle, bodies, db, wet, g)
         self.joint_k = np.zeros(n_q) if joint_k is None else np.asarray(joint_k, float)
         self.joint_c = np.zeros(n_q) if joint_c is None else np.asarray(joint_c, float)
         self.joint_rest = np.zeros(n_q) if joint_rest is None else np.asarray(joint_rest, float)
-        q0 = jnp.zeros(n_q)
+        q0 = jnp.zeros(n_q) if q_lin is None else jnp.asarray(q_lin, float)   # linearised here
         rho = float(db.attrs["rho"])
         # mass matrix: Σ m JᵀJ + Iyy aᵀa (planar: one angular velocity per body)
         M = np.zeros((n_q, n_q))
@@ -251,13 +251,16 @@ def hinged(sphere_db, tmp_path_factory):
     def angle(b, q):
         return q[0]
 
-    hand = Hand(1, point, angle, {"sphere": (SPHERE["mass"], SPHERE["principal_inertia"][1], c0)},
-                sphere_db, [("sphere", 0)], joint_k=[K_JOINT], joint_c=[C_JOINT], joint_rest=[REST])
-    return mfm.load(path), hand
+    def hand(q_lin=None):
+        return Hand(1, point, angle, {"sphere": (SPHERE["mass"], SPHERE["principal_inertia"][1], c0)},
+                    sphere_db, [("sphere", 0)], joint_k=[K_JOINT], joint_c=[C_JOINT],
+                    joint_rest=[REST], q_lin=q_lin)
+
+    return mfm.load(path), hand(), hand
 
 
 def test_hinged_float_natural_frequency(hinged):
-    model, hand = hinged
+    model, hand, _ = hinged
     w = 1.0
     for _ in range(100):
         w = math.sqrt(hand.K[0, 0] / (hand.M[0, 0] + hand.added_mass_q(w)[0, 0]))
@@ -268,7 +271,7 @@ def test_hinged_float_natural_frequency(hinged):
 
 
 def test_hinged_float_equilibrium_under_an_applied_moment(hinged):
-    model, hand = hinged
+    model, hand, _ = hinged
     # the joint spring's rest angle applies k·rest at φ = 0; weight and buoyancy balance there
     grad_gravity_buoyancy = hand.dV[0] + K_JOINT * REST
     assert abs(grad_gravity_buoyancy) < 1e-6 * K_JOINT * REST
@@ -280,7 +283,7 @@ def test_hinged_float_equilibrium_under_an_applied_moment(hinged):
 
 def test_hinged_float_damped_response_against_single_dof(hinged, sphere_db):
     """x̂ = Hᵀ X / (K − ω² (I_h + Hᵀ A H) − iω (Hᵀ B H + c)): the damped single-dof system."""
-    model, hand = hinged
+    model, hand, _ = hinged
     omega = sphere_db.omega.values[4:56:3]                # database points: no interpolation
     rao = mfm.frequency_response(model, omega, q0=np.zeros(1)).rao.values[:, 0]
     ref = np.array([hand.rao(w)[0] for w in omega])
@@ -326,3 +329,16 @@ def test_m4_111_frequency_response_against_hand_assembly():
     # 1e-8 of the largest response: linear algebra on the same numbers (coupled 18×18 hydro)
     np.testing.assert_allclose(rao, ref, rtol=0, atol=1e-8 * np.abs(ref).max())
     assert np.abs(ref[:, 3]).max() > 0.5                   # the hinge responds: not vacuous
+
+
+def test_hinged_float_response_about_its_equilibrium(hinged, sphere_db):
+    """Without q0, mfm linearises about its equilibrium (φ₀ ≈ 7e-4 rad under the spring's rest
+    angle): M, K, H and the excitation at φ₀, against the hand model linearised there."""
+    model, hand0, hand_at = hinged
+    hand = hand_at(q_lin=hand0.equilibrium())
+    omega = sphere_db.omega.values[4:56:6]
+    rao = mfm.frequency_response(model, omega).rao.values[:, 0]
+    ref = np.array([hand.rao(w)[0] for w in omega])
+    # 1e-7: the two equilibria agree to 1e-10 rad; K at φ₀ differs from K at 0 by 5e-4
+    np.testing.assert_allclose(rao, ref, rtol=1e-7)
+    assert np.abs(hand.K - hand0.K).max() > 1e-4 * np.abs(hand0.K).max()   # 5e-4: visible
