@@ -40,6 +40,7 @@ import numpy as np
 import xarray as xr
 
 from hydro import geometry as geo
+from hydro.database import read_netcdf, write_netcdf
 
 LOG = logging.getLogger(__name__)
 
@@ -499,14 +500,13 @@ def save(ds, path):
         if c in out.coords:
             out[c] = out[c].astype(str)
             encoding[c] = {"dtype": "U"}
-    out.to_netcdf(path, encoding=encoding)
+    write_netcdf(out, path, encoding=encoding)
 
 
 def load(path):
     """Read a NetCDF written by ``save`` (or capytaine's ``export_dataset``), complex values
-    merged back."""
+    merged back; read whole into memory (``hydro.database.read_netcdf``: safe while the process
+    holds the file open)."""
     from capytaine.io.xarray import merge_complex_values
 
-    with xr.open_dataset(path) as f:
-        ds = f.load()
-    return merge_complex_values(ds)
+    return merge_complex_values(read_netcdf(path))

@@ -228,27 +228,104 @@ def merge_complex(ds: xr.Dataset) -> xr.Dataset:
     return out.drop_vars("complex")
 
 
+# Every NetCDF file of the project is read whole by :func:`read_netcdf` and written by
+# :func:`write_netcdf`, never with a bare ``xr.open_dataset(path)`` / ``ds.to_netcdf(path)``:
+#
+# - the netCDF-C 4.10 / HDF5 2.2 libraries of the netCDF4 wheel crash (segmentation fault) when a
+#   file that is already open in the process (a user's ``xr.open_dataset`` in a notebook) is opened
+#   a second time, read, closed, and opened a third time: HDF5 shares one file object between the
+#   handles of one path, and the close of the second handle leaves it in a state the third open
+#   dereferences. Reading the bytes with Python and decoding them from memory never gives HDF5 a
+#   second handle on the path, however many times the file is read;
+# - HDF5 locks and truncates a file it opens for writing: writing over a result that a reader holds
+#   open fails ("Permission denied") after the truncation has destroyed it. A temporary file in the
+#   same directory, renamed over the path (atomic on POSIX), leaves the reader its old file and
+#   every later reader the complete new one.
+
+
+def read_netcdf(path) -> xr.Dataset:
+    """The NetCDF file at `path` as an in-memory ``xarray.Dataset`` (no file left open): its bytes
+    read with Python and decoded from memory, so the HDF5 library never opens the path (see the
+    note above: a second HDF5 handle on a file the process holds open can crash it)."""
+    path = Path(path)
+    data = path.read_bytes()
+    try:
+        with xr.open_dataset(data, engine="netcdf4") as ds:
+            return ds.load()
+    except (OSError, ValueError) as e:
+        raise ValueError(f"{str(path)!r} is not a readable NetCDF file ({e})") from None
+
+
+def write_netcdf(ds: xr.Dataset, path, **kwargs) -> Path:
+    """``ds.to_netcdf`` atomically: written to a temporary file beside `path`, then renamed over it
+    (a reader holding the old file keeps it; nobody ever sees a half-written one). `kwargs` go to
+    ``Dataset.to_netcdf`` (e.g. ``encoding``)."""
+    import os
+
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    try:
+        ds.to_netcdf(tmp, **kwargs)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
+
+
 def to_netcdf(db: xr.Dataset, path) -> Path:
-    """Write `db` to NetCDF at `path` (complex values split into a trailing ``complex`` dim)."""
+    """Write `db` to NetCDF at `path` (complex values split into a trailing ``complex`` dim),
+    atomically (:func:`write_netcdf`)."""
     path = Path(path)
     ds = split_complex(db)
     for c in ("body", "influenced_dof", "radiating_dof", "axis"):
         if c in ds.coords:
             ds = ds.assign_coords({c: np.asarray(ds[c].values).astype(str)})
     ds.attrs = {k: (str(v) if isinstance(v, (bool, type(None))) else v) for k, v in ds.attrs.items()}
-    ds.to_netcdf(path)
+    write_netcdf(ds, path)
     return path
 
 
 def open_database(path) -> xr.Dataset:
     """Read a database written by :func:`to_netcdf` (loaded into memory, complex rejoined)."""
-    with xr.open_dataset(path) as ds:
-        ds = ds.load()
+    return _ours(read_netcdf(path))
+
+
+def _ours(ds: xr.Dataset) -> xr.Dataset:
+    """A dataset of :func:`to_netcdf` as read from the file → the database (complex rejoined)."""
     ds = merge_complex(ds)
     for c in ("body", "influenced_dof", "radiating_dof", "axis"):
         if c in ds.coords:
             ds = ds.assign_coords({c: np.asarray(ds[c].values).astype(str)})
     return ds
+
+
+def open_any_database(path, *, names=None, rho=None, g=None) -> xr.Dataset:
+    """Any hydro database file as the internal schema, in memory: our NetCDF (:func:`to_netcdf`),
+    a capytaine NetCDF (``mfm hydro``, ``hydro.bem.save``, ``cpt.export_dataset``; converted by
+    :func:`from_capytaine`), or WAMIT output (``.out`` with its ``.1``/``.3``/``.hst``; `names`
+    the bodies in file order, `rho` and `g` as :func:`hydro.wamit.read_wamit` takes them). A NetCDF
+    file is read once, whole (:func:`read_netcdf`): safe while the process holds it open."""
+    path = Path(path)
+    if path.suffix == ".nc":
+        if not path.exists():
+            raise FileNotFoundError(f"hydro.database: {str(path)!r} not found; generate it with "
+                                    "`mfm hydro CONFIG` or fix the path (relative to the config)")
+        raw = read_netcdf(path)
+        # ours has A∞ as a variable; capytaine's has it at ω = ∞ (complex dims rejoined by both)
+        return _ours(raw) if "added_mass_inf" in raw.data_vars else from_capytaine(raw)
+    from hydro.wamit import read_wamit
+
+    stem = path.with_suffix("") if path.suffix in (".out", ".1", ".3", ".hst") else path
+    if not stem.with_suffix(".out").exists():
+        raise FileNotFoundError(f"hydro.database: {str(path)!r}: no WAMIT output {stem}.out and not "
+                                "a .nc file; accepted: a NetCDF database or a WAMIT .out/.1/.3/.hst set")
+    kw = {}
+    if rho is not None:
+        kw["rho"] = float(rho)
+    if g is not None:
+        kw["g"] = float(g)
+    return read_wamit(stem, body_names=names, **kw)
 
 
 # ---------------------------------------------------------------------------------- capytaine

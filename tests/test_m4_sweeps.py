@@ -6,7 +6,6 @@ impedance evaluated per entry; single ``simulate`` runs; closed forms of wave po
 period; a linear filter of known gain.
 """
 import math
-import warnings
 from pathlib import Path
 
 import equinox as eqx
@@ -21,7 +20,8 @@ from mfm import wec
 from mfm.water import build_water, modal_form
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
-warnings.simplefilter("ignore", hydro.database.HydroDatabaseWarning)
+# per module, not session-wide: a database warning is expected here (the shipped BEM data)
+pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 
 
 @pytest.fixture(scope="module")

@@ -12,7 +12,8 @@ import mfm
 from mfm.cli import main
 from mfm.config import parse_config
 
-warnings.filterwarnings("ignore", category=hydro.database.HydroDatabaseWarning)
+# per module, not session-wide: a database warning is expected here (the shipped BEM data)
+pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 
 
 def test_locked_hinge_is_rigid():

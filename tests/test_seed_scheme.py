@@ -1,6 +1,5 @@
 """The scheme of seed 001 §5 (A∞ ξ̈ on the right-hand side, iterated in Beeman's corrector to 1 %)
 against ours (A∞ in M*), and where the seed's iteration cannot work."""
-import warnings
 
 import pytest
 from conftest import CONFIGS
@@ -8,7 +7,8 @@ from conftest import CONFIGS
 import hydro
 import mfm
 
-warnings.filterwarnings("ignore", category=hydro.database.HydroDatabaseWarning)
+# per module, not session-wide: a database warning is expected here (the shipped BEM data)
+pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 
 
 def test_seed_scheme_matches_ours_on_m4_111():

@@ -2,7 +2,6 @@
 against the frequency domain of the same model, capytaine's own RAO, bad inputs."""
 import dataclasses
 import math
-import warnings
 
 import numpy as np
 import pytest
@@ -12,7 +11,8 @@ import hydro
 import mfm
 from mfm.frequency import equilibrium, frequency_response, natural_frequencies
 
-warnings.filterwarnings("ignore", category=hydro.database.HydroDatabaseWarning)
+# per module, not session-wide: a database warning is expected here (the shipped BEM data)
+pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 
 
 def load(name, **kw):

@@ -1,0 +1,227 @@
+"""Mutation check of the device modules: plants one plausible bug at a time on a temporary copy of
+the repository, runs the tests that cover it, and reports which mutants the tests kill.
+
+    python tools/mutation_check.py                 # every mutant
+    python tools/mutation_check.py --only pto-gdot-sign,jonswap-sigma-swap
+    python tools/mutation_check.py --list
+
+Each mutant is a unique snippet of source text, its replacement, a one-line description and the
+test files (or node ids) that should catch it. The file is found by searching the snippet in
+mfm/**/*.py and hydro/**/*.py (not a fixed path: modules move), and the snippet must occur exactly
+once there. A mutant is killed when pytest fails (exit 1); exit 5 (nothing collected), a missing
+or ambiguous snippet, or a timeout is reported as an error, not a kill. Not run in CI (about an
+hour on two cores).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@dataclass(frozen=True)
+class Mutant:
+    name: str
+    description: str
+    snippet: str
+    replacement: str
+    tests: tuple[str, ...]
+    equivalent: str = ""          # why the mutant cannot be observed (then a survivor is fine)
+
+
+PTO = ("tests/test_device_ptos.py",)
+MOOR = ("tests/test_device_moorings.py::test_stiffness_6x6_against_hand", "tests/test_device_moorings.py")
+_F = "tests/test_device_frequency.py::"
+FREQ = ("tests/test_device_frequency.py",)
+NATFREQ = (_F + "test_sphere_heave_natural_frequency", _F + "test_hinged_float_natural_frequency")
+FRESP = (_F + "test_hinged_float_damped_response_against_single_dof",
+         _F + "test_m4_111_frequency_response_against_hand_assembly")
+EQUIL = (_F + "test_sphere_equilibrium_heavy_and_off_centre",
+         _F + "test_hinged_float_equilibrium_under_an_applied_moment")
+LINEAR = (_F + "test_hinged_float_response_about_its_equilibrium",)
+DRAG = ("tests/test_device_drag.py",)
+SPEC = ("tests/test_device_spectra.py",)
+_H = "tests/test_device_headings.py::"
+HEAD = ("tests/test_device_headings.py",)
+HEAD_REG = (_H + "test_regular_wave_excitation_at_heading", _H + "test_spread_sea_force_spectrum_against_hand_sum")
+HEAD_SPREAD = (_H + "test_spreading_directions_follow_cos2s", _H + "test_spread_sea_force_spectrum_against_hand_sum")
+HEAD_FR = (_H + "test_frequency_response_at_heading",)
+
+MUTANTS = [
+    # ---------------------------------------------------------------- PTOs (issue 16 bugs 1, 2)
+    Mutant("pto-gdot-sign", "planted bug 1: the sign of (|Δv|² − ẇ²)/L in the hydraulic PTO's ġq̇ flipped",
+           "+ (jnp.sum(dv * dv, axis=1) - wd**2) / L", "- (jnp.sum(dv * dv, axis=1) - wd**2) / L", PTO),
+    Mutant("pto-reaction-b-sign", "planted bug 2: the reaction on the PTO's second body with the wrong sign",
+           "Wb = self.b.to_body_wrench((-Fa.reshape(P, 6)", "Wb = self.b.to_body_wrench((Fa.reshape(P, 6)", PTO),
+    Mutant("pto-no-beta", "hydraulic damping β left out of the piston force",
+           "f = self.mu * gdot_qd + self.beta * wd + self.kappa * w",
+           "f = self.mu * gdot_qd + self.kappa * w", PTO),
+    Mutant("pto-half-oil-mass", "oil mass μ g gᵀ halved in M*",
+           'mass=jnp.einsum("p,pi,pj->ij", self.mu, g, g)', 'mass=0.5 * jnp.einsum("p,pi,pj->ij", self.mu, g, g)', PTO),
+    Mutant("pto-row-sum", "stroke-rate row g = uᵀ(H_a + H_b) instead of uᵀ(H_a − H_b)",
+           'g = jnp.einsum("pa,paq->pq", u, Ha - Hb)', 'g = jnp.einsum("pa,paq->pq", u, Ha + Hb)', PTO),
+    Mutant("pto-power-abs", "absorbed power β|ẇ| instead of β ẇ²",
+           '"hydraulic_power": self.beta * wd**2', '"hydraulic_power": self.beta * jnp.abs(wd)', PTO),
+    Mutant("pto-bias-b-dropped", "the second end's velocity-product acceleration left out of ġq̇",
+           "jnp.sum(u * (aa - ab), axis=1)", "jnp.sum(u * aa, axis=1)", PTO),
+    # ------------------------------------------------------ moorings and point loads (bug 3)
+    Mutant("mooring-lever-dropped", "planted bug 3: the mooring force applied at the CoM (lever arm dropped)",
+           "return LoadOutput(body=self.points.to_body_wrench(F, kin, model.n_bodies))",
+           "return LoadOutput(body=self.points.to_body_wrench(F, kin, model.n_bodies, "
+           "point_offset=jnp.zeros_like(self.points.d_ref)))", MOOR),
+    Mutant("mooring-axes-swapped", "mooring stiffness applied to the axes in reverse order (x ↔ z)",
+           "f = -self.stiffness * (self.points.positions(kin)", "f = -self.stiffness[:, ::-1] * (self.points.positions(kin)", MOOR),
+    Mutant("point-moment-sign", "moment of a point force about the CoM with the wrong sign (ρ × f)",
+           "mb = jnp.einsum(\"kba,kb->ka\", R, m + jnp.cross(rho, f))",
+           "mb = jnp.einsum(\"kba,kb->ka\", R, m - jnp.cross(rho, f))", MOOR),
+    # ------------------------------------------ frequency domain and equilibrium (bug 4)
+    Mutant("natfreq-stiffness-scaled", "planted bug 4: every natural frequency 10 % high (K × 1.21 inside natural_frequencies)",
+           "    q0, M0, K, C, H0 = linearise(model, q0)\n    spec = model.hydro\n",
+           "    q0, M0, K, C, H0 = linearise(model, q0)\n    K = 1.21 * K\n    spec = model.hydro\n", NATFREQ),
+    Mutant("fr-damping-sign", "frequency response with +iω(B + C): the e^{+iωt} convention's impedance",
+           "Z = -w**2 * (M0[None] + Aq) - 1j * w * (Bq + C[None]) + K[None]",
+           "Z = -w**2 * (M0[None] + Aq) + 1j * w * (Bq + C[None]) + K[None]", FRESP),
+    Mutant("fr-joint-damper-dropped", "frequency response without the joint dampers C",
+           "(Bq + C[None])", "(Bq)", FRESP),
+    Mutant("fr-excitation-conj", "frequency response with the conjugate excitation (WAMIT's convention)",
+           'F = np.einsum("ai,wa->wi", H0, X)', 'F = np.einsum("ai,wa->wi", H0, X.conj())', FRESP),
+    Mutant("linearise-about-zero", "stiffness taken at q = 0 instead of the equilibrium",
+           "K = -np.asarray(jax.jacfwd(G)(q0))", "K = -np.asarray(jax.jacfwd(G)(jnp.zeros_like(q0)))", LINEAR),
+    Mutant("fr-heading-ignored", "frequency response in head seas whatever the heading",
+           "heading=np.full_like(omega, heading)", "heading=np.full_like(omega, 0.0)", HEAD_FR),
+    # -------------------------------------------------------------------------- hydrostatics
+    Mutant("waterplane-scaled", "water-plane stiffness 10 % low in the time and frequency domains",
+           "hyd_stat = -(self.C_wp @ xi)", "hyd_stat = -(0.9 * self.C_wp @ xi)", NATFREQ),
+    Mutant("buoyancy-lever-fixed", "centre of buoyancy lever not turned with the body",
+           'lever = jnp.einsum("kab,kb->ka", R, self.d_cob)', "lever = self.d_cob", NATFREQ + EQUIL),
+    Mutant("buoyancy-g", "buoyancy with g = 9.8 instead of the database's 9.81",
+           "buoyancy=f64(spec.rho * spec.g * spec.volume)", "buoyancy=f64(spec.rho * 9.8 * spec.volume)", EQUIL),
+    # ---------------------------------------------------------------------------------- drag
+    Mutant("drag-no-abs", "drag −c u² (no |u|): pushes one way whatever the direction",
+           "-self.drag * jnp.abs(vv) * vv", "-self.drag * vv * vv", DRAG),
+    Mutant("drag-com-velocity", "drag on the CoM velocity instead of the hydro reference point's",
+           "vv = v.reshape(-1, 6)[:, :3]", "vv = kin.X[np.asarray(g.body_index), :3]", DRAG),
+    Mutant("drag-no-half", "drag coefficient without the ½ of ½ ρ C_D A",
+           "self.drag = 0.5 * self.rho * np.asarray(drag, dtype=float)",
+           "self.drag = self.rho * np.asarray(drag, dtype=float)", DRAG),
+    # ------------------------------------------------------------------ waves and spectra (bug 5)
+    Mutant("jonswap-sigma-swap", "planted bug 5: JONSWAP σ_a = 0.07 and σ_b = 0.09 swapped",
+           "sigma = np.where(x <= 1.0, 0.07, 0.09)", "sigma = np.where(x <= 1.0, 0.09, 0.07)", SPEC),
+    Mutant("pm-exponent", "Pierson–Moskowitz exponent −1.2 (ω_p/ω)⁴ instead of −5/4",
+           "np.exp(-1.25 * r**4)", "np.exp(-1.2 * r**4)", SPEC),
+    Mutant("amplitude-no-2", "component amplitude √(S Δω) instead of √(2 S Δω)",
+           "amp = np.sqrt(2.0 * np.maximum(self.spectrum(w), 0.0) * dw)",
+           "amp = np.sqrt(np.maximum(self.spectrum(w), 0.0) * dw)", SPEC),
+    Mutant("dnv-agamma", "DNV normalisation 1 − 0.28 ln γ instead of 1 − 0.287 ln γ",
+           "return 1.0 - 0.287 * math.log(gamma)", "return 1.0 - 0.28 * math.log(gamma)", SPEC),
+    Mutant("deep-water-k", "deep-water wavenumber ω²/(2g)",
+           "k_deep = w * w / g", "k_deep = w * w / (2.0 * g)", SPEC),
+    Mutant("regular-amplitude", "regular wave amplitude H instead of H/2",
+           "np.array([self.omega]), np.array([0.5 * self.height])", "np.array([self.omega]), np.array([self.height])", HEAD_REG),
+    Mutant("spreading-half", "spread directions drawn at half their angle",
+           "return sign * 2.0 * np.arcsin(np.sqrt(x))", "return sign * np.arcsin(np.sqrt(x))", HEAD_SPREAD),
+    # ---------------------------------------------------------------------------- excitation
+    Mutant("excitation-heading-ignored", "excitation interpolated at heading 0 whatever the sea's heading",
+           "b = _map_headings(grid_b, periodic, c.heading, active)",
+           "b = _map_headings(grid_b, periodic, 0.0 * c.heading, active)", HEAD_REG),
+    Mutant("excitation-phase-interp", "phase interpolated the wrong way between database points",
+           "np.exp(1j * (p0 + s * dp))", "np.exp(1j * (p0 - s * dp))", HEAD_REG),
+    Mutant("excitation-time-sign", "excitation time series with e^{+iωt} (sin term sign)",
+           "out[i:i + step] = np.cos(wt) @ cr + np.sin(wt) @ ci", "out[i:i + step] = np.cos(wt) @ cr - np.sin(wt) @ ci", HEAD_REG),
+]
+
+IGNORE = shutil.ignore_patterns(".git", ".venv", "__pycache__", "*.pyc", ".pytest_cache", "out",
+                                "figures", "*.egg-info")
+
+
+def locate(root: Path, snippet: str) -> tuple[Path | None, str]:
+    hits = []
+    for pkg in ("mfm", "hydro"):
+        for f in sorted((root / pkg).rglob("*.py")):
+            n = f.read_text().count(snippet)
+            if n:
+                hits.append((f, n))
+    if not hits:
+        return None, "snippet not found"
+    if len(hits) > 1 or hits[0][1] > 1:
+        return None, "snippet not unique: " + ", ".join(f"{f.relative_to(root)} ×{n}" for f, n in hits)
+    return hits[0][0], ""
+
+
+def run_mutant(copy: Path, m: Mutant, timeout: float) -> tuple[str, str, float]:
+    # the tests as they are now in the working tree (they may be edited while this runs)
+    shutil.rmtree(copy / "tests")
+    shutil.copytree(ROOT / "tests", copy / "tests", ignore=IGNORE)
+    path, err = locate(copy, m.snippet)
+    if path is None:
+        return "error", err, 0.0
+    original = path.read_text()
+    path.write_text(original.replace(m.snippet, m.replacement))
+    env = dict(os.environ, PYTHONPATH=str(copy), MPLBACKEND="Agg")
+    t0 = time.perf_counter()
+    try:
+        r = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
+                            *m.tests], cwd=copy, env=env, capture_output=True, text=True,
+                           timeout=timeout)
+        rc = r.returncode
+        tail = (r.stdout.strip().splitlines() or [""])[-1]
+    except subprocess.TimeoutExpired:
+        rc, tail = None, f"timeout after {timeout:.0f} s"
+    finally:
+        path.write_text(original)
+    wall = time.perf_counter() - t0
+    where = str(path.relative_to(copy))
+    if rc == 1:
+        failed = [ln.split(" ")[1] for ln in (r.stdout.splitlines()) if ln.startswith("FAILED ")]
+        return "killed", f"{where}: {failed[0] if failed else tail}", wall
+    if rc == 0:
+        return "survived", f"{where}: {tail}", wall
+    return "error", f"{where}: exit {rc}: {tail}", wall
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--only", help="comma-separated mutant names")
+    ap.add_argument("--list", action="store_true", help="list the mutants and exit")
+    ap.add_argument("--timeout", type=float, default=1200.0, help="seconds per mutant (default 1200)")
+    args = ap.parse_args(argv)
+    mutants = MUTANTS
+    if args.only:
+        names = args.only.split(",")
+        unknown = sorted(set(names) - {m.name for m in MUTANTS})
+        if unknown:
+            ap.error(f"unknown mutants {unknown}")
+        mutants = [m for m in MUTANTS if m.name in names]
+    if args.list:
+        for m in mutants:
+            print(f"{m.name:28s} {m.description}  [{' '.join(m.tests)}]")
+        return 0
+    results = []
+    with tempfile.TemporaryDirectory(prefix="mfm-mutants-") as tmp:
+        copy = Path(tmp) / "repo"
+        shutil.copytree(ROOT, copy, ignore=IGNORE)
+        for m in mutants:
+            status, detail, wall = run_mutant(copy, m, args.timeout)
+            note = f"  (equivalent: {m.equivalent})" if status == "survived" and m.equivalent else ""
+            print(f"{status:8s} {m.name:28s} {wall:6.0f} s  {detail}{note}", flush=True)
+            results.append((m, status))
+    killed = sum(s == "killed" for _, s in results)
+    scored = [r for r in results if r[1] != "error"]
+    print(f"\nkilled {killed} of {len(scored)} mutants ({100 * killed / max(len(scored), 1):.0f} %); "
+          f"{len(results) - len(scored)} errors")
+    for m, s in results:
+        if s != "killed":
+            print(f"  {s}: {m.name}: {m.description}" + (f" (equivalent: {m.equivalent})" if m.equivalent else ""))
+    return 0 if killed == len(results) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
