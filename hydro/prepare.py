@@ -4,8 +4,8 @@
 A(ω), B(ω), A∞ (reciprocity), applies the body-coupling mask, corrects A∞ to be consistent with
 A(ω) and B(ω), and computes on demand (cached) the impulse response K(t), its memory length, the
 convolution weights of a time step and the passive state-space fit. :func:`modal_form` realises a
-fit in modal form; :func:`open_any_database` opens any database file by its type. Nothing here
-imports :mod:`mfm`: the mechanics hands in where each body's reference point sits (``com0``,
+fit in modal form; :func:`~hydro.database.open_any_database` (importable from here too) opens any
+database file by its type. Nothing here imports :mod:`mfm`: the mechanics hands in where each body's reference point sits (``com0``,
 ``body_index``) and which dofs its joints move (``moving``).
 """
 from __future__ import annotations
@@ -16,6 +16,9 @@ from typing import Sequence
 
 import numpy as np
 import xarray as xr
+
+# one function opens any database file by its type (read whole, from memory); kept importable here
+from .database import open_any_database  # noqa: F401
 
 
 class HydroSpec:
@@ -266,29 +269,3 @@ def modal_form(ss):
     if not poles:
         return np.zeros(0, complex), np.zeros((0, 0), complex), (), ()
     return np.concatenate(poles), np.concatenate(cols, axis=1), tuple(ins), outs
-
-
-def open_any_database(path: Path, *, names=None, rho=None, g=None) -> xr.Dataset:
-    """Open a hydro database: our NetCDF, a capytaine NetCDF (converted), or WAMIT output."""
-    from . import bem
-    from .database import from_capytaine, open_database
-    from .wamit import read_wamit
-
-    path = Path(path)
-    if path.suffix == ".nc":
-        if not path.exists():
-            raise FileNotFoundError(f"hydro.database: {str(path)!r} not found; generate it with "
-                                    "`mfm hydro CONFIG` or fix the path (relative to the config)")
-        with xr.open_dataset(path) as raw:
-            ours = "added_mass_inf" in raw.data_vars
-        return open_database(path) if ours else from_capytaine(bem.load(path))
-    stem = path.with_suffix("") if path.suffix in (".out", ".1", ".3", ".hst") else path
-    if not stem.with_suffix(".out").exists():
-        raise FileNotFoundError(f"hydro.database: {str(path)!r}: no WAMIT output {stem}.out and not "
-                                "a .nc file; accepted: a NetCDF database or a WAMIT .out/.1/.3/.hst set")
-    kw = {}
-    if rho is not None:
-        kw["rho"] = float(rho)
-    if g is not None:
-        kw["g"] = float(g)
-    return read_wamit(stem, body_names=names, **kw)

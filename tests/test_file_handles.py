@@ -74,11 +74,6 @@ def test_two_models_load_one_database():
     check(r)
 
 
-@pytest.mark.xfail(strict=True, reason="BUG (mfm/water.py open_any_database): it probes a .nc with "
-                   "xr.open_dataset(path) before reading it, a second HDF5 handle on a file the user "
-                   "holds open; the second mfm.load's probe is then the crashing third open. Fix: "
-                   "open_any_database = hydro.database.open_any_database (reads the file once, "
-                   "from memory)")
 def test_two_models_load_one_database_held_open():
     r = run_python(f"""
         import xarray as xr, mfm
