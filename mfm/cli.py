@@ -98,17 +98,18 @@ def _pairs(items, what):
 
 
 def no_restoring(model, tol=1e-9):
-    """Coordinates with no static restoring: the column of the static stiffness K (at q = 0,
-    gravity, buoyancy, water-plane, moorings, joint springs) is zero to `tol` of its largest
-    entry. Such a coordinate drifts freely (RM3's surge: wave drift forces act, nothing pulls
-    back). Returns (names, K)."""
+    """Coordinates with no static restoring: displaced alone, nothing pushes them back, i.e. the
+    diagonal entry K_kk of the static stiffness at q = 0 (gravity, buoyancy, water plane,
+    moorings, joint springs) is ≤ `tol` × the largest |K|. RM3's surge has K = 0 in its whole
+    column; it drifts freely (wave drift forces act, nothing pulls back). A negative K_kk is
+    listed too (unstable alone). Returns (names, K)."""
     import numpy as np
 
     import mfm
 
     K = mfm.frequency.linearise(model, q0=np.zeros(model.n_coordinates))[2]
     scale = max(float(np.abs(K).max()), 1e-300)
-    free = [c for k, c in enumerate(model.coordinates) if float(np.abs(K[:, k]).max()) <= tol * scale]
+    free = [c for k, c in enumerate(model.coordinates) if float(K[k, k]) <= tol * scale]
     return free, K
 
 

@@ -52,9 +52,16 @@ def plot_layout(model: "Model", q=None, *, ax=None, title=None):
         a.set_title(label)
         a.set_aspect("equal", adjustable="datalim")
         a.grid(alpha=0.3)
-    fig.suptitle(title or f"{model.name}: {model.n_bodies} bodies, {model.n_coordinates} coordinates "
-                 "(■ hinge, ◆ slider, arrow = joint axis)")
-    fig.tight_layout()
+    text = title or (f"{model.name}: {model.n_bodies} bodies, {model.n_coordinates} coordinates "
+                     "(■ hinge, ◆ slider, arrow = joint axis)")
+    if ax is None:
+        fig.suptitle(text)
+        fig.tight_layout()
+    else:
+        # axes of a larger figure (e.g. one row per layout): the figure's title is the caller's;
+        # a suptitle here would name every row after the last model drawn
+        axes[0].set_title(f"{model.name}: plan view (x–y)")
+        axes[1].set_title(f"{model.name}: side view (x–z)")
     return fig
 
 
