@@ -100,8 +100,26 @@ def _file_digest(path):
     return h.hexdigest()
 
 
+def code_version() -> str:
+    """The version of the code that turns specs into BEM results: the installed package version
+    and a digest of the sources that mesh the hulls and post-process capytaine's results
+    (hydro/bem.py, hydro/geometry.py), so that an edit to either invalidates cached results
+    even while the package version stays the same."""
+    try:
+        from importlib.metadata import version
+
+        pkg = version("mfm")
+    except Exception:  # noqa: BLE001 - not installed (run from a checkout)
+        pkg = "unknown"
+    h = hashlib.sha256()
+    for name in ("bem.py", "geometry.py"):
+        h.update((Path(__file__).parent / name).read_bytes())
+    return f"{pkg}+{h.hexdigest()[:12]}"
+
+
 def settings_hash(specs, settings):
-    """SHA-256 (hex) of the normalised body specs, the settings and the capytaine version."""
+    """SHA-256 (hex) of the normalised body specs (mesh files by content), the settings, the
+    capytaine version and :func:`code_version`."""
     import capytaine as cpt
 
     bodies = []
@@ -110,8 +128,8 @@ def settings_hash(specs, settings):
         if s["shape"] == "mesh":
             s["file"] = _file_digest(s["file"])  # content, not path
         bodies.append(s)
-    key = {"schema": SCHEMA_VERSION, "capytaine": cpt.__version__, "bodies": bodies,
-           "settings": settings}
+    key = {"schema": SCHEMA_VERSION, "capytaine": cpt.__version__, "code": code_version(),
+           "bodies": bodies, "settings": settings}
     text = json.dumps(key, sort_keys=True, allow_nan=True, default=float)
     return hashlib.sha256(text.encode()).hexdigest()
 
@@ -431,7 +449,7 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
         "infinite_frequency": str(bool(infinite_frequency)),
         "nb_hull_panels": str(n_hull), "nb_lid_panels": str(n_lid),
         "capytaine_version": cpt.__version__, "numpy_version": np.__version__,
-        "xarray_version": xr.__version__, "schema": SCHEMA_VERSION,
+        "xarray_version": xr.__version__, "schema": SCHEMA_VERSION, "mfm_code_version": code_version(),
         "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         "hash": digest,
         "hydrostatic_stiffness_terms": HYDROSTATIC_TERMS,
@@ -506,7 +524,9 @@ def save(ds, path):
 def load(path):
     """Read a NetCDF written by ``save`` (or capytaine's ``export_dataset``), complex values
     merged back; read whole into memory (``hydro.database.read_netcdf``: safe while the process
-    holds the file open)."""
-    from capytaine.io.xarray import merge_complex_values
+    holds the file open). Needs no capytaine: reading a database is for the base install
+    (capytaine is the ``bem`` extra, needed only to make one)."""
+    from .checks import check_netcdf_file
+    from .database import merge_complex
 
-    return merge_complex_values(read_netcdf(path))
+    return merge_complex(read_netcdf(check_netcdf_file(path)))

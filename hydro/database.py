@@ -156,6 +156,7 @@ def validate(db: xr.Dataset, bodies=None, *, sym_rtol: float = 0.05,
                          "'complex' dim, open it with hydro.database.open_database.")
     if bodies is not None:
         _check_bodies(db, [bodies] if isinstance(bodies, str) else list(bodies))
+    _check_finite(db, om)
 
     labels = expected
     for name in ("added_mass", "radiation_damping", "added_mass_inf"):
@@ -163,6 +164,37 @@ def validate(db: xr.Dataset, bodies=None, *, sym_rtol: float = 0.05,
     _warn_negative_damping(np.asarray(db["radiation_damping"].values, dtype=float), labels, om,
                            damping_noise)
     return db
+
+
+def _check_finite(db, om):
+    """NaN or inf in a coefficient would surface later as a LinAlgError or NaN motions deep in
+    jax; name the variable and the first bad entry here instead."""
+    for name in (*REQUIRED, *OPTIONAL):
+        if name not in db:
+            continue
+        da = db[name]
+        vals = np.asarray(da.values)
+        bad = ~np.isfinite(vals)
+        if not bad.any():
+            continue
+        first = np.unravel_index(int(np.argmax(bad)), vals.shape)
+        where = []
+        for dim, i in zip(da.dims, first):
+            label = db[dim].values[i] if dim in db.coords else i
+            if dim == "omega":
+                where.append(f"omega = {float(label):.6g} rad/s")
+            elif dim == "wave_direction":
+                where.append(f"wave_direction = {float(label):.6g} rad")
+            else:
+                where.append(f"{dim} = {str(label)!r}")
+        fix = ("regenerate the database (a BEM problem that failed leaves NaN) or fix the file "
+               "it was read from")
+        if da.dims and da.dims[0] == "omega":
+            fix += f", or drop that frequency: db.sel(omega=db.omega != {float(om[first[0]])!r})"
+        raise ValueError(
+            f"hydro database variable {name!r} has {int(bad.sum())} non-finite value(s) (NaN or "
+            f"inf); the first is {vals[first]!r} at {', '.join(where) or 'its only entry'}. Every "
+            f"coefficient must be finite: {fix}.")
 
 
 def _warn_asymmetry(name, M, labels, om, rtol):

@@ -5,8 +5,8 @@ A(ω), B(ω), A∞ (reciprocity), applies the body-coupling mask, corrects A∞ 
 A(ω) and B(ω), and computes on demand (cached) the impulse response K(t), its memory length, the
 convolution weights of a time step and the passive state-space fit. :func:`modal_form` realises a
 fit in modal form; :func:`~hydro.database.open_any_database` (importable from here too) opens any
-database file by its type. Nothing here imports :mod:`mfm`: the mechanics hands in where each body's reference point sits (``com0``,
-``body_index``) and which dofs its joints move (``moving``).
+database file by its type. Nothing here imports :mod:`mfm`: the mechanics hands in where each
+body's reference point sits (``com0``, ``body_index``) and which dofs its joints move (``moving``).
 """
 from __future__ import annotations
 

@@ -68,18 +68,46 @@ def _paths(stem_or_paths):
     return {k: v for k, v in paths.items() if v.is_file()}
 
 
-def _rows(path, ncol_min):
-    rows = []
-    with open(path) as f:
-        for line in f:
+def _rows(path, ncol_min, *, lines=False):
+    """The numeric rows of a WAMIT numeric output file (.1, .3, .hst).
+
+    Text lines before the first numeric row are headers. After it, every non-blank line must be
+    a row of at least `ncol_min` finite numbers: a NaN/inf token, a word, or a line cut short
+    (a truncated file) is an error naming the file, the line and what was expected, instead of
+    a row silently dropped or a NaN that surfaces later deep inside the solver.
+    With ``lines=True`` also returns the 1-based line number of each row.
+    """
+    rows, numbers = [], []
+    with open(path, errors="replace") as f:
+        for n, line in enumerate(f, 1):
             parts = line.split()
+            if not parts:
+                continue
             try:
                 vals = [float(p.replace("D", "E").replace("d", "e")) for p in parts]
             except ValueError:
-                continue                                   # header lines
-            if len(vals) >= ncol_min:
-                rows.append(vals)
-    return rows
+                if not rows:
+                    continue                               # header lines
+                raise ValueError(f"{path}, line {n}: {line.strip()!r} is not a row of numbers "
+                                 f"(expected at least {ncol_min} numbers per line, as on line "
+                                 f"{numbers[-1]}); the file is damaged or truncated: re-export "
+                                 "it from WAMIT") from None
+            if not all(np.isfinite(vals)):
+                raise ValueError(f"{path}, line {n}: {line.strip()!r} holds a non-finite value "
+                                 "(NaN or inf); WAMIT writes finite numbers only: the file was "
+                                 "edited or damaged; re-export it from WAMIT")
+            if len(vals) < ncol_min:
+                if not rows:
+                    continue                               # a numeric header (e.g. a count)
+                raise ValueError(f"{path}, line {n}: {line.strip()!r} has {len(vals)} numbers; "
+                                 f"expected at least {ncol_min} (the file looks truncated or "
+                                 "damaged: re-export it from WAMIT)")
+            rows.append(vals)
+            numbers.append(n)
+    if not rows:
+        raise ValueError(f"{path}: no rows of at least {ncol_min} numbers; is this a WAMIT numeric "
+                         "output file (.1, .3, .hst)?")
+    return (rows, numbers) if lines else rows
 
 
 def parse_out(path) -> dict:
@@ -162,8 +190,18 @@ def read_wamit(stem_or_paths, rho: float = 1000.0, g: float = 9.81, body_names=N
     k_ab = _k_matrix(n)
 
     # ---- .1: added mass and damping
-    rows = np.array([r[:5] + [np.nan] * (5 - len(r[:5])) for r in _rows(paths["1"], 4)])
+    raw1, line1 = _rows(paths["1"], 4, lines=True)
+    rows = np.array([r[:5] + [np.nan] * (5 - len(r[:5])) for r in raw1])
     col0, ii, jj = rows[:, 0], rows[:, 1].astype(int) - 1, rows[:, 2].astype(int) - 1
+    # rows at a finite frequency carry A and B (5 numbers); only the ω = 0 / ∞ rows carry A alone
+    regular = col0 > 0
+    short = np.flatnonzero(regular & np.isnan(rows[:, 4]))
+    if short.size:
+        k = int(short[0])
+        raise ValueError(f"{paths['1']}, line {line1[k]}: {raw1[k]} has {len(raw1[k])} numbers; a "
+                         f"row at a finite {first_column} needs 5 ({first_column}, i, j, added "
+                         "mass, damping): the file looks truncated or damaged; re-export it from "
+                         "WAMIT")
     if ii.max() >= n or jj.max() >= n:
         raise ValueError(f"{paths['1']}: mode index {max(ii.max(), jj.max()) + 1} > 6 × {nb} bodies; "
                          "generalised modes are not supported.")

@@ -254,6 +254,108 @@ def _sha256(path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
+def geometry_record(specs) -> list[dict]:
+    """The normalised body specs with each mesh file replaced by its SHA-256 (content, not
+    path): what a database's hulls are, whatever the file is called or where it lies."""
+    out = []
+    for s in specs:
+        s = dict(s)
+        if s.get("shape") == "mesh":
+            s["file_sha256"] = _sha256(s.pop("file"))
+        out.append(s)
+    return out
+
+
+def geometry_hash(specs) -> str:
+    """SHA-256 of :func:`geometry_record` (recorded as ``mfm_geometry_sha256``)."""
+    text = json.dumps(geometry_record(specs), sort_keys=True, default=float)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _code_version() -> str:
+    from hydro.bem import code_version
+
+    return code_version()
+
+
+def _spec_diff(old: list, new: list) -> list[str]:
+    """Human differences between two lists of body specs (recorded vs current)."""
+    o = {s.get("name"): s for s in old}
+    n = {s.get("name"): s for s in new}
+    diffs = []
+    for name in n:
+        if name not in o:
+            diffs.append(f"body {name!r} is in the config but not in the database")
+            continue
+        for k in sorted(set(o[name]) | set(n[name])):
+            a, b = o[name].get(k), n[name].get(k)
+            if json.dumps(a, sort_keys=True, default=float) != json.dumps(b, sort_keys=True, default=float):
+                what = "contents" if k == "file_sha256" else repr(a)
+                diffs.append(f"body {name!r} {k}: {what} in the database, "
+                             f"{'other contents' if k == 'file_sha256' else repr(b)} in the config")
+    diffs += [f"body {name!r} is in the database but not in the config" for name in o if name not in n]
+    return diffs
+
+
+def database_is_stale(config_path, database=None) -> tuple[bool, str]:
+    """Whether the hydro database of a config was made from other hulls or BEM settings than the
+    config has now (an edited radius, draft, position, STL file or ``[hydro.bem]`` key).
+
+    Compares the config's ``[bodies.geometry]`` specs (normalised; STL files by content) and its
+    ``[hydro.bem]`` table with what ``mfm hydro`` recorded in the database's attrs
+    (``mfm_geometry_sha256`` / ``mfm_geometry``, else hydro.bem's ``bodies`` record for files
+    made before those existed; ``mfm_bem_settings``). Reads only the file's attributes (fast; no
+    capytaine, no jax).
+
+    database: the NetCDF to check (default: the config's ``[hydro] database``).
+
+    Returns ``(stale, reason)``: ``(True, "…")`` names each difference and the fix (``mfm hydro
+    CONFIG --force``); ``(False, "…")`` says why it is up to date or why it cannot be checked (a
+    WAMIT database, or a config without ``[bodies.geometry]`` tables: nothing recorded to compare).
+    """
+    import xarray as xr
+
+    config_path = Path(config_path)
+    options, bodies = load_config(config_path)
+    hydro = options.get("hydro") or {}
+    if database is None:
+        if not hydro.get("database"):
+            return False, f"{config_path} has no [hydro] database: nothing to check"
+        database = config_path.parent / hydro["database"]
+    database = Path(database)
+    if database.suffix != ".nc":
+        return False, f"{database} is not a NetCDF made by `mfm hydro` (WAMIT?): not checked"
+    raw = tomllib.loads(config_path.read_text())
+    if not any("geometry" in b for b in raw.get("bodies", [])):
+        return False, (f"{config_path} has no [bodies.geometry] table: the database was not made "
+                       "from this config's hulls; not checked")
+    from hydro.checks import check_netcdf_file
+
+    with xr.open_dataset(check_netcdf_file(database)) as f:
+        attrs = dict(f.attrs)
+    specs = body_specs(config_path, raw, bodies)
+    diffs = []
+    if "mfm_geometry" in attrs:
+        diffs += _spec_diff(json.loads(attrs["mfm_geometry"]), geometry_record(specs))
+    elif "bodies" in attrs:                 # made before mfm_geometry: specs without file digests
+        old = json.loads(attrs["bodies"])
+        diffs += _spec_diff(old, [dict(s) for s in specs])
+    else:
+        return False, f"{database} records no hull geometry (not made by hydro.bem): not checked"
+    if "mfm_bem_settings" in attrs:
+        settings = bem_settings(hydro.get("bem"), hydro=hydro, gravity=options["gravity"])["record"]
+        recorded = json.loads(attrs["mfm_bem_settings"])
+        for k in sorted(set(recorded) | set(settings)):
+            if recorded.get(k) != settings.get(k):
+                diffs.append(f"[hydro.bem] {k}: {recorded.get(k)!r} in the database, "
+                             f"{settings.get(k)!r} in the config")
+    if diffs:
+        return True, (f"hydro database {os.path.normpath(database)!r} is stale: it was made from other hulls or "
+                      f"settings than {str(config_path)!r} has now: " + "; ".join(diffs)
+                      + f". Regenerate it: mfm hydro {config_path} --force")
+    return False, f"{os.path.normpath(database)} matches the hulls and [hydro.bem] settings of {config_path}"
+
+
 def _check_database(path: Path, config_path: Path, options: dict, bodies) -> None:
     """Load ``path`` the way ``mfm.load(config)`` does (open_any_database → from_capytaine →
     schema checks → the config's bodies on the tree)."""
@@ -326,7 +428,12 @@ def generate(config_path, *, out=None, force=False, progress=True, n_threads=Non
     specs = body_specs(config_path, raw, bodies)
     kw = settings["kwargs"]
     config_sha = hashlib.sha256(text.encode()).hexdigest()
-    key = hashlib.sha256(json.dumps({"config": config_sha, "overrides": overrides or {}},
+    # the up-to-date stamp: the config's text, the hulls it points to (STL files by content), the
+    # settings and the code; any change of one makes the file stale
+    geometry_sha = geometry_hash(specs)
+    code = _code_version()
+    key = hashlib.sha256(json.dumps({"config": config_sha, "geometry": geometry_sha,
+                                     "overrides": overrides or {}, "code": code},
                                     sort_keys=True, default=str).encode()).hexdigest()
 
     if out.exists() and not force:
@@ -338,12 +445,26 @@ def generate(config_path, *, out=None, force=False, progress=True, n_threads=Non
         except Exception:  # noqa: BLE001 - unreadable: treat as foreign
             pass
         if stored == key:
-            print(f"mfm hydro: {out} is up to date (same config contents and settings); "
-                  f"use --force to solve again")
+            print(f"mfm hydro: {out} is up to date (same config, hull files, settings and code "
+                  f"version); use --force to solve again")
             return out
-        raise FileExistsError(f"mfm hydro: {str(out)!r} exists and was not made from this config "
-                              f"as it is now; use --force to overwrite it")
+        stale, why = (False, "")
+        try:
+            stale, why = database_is_stale(config_path, out)
+        except Exception:  # noqa: BLE001 - the reason is optional
+            pass
+        raise FileExistsError(f"mfm hydro: {str(out)!r} exists and was not made from this config, "
+                              f"its hull files and this code version as they are now"
+                              + (f" ({why})" if stale else "") + "; use --force to overwrite it")
 
+    try:
+        import capytaine  # noqa: F401 - the BEM solver is an optional extra
+    except ImportError:
+        raise ModuleNotFoundError(
+            "mfm hydro: the BEM solver capytaine is not installed (it is the optional 'bem' "
+            "extra, needed to make databases, never to read them); install it with: "
+            "pip install -e \".[bem]\" (from the repository root), or pip install "
+            "\"capytaine>=3.0\" trimesh threadpoolctl") from None
     if n_threads is not None:
         try:
             import threadpoolctl  # noqa: F401 - capytaine needs it to honour n_threads
@@ -365,6 +486,9 @@ def generate(config_path, *, out=None, force=False, progress=True, n_threads=Non
         "mfm_bem_settings": json.dumps(settings["record"], sort_keys=True, default=str),
         "mfm_overrides": json.dumps(overrides or {}, sort_keys=True, default=str),
         "mfm_generate_key": key,
+        "mfm_geometry": json.dumps(geometry_record(specs), sort_keys=True, default=float),
+        "mfm_geometry_sha256": geometry_sha,
+        "mfm_code_version": code,
         "mfm_headings_deg": json.dumps(settings["headings_deg"]),
         "mfm_wall_time_s": round(wall, 1),
         "mfm_n_threads": str(n_threads),

@@ -1,12 +1,87 @@
-"""Command line: ``mfm info | simulate | rao | hydro | plot``."""
+"""Command line: ``mfm info | simulate | rao | hydro | plot``.
+
+Nothing heavy (numpy, jax, xarray, matplotlib) is imported before the arguments are parsed, so
+``mfm --help`` and a mistyped argument answer at once; each command imports what it needs.
+"""
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from pathlib import Path
 
-import numpy as np
+LENGTH_SUFFIXES = ("surge", "sway", "heave", "stroke")
+
+
+def _unit(coordinate: str) -> str:
+    """SI unit of a coordinate from its name: root surge/sway/heave and prismatic strokes are
+    lengths, everything else (roll, pitch, yaw, revolute angles) angles."""
+    return "m" if coordinate.rsplit(".", 1)[-1] in LENGTH_SUFFIXES else "rad"
+
+
+def _number(kind, *, minimum=None, strict=True, integer=False):
+    """argparse type: a finite number (> or ≥ minimum); the error names the value and the range."""
+    def parse(text):
+        try:
+            v = int(text) if integer else float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not {'a whole number' if integer else 'a number'}") from None
+        if not math.isfinite(v):
+            raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+        if minimum is not None and (v <= minimum if strict else v < minimum):
+            raise argparse.ArgumentTypeError(f"{text!r} is out of range; give {kind}")
+        return v
+    parse.__name__ = kind               # argparse names the type in some messages
+    return parse
+
+
+POSITIVE = _number("a positive number", minimum=0.0)
+NONNEGATIVE = _number("a number ≥ 0", minimum=0.0, strict=False)
+FINITE = _number("a finite number")
+
+
+def _count(minimum):
+    return _number(f"a whole number ≥ {minimum}", minimum=minimum, strict=False, integer=True)
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    def v(pkg):
+        try:
+            return version(pkg)
+        except PackageNotFoundError:
+            return "not installed"
+
+    return (f"mfm {v('mfm')} (python {sys.version.split()[0]}, jax {v('jax')}, capytaine "
+            f"{v('capytaine')}: the BEM extra, only for `mfm hydro`)")
+
+
+def _writable(path, what="--out", suffixes=(".nc",)) -> Path:
+    """Check an output path before the run: its suffix, and that its folder can be made and
+    written to. A path that cannot be written costs the whole run otherwise."""
+    path = Path(path)
+    if suffixes and path.suffix not in suffixes:
+        raise ValueError(f"{what} {str(path)!r}: give a file ending in {' or '.join(suffixes)}")
+    if path.is_dir():
+        raise ValueError(f"{what} {str(path)!r} is a directory; give a file name, e.g. "
+                         f"{path / ('run' + suffixes[0])}")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise ValueError(f"{what} {str(path)!r}: cannot create its folder ({e.strerror}); choose "
+                         "another path") from None
+    existed = path.exists()
+    try:
+        with open(path, "ab"):
+            pass
+    except OSError as e:
+        raise ValueError(f"{what} {str(path)!r} is not writable ({e.strerror}); choose another "
+                         "path or fix the permissions") from None
+    if not existed:
+        path.unlink()
+    return path
 
 
 def _pairs(items, what):
@@ -22,10 +97,31 @@ def _pairs(items, what):
     return out
 
 
-def cmd_info(args):
+def no_restoring(model, tol=1e-9):
+    """Coordinates with no static restoring: displaced alone, nothing pushes them back, i.e. the
+    diagonal entry K_kk of the static stiffness at q = 0 (gravity, buoyancy, water plane,
+    moorings, joint springs) is ≤ `tol` × the largest |K|. RM3's surge has K = 0 in its whole
+    column; it drifts freely (wave drift forces act, nothing pulls back). A negative K_kk is
+    listed too (unstable alone). Returns (names, K)."""
+    import numpy as np
+
     import mfm
 
-    model = mfm.load(args.config, hydro=False)
+    K = mfm.frequency.linearise(model, q0=np.zeros(model.n_coordinates))[2]
+    scale = max(float(np.abs(K).max()), 1e-300)
+    free = [c for k, c in enumerate(model.coordinates) if float(K[k, k]) <= tol * scale]
+    return free, K
+
+
+def cmd_info(args):
+    import numpy as np
+
+    import mfm
+    from mfm.config import load_config
+
+    options, _ = load_config(args.config)
+    wet = "hydro" in options and not args.no_hydro
+    model = mfm.load(args.config, hydro=wet)
     print(f"{model.name}: {model.n_bodies} bodies, {model.n_coordinates} coordinates, "
           f"gravity {float(model.gravity)} m/s²")
     print("\ntree:")
@@ -39,7 +135,7 @@ def cmd_info(args):
         if j.axis is not None:
             extra += f" axis {np.round(j.axis, 4).tolist()}"
         if j.point is not None:
-            extra += f" point {np.round(j.point, 4).tolist()}"
+            extra += f" point {np.round(j.point, 4).tolist()} m"
         print(f"  {'  ' * depth}{b.name}  [{j.kind}{extra}]  mass {b.mass:g} kg, "
               f"CoM {np.round(b.com, 4).tolist()} m")
         for c in children.get(b.name, []):
@@ -49,16 +145,31 @@ def cmd_info(args):
         show(root, 0)
     print("\ncoordinates:")
     for k, c in enumerate(model.coordinates):
+        u = _unit(c)
         loads = []
         if float(model.stiffness[k]):
-            loads.append(f"spring {float(model.stiffness[k]):g}")
+            loads.append(f"spring {float(model.stiffness[k]):g} N{' m' if u == 'rad' else ''}/{u}")
         if float(model.damping[k]):
-            loads.append(f"damper {float(model.damping[k]):g}")
-        print(f"  q[{k}] {c}" + (f"  ({', '.join(loads)})" if loads else ""))
+            loads.append(f"damper {float(model.damping[k]):g} N{' m' if u == 'rad' else ''} s/{u}")
+        print(f"  q[{k}] {c} [{u}]" + (f"  ({', '.join(loads)})" if loads else ""))
     print(f"\ntotal mass {float(model.mass.sum()):g} kg")
+    if args.no_restoring:
+        return
+    print("\nrestoring (static stiffness at q = 0" + (", with the water" if wet else
+          ", mechanics only: no [hydro] table" if "hydro" not in options else
+          ", mechanics only (--no-hydro)") + "):", flush=True)
+    free, _ = no_restoring(model)
+    if free:
+        print(f"  no restoring in {', '.join(free)}: nothing pulls these coordinates back, so they "
+              "drift after the start-up transient (wave drift, any mean load); add a mooring "
+              "([[moorings]]) or a joint spring if they must stay bounded")
+    else:
+        print("  every coordinate has restoring")
 
 
 def _sea(args):
+    import numpy as np
+
     import hydro
 
     if args.wave is None:
@@ -81,36 +192,79 @@ def _sea(args):
 
 
 def cmd_simulate(args):
+    out = _writable(args.out)              # before the run, not after it
+    png = out.with_suffix(".png")
+    if not args.no_plot:
+        _writable(png, "the figure beside --out", (".png",))
+    if args.ramp > args.duration:
+        raise ValueError(f"--ramp {args.ramp:g} s is longer than --duration {args.duration:g} s: "
+                         "the waves would never reach full height; shorten the ramp")
     import mfm
 
     model = mfm.load(args.config, body_coupling=False if args.no_body_coupling else None)
     sea = _sea(args)
+    from hydro.database import write_netcdf
+
+    command = "mfm " + " ".join(sys.argv[1:]) if sys.argv[1:] else "mfm simulate"
     t0 = time.perf_counter()
-    ds = mfm.simulate(model, sea, duration=args.duration, dt=args.dt, integrator=args.integrator,
-                      q0=_pairs(args.initial, "--initial"),
-                      qd0=_pairs(args.initial_velocity, "--initial-velocity"),
-                      save_every=args.save_every, ramp=args.ramp, radiation=args.radiation)
+    try:
+        ds = mfm.simulate(model, sea, duration=args.duration, dt=args.dt, integrator=args.integrator,
+                          q0=_pairs(args.initial, "--initial"),
+                          qd0=_pairs(args.initial_velocity, "--initial-velocity"),
+                          save_every=args.save_every, ramp=args.ramp, radiation=args.radiation)
+    except mfm.SimulationError as e:
+        # keep what was computed: the run up to the last finite sample, marked incomplete
+        if e.dataset is not None:
+            e.dataset.attrs["command"] = command
+            write_netcdf(e.dataset, out)
+            print(f"mfm simulate: the run stopped; the {e.dataset.time.size} samples up to "
+                  f"t = {float(e.dataset.time[-1]):g} s are in {out} (attribute complete = false)",
+                  file=sys.stderr)
+        raise
     wall = time.perf_counter() - t0
-    ds.attrs["config"] = str(args.config)
-    ds.attrs["command"] = "mfm " + " ".join(sys.argv[1:]) if sys.argv[1:] else "mfm simulate"
-    if sea is not None:
-        ds.attrs["sea"] = repr(sea)
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    ds.to_netcdf(out)
+    ds.attrs["command"] = command
+    write_netcdf(ds, out)
     n = int(round(args.duration / args.dt))
-    print(f"{model.name}: {n} steps of {args.dt} s with {args.integrator} in {wall:.2f} s "
+    print(f"{model.name}: {n} steps of {args.dt:g} s with {args.integrator} in {wall:.2f} s "
           f"(including compilation) -> {out}")
     half = ds.isel(time=slice(len(ds.time) // 2, None))
+    t_half = float(half.time[0])
+    print(f"  over the second half (t ≥ {t_half:g} s):")
     for c in model.coordinates:
         q = half.q.sel(coordinate=c)
-        print(f"  {c:>24s}: std over the second half {float(q.std()):.5g}, last {float(q[-1]):+.5g}")
+        u = _unit(c)
+        print(f"  {c:>24s}: std {float(q.std()):.5g} {u}, mean {float(q.mean()):+.5g} {u}, "
+              f"last {float(q[-1]):+.5g} {u}")
     if "pto_power" in ds:
         for p in ds.pto.values:
-            print(f"  mean power of {p} over the second half: {float(half.pto_power.sel(pto=p).mean()):.6g} W")
+            print(f"  mean power of {p}: {float(half.pto_power.sel(pto=p).mean()):.6g} W")
+    if not args.no_plot:
+        from mfm.plotting import save_result_plot
+
+        save_result_plot(ds, png)
+        print(f"  figure -> {png}")
+
+
+def _peak_text(omega, a, unit):
+    """The largest |RAO| and where, or that there is no peak inside the grid: a maximum at
+    the first or last frequency is where the grid stops, not a resonance."""
+    import numpy as np
+
+    k = int(np.argmax(a))
+    if k == 0 or k == len(a) - 1:
+        edge = "lowest" if k == 0 else "highest"
+        return (f"no peak inside the grid (largest |RAO| {a[k]:.4g} {unit} at its {edge} "
+                f"frequency {omega[k]:.4g} rad/s; widen --omega-min/--omega-max to see more)")
+    return f"peak |RAO| {a[k]:.4g} {unit} at {omega[k]:.4g} rad/s (period {2 * np.pi / omega[k]:.4g} s)"
 
 
 def cmd_rao(args):
+    if args.omega_max <= args.omega_min:
+        raise ValueError(f"--omega-max {args.omega_max:g} must be > --omega-min {args.omega_min:g} "
+                         "(rad/s)")
+    out = _writable(args.out)
+    import numpy as np
+
     import mfm
     from hydro.database import split_complex
 
@@ -123,15 +277,16 @@ def cmd_rao(args):
                                                          "long_name": "undamped, generalised eigenproblem"})
     ds.attrs["natural_frequencies_min_det"] = np.array2string(nat["min_det"].values, precision=5)
     ds.attrs["config"] = str(args.config)
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    split_complex(ds).to_netcdf(out)
-    print(f"{model.name}: RAOs at {args.n} frequencies {args.omega_min}–{args.omega_max} rad/s -> {out}")
+    from hydro.database import write_netcdf
+
+    write_netcdf(split_complex(ds), out)
+    print(f"{model.name}: RAOs at {args.n} frequencies {args.omega_min:g}–{args.omega_max:g} rad/s "
+          f"-> {out}")
     print(f"  natural frequencies (eigen): {np.round(nat['eigen'].values, 4).tolist()} rad/s")
     print(f"  natural frequencies (min |det|): {np.round(nat['min_det'].values, 4).tolist()} rad/s")
     for c in model.coordinates:
         a = np.abs(ds.rao.sel(coordinate=c).values)
-        print(f"  {c:>24s}: peak |RAO| {a.max():.4g} at {omega[a.argmax()]:.4g} rad/s")
+        print(f"  {c:>24s}: {_peak_text(omega, a, _unit(c) + '/m')}")
 
 
 def cmd_hydro(args):
@@ -144,78 +299,112 @@ def cmd_plot(args):
     import matplotlib
 
     matplotlib.use("Agg")
+    src = Path(args.config)
+    if src.suffix == ".nc":
+        out = _writable(args.out or src.with_suffix(".png"), "--out", (".png",))
+        import xarray as xr
+
+        from mfm.plotting import save_result_plot
+
+        if not src.exists():
+            raise FileNotFoundError(f"result file {str(src)!r} not found")
+        from hydro.checks import check_netcdf_file
+
+        with xr.open_dataset(check_netcdf_file(src)) as f:
+            ds = f.load()
+        kind = save_result_plot(ds, out, dpi=args.dpi)
+        print(f"{kind} of {src} -> {out}")
+        return
+    out = _writable(args.out or Path(src.with_suffix(".png").name), "--out", (".png",))
     import mfm
     from mfm.plotting import plot_layout
 
     model = mfm.load(args.config, hydro=False)
     fig = plot_layout(model)
-    out = Path(args.out or Path(args.config).with_suffix(".png").name)
-    out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=args.dpi)
     print(f"layout of {model.name} -> {out}")
 
 
-def main(argv=None):
+def build_parser():
     ap = argparse.ArgumentParser(prog="mfm", description="Floating multi-body systems by the Moving "
-                                 "Frame Method.")
-    sub = ap.add_subparsers(dest="command", required=True)
-    p = sub.add_parser("info", help="print the tree, coordinates and masses of a config")
+                                 "Frame Method. Units are SI (m, rad, s, kg, N, W); headings in "
+                                 "degrees on the command line.")
+    ap.add_argument("--version", action="version", version=_version())
+    sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    p = sub.add_parser("info", help="print the tree, coordinates, masses and which coordinates "
+                       "have no restoring")
     p.add_argument("config")
+    p.add_argument("--no-hydro", action="store_true", help="mechanics only (skip the database)")
+    p.add_argument("--no-restoring", action="store_true",
+                   help="skip the static-stiffness check (it compiles the model: ~10-30 s)")
     p.set_defaults(func=cmd_info)
-    p = sub.add_parser("simulate", help="simulate a config and write the results as NetCDF")
+    p = sub.add_parser("simulate", help="simulate a config; write the results as NetCDF and a "
+                       "figure beside them (PNG)")
     p.add_argument("config")
-    p.add_argument("--duration", type=float, default=10.0, help="s (default 10)")
-    p.add_argument("--dt", type=float, default=0.01, help="time step, s (default 0.01)")
+    p.add_argument("--duration", type=POSITIVE, default=10.0, help="s (default 10)")
+    p.add_argument("--dt", type=POSITIVE, default=0.01, help="time step, s (default 0.01)")
     p.add_argument("--integrator", default="rk4", choices=["rk4", "beeman", "semi_implicit", "newmark"])
     p.add_argument("--initial", action="append", metavar="NAME=VALUE",
                    help="initial coordinate (m or rad), repeatable, e.g. --initial upper.angle=0.3")
     p.add_argument("--initial-velocity", action="append", metavar="NAME=VALUE",
                    help="initial rate (m/s or rad/s), repeatable")
-    p.add_argument("--save-every", type=int, default=1, help="keep every k-th step")
+    p.add_argument("--save-every", type=_count(1), default=1, help="keep every k-th step")
     p.add_argument("--wave", choices=["regular", "jonswap"], help="sea state (default: still water)")
-    p.add_argument("--height", type=float, help="regular wave height H, m")
-    p.add_argument("--period", type=float, help="regular wave period T, s")
-    p.add_argument("--hs", type=float, help="JONSWAP significant wave height, m")
-    p.add_argument("--tp", type=float, help="JONSWAP peak period, s")
-    p.add_argument("--gamma", type=float, default=3.3, help="JONSWAP peak enhancement (default 3.3)")
-    p.add_argument("--seed", type=int, default=0, help="random phases seed (default 0)")
-    p.add_argument("--components", type=int, help="number of wave components")
-    p.add_argument("--heading", type=float, default=0.0, help="wave heading, degrees (0 = towards +x)")
-    p.add_argument("--ramp", type=float, default=0.0, help="start-up ramp of the excitation, s")
+    p.add_argument("--height", type=POSITIVE, help="regular wave height H, m")
+    p.add_argument("--period", type=POSITIVE, help="regular wave period T, s")
+    p.add_argument("--hs", type=POSITIVE, help="JONSWAP significant wave height, m")
+    p.add_argument("--tp", type=POSITIVE, help="JONSWAP peak period, s")
+    p.add_argument("--gamma", type=_number("a number ≥ 1", minimum=1.0, strict=False), default=3.3,
+                   help="JONSWAP peak enhancement (default 3.3)")
+    p.add_argument("--seed", type=_count(0), default=0, help="random phases seed (default 0)")
+    p.add_argument("--components", type=_count(1), help="number of wave components")
+    p.add_argument("--heading", type=FINITE, default=0.0, help="wave heading, degrees (0 = towards +x)")
+    p.add_argument("--ramp", type=NONNEGATIVE, default=0.0, help="start-up ramp of the excitation, s")
     p.add_argument("--radiation", default="convolution", choices=["convolution", "state_space", "none"])
     p.add_argument("--no-body-coupling", action="store_true",
                    help="drop the hydrodynamic interaction between bodies")
     p.add_argument("--out", default="out/simulation.nc", help="NetCDF output (default out/simulation.nc)")
+    p.add_argument("--no-plot", action="store_true",
+                   help="do not draw the figure (PNG beside --out: q, PTO power, spectra)")
     p.set_defaults(func=cmd_simulate)
     p = sub.add_parser("rao", help="frequency-domain RAOs and natural frequencies (NetCDF)")
     p.add_argument("config")
-    p.add_argument("--omega-min", type=float, required=True, help="rad/s")
-    p.add_argument("--omega-max", type=float, required=True, help="rad/s")
-    p.add_argument("--n", type=int, default=100, help="number of frequencies (default 100)")
-    p.add_argument("--heading", type=float, default=0.0, help="degrees")
+    p.add_argument("--omega-min", type=POSITIVE, required=True, help="rad/s, > 0")
+    p.add_argument("--omega-max", type=POSITIVE, required=True, help="rad/s, > omega-min")
+    p.add_argument("--n", type=_count(2), default=100, help="number of frequencies, ≥ 2 (default 100)")
+    p.add_argument("--heading", type=FINITE, default=0.0, help="degrees")
     p.add_argument("--radiation", default="database", choices=["database", "convolution", "state_space"])
     p.add_argument("--no-body-coupling", action="store_true")
     p.add_argument("--out", default="out/rao.nc")
     p.set_defaults(func=cmd_rao)
-    p = sub.add_parser("hydro", help="generate the config's hydro database with capytaine")
+    p = sub.add_parser("hydro", help="generate the config's hydro database with capytaine "
+                       "(the 'bem' extra: pip install -e \".[bem]\")")
     p.add_argument("config")
     p.add_argument("--out", help="NetCDF path (default: the config's [hydro] database)")
-    p.add_argument("--force", action="store_true", help="solve again even if cached")
-    p.add_argument("--threads", type=int, help="threads per BEM solve (default: all cores)")
+    p.add_argument("--force", action="store_true", help="solve again even if up to date")
+    p.add_argument("--threads", type=_count(1), help="threads per BEM solve (default: all cores)")
     p.set_defaults(func=cmd_hydro)
-    p = sub.add_parser("plot", help="plan and side view of a config's layout (PNG)")
-    p.add_argument("config")
-    p.add_argument("--out", help="PNG file (default: the config's name in the current directory)")
-    p.add_argument("--dpi", type=int, default=120)
+    p = sub.add_parser("plot", help="a config's layout (plan and side view), or a result file: "
+                       "time series and spectra (simulate), RAOs (rao), mean power per case "
+                       "(batch); PNG")
+    p.add_argument("config", metavar="CONFIG_OR_RESULT", help="a .toml config or a .nc result")
+    p.add_argument("--out", help="PNG file (default: beside a result, or the config's name in the "
+                   "current directory)")
+    p.add_argument("--dpi", type=_count(10), default=120)
     p.set_defaults(func=cmd_plot)
-    args = ap.parse_args(argv)
+    return ap
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
     try:
         args.func(args)
     except Exception as e:  # config and simulation errors: one clear line, exit code 2
         from mfm import ConfigError, SimulationError
 
-        if isinstance(e, (ConfigError, SimulationError, ValueError, KeyError, FileNotFoundError)):
-            print(f"mfm {args.command}: error: {e}", file=sys.stderr)
+        if isinstance(e, (ConfigError, SimulationError, ValueError, KeyError, OSError, ImportError)):
+            msg = e.args[0] if isinstance(e, KeyError) and e.args else e
+            print(f"mfm {args.command}: error: {msg}", file=sys.stderr)
             return 2
         raise
     return 0

@@ -180,6 +180,14 @@ def _parse_hydro(raw, source):
            "body_coupling": raw.get("body_coupling", True),
            "added_mass_inf": raw.get("added_mass_inf", "consistent"),
            "rho": raw.get("rho"), "g": raw.get("g"), "bem": raw.get("bem")}
+    for key, unit, typical in (("rho", "kg/m³", "1025 for sea water, 1000 for fresh water"),
+                               ("g", "m/s²", "9.81")):
+        v = out[key]
+        if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))
+                              or not np.isfinite(v) or v <= 0):
+            raise ConfigError(f"hydro.{key}: {v!r} is not a positive number; give the "
+                              f"{'water density' if key == 'rho' else 'gravity'} in {unit} "
+                              f"(e.g. {typical}), or leave the key out to use the database's value")
     if out["bem"] is not None and not isinstance(out["bem"], dict):
         raise ConfigError("hydro.bem: expected a table of BEM settings (see mfm.bemgen)")
     if not isinstance(out["body_coupling"], bool):
@@ -257,9 +265,16 @@ def load_config(path: str | Path) -> tuple[dict, list[BodySpec]]:
     """Read and validate a TOML config file."""
     path = Path(path)
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise ConfigError(f"config file {str(path)!r} not found") from None
+    except IsADirectoryError:
+        raise ConfigError(f"config {str(path)!r} is a directory; give a TOML file, e.g. "
+                          "configs/rm3.toml") from None
+    except UnicodeDecodeError as e:
+        raise ConfigError(f"config file {str(path)!r} is not UTF-8 text (byte {e.object[e.start:e.start + 1]!r} "
+                          f"at offset {e.start}): a binary file, or the wrong file? A config is a "
+                          "TOML text file such as configs/rm3.toml") from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:

@@ -10,9 +10,9 @@ from mfm.cli import main
 
 
 def test_cli_info(capsys):
-    assert main(["info", str(CONFIGS / "m4_132.toml")]) == 0
+    assert main(["info", str(CONFIGS / "m4_132.toml"), "--no-restoring"]) == 0
     out = capsys.readouterr().out
-    assert "M4 132: 6 bodies, 5 coordinates" in out and "float6.angle  (damper 6)" in out
+    assert "M4 132: 6 bodies, 5 coordinates" in out and "float6.angle [rad]  (damper 6 N m s/rad)" in out
 
 
 def test_cli_simulate_and_plot(tmp_path, capsys):

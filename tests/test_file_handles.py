@@ -115,10 +115,6 @@ def test_database_held_open_while_mfm_hydro_rewrites_it(tmp_path):
     check(r)
 
 
-@pytest.mark.xfail(strict=True, reason="BUG (mfm/cli.py cmd_simulate, cmd_rao): ds.to_netcdf(out) "
-                   "writes in place; HDF5 truncates the file a reader holds open, then fails "
-                   "(Permission denied): the old result is destroyed and no new one is written. "
-                   "Fix: hydro.database.write_netcdf(ds, out) (temporary file + os.replace)")
 def test_result_held_open_while_the_cli_writes_it(tmp_path):
     out = tmp_path / "run.nc"
     cli = [sys.executable, "-m", "mfm.cli", "simulate", str(ROOT / "configs" / "double_pendulum.toml"),

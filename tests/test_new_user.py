@@ -1,0 +1,453 @@
+"""What a new user meets (issue 9): the base install reads every shipped database, bad inputs give
+errors that name the item, the value and the fix, stale or swapped hydro data are found, and the
+command line answers fast and says what it does.
+"""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from conftest import CONFIGS, ROOT
+
+SHIPPED = sorted(CONFIGS.glob("*.toml")) + sorted((CONFIGS / "sensitivity").glob("*.toml"))
+
+# capytaine made unimportable, as in a base install (`pip install -e .` without the bem extra)
+NO_CAPYTAINE = "import sys; sys.modules['capytaine'] = None\n"
+
+
+def _run(code, timeout=300):
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
+    return subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True,
+                          text=True, timeout=timeout)
+
+
+def _config_copy(tmp_path, name, **replace):
+    """A copy of a shipped config in tmp_path, its database path made absolute."""
+    text = (CONFIGS / name).read_text()
+    import tomllib
+
+    db = tomllib.loads(text)["hydro"]["database"]
+    text = text.replace(f'"{db}"', json.dumps(str((CONFIGS / db).resolve())), 1)
+    for old, new in replace.items():
+        assert old in text
+        text = text.replace(old, new, 1)
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+# ------------------------------------------------------------------------------ base install
+def test_every_shipped_config_loads_without_capytaine():
+    code = NO_CAPYTAINE + (
+        "import warnings; warnings.simplefilter('ignore')\n"
+        "import mfm\n"
+        f"for c in {[str(p) for p in SHIPPED]!r}:\n"
+        "    m = mfm.load(c)\n"
+        "    print(c, m.n_coordinates, m.hydro is not None)\n"
+        "import importlib; assert importlib.util.find_spec is not None\n"
+        "assert sys.modules['capytaine'] is None\n")
+    r = _run(code)
+    assert r.returncode == 0, r.stderr[-3000:]
+    assert len(r.stdout.splitlines()) == len(SHIPPED)
+    assert sum(line.endswith("True") for line in r.stdout.splitlines()) == len(SHIPPED) - 1
+
+
+def test_mfm_hydro_without_capytaine_prints_the_install_command(tmp_path):
+    r = _run(NO_CAPYTAINE + "from mfm.cli import main\n"
+             f"sys.exit(main(['hydro', 'configs/m4_111.toml', '--out', {str(tmp_path / 'x.nc')!r}]))")
+    assert r.returncode == 2, r.stderr
+    assert 'pip install -e ".[bem]"' in r.stderr and "Traceback" not in r.stderr
+
+
+# ------------------------------------------------------------------------------ clear errors
+def test_nan_in_a_database_entry_names_variable_and_frequency():
+    from hydro import bem
+    from hydro.database import from_capytaine, validate
+
+    db = from_capytaine(bem.load(ROOT / "hydro/data/sphere.nc"))
+    validate(db)
+    bad = db.copy(deep=True)
+    bad["added_mass"][3, 2, 2] = np.nan
+    with pytest.raises(ValueError, match=r"'added_mass' has 1 non-finite.*omega = 0\.4 rad/s.*"
+                                         r"influenced_dof = 'sphere__Heave'"):
+        validate(bad)
+    bad = db.copy(deep=True)
+    bad["waterplane_stiffness"][2, 2] = np.inf
+    with pytest.raises(ValueError, match="'waterplane_stiffness'.*regenerate"):
+        validate(bad)
+
+
+@pytest.fixture
+def rm3_copy(tmp_path):
+    d = tmp_path / "rm3"
+    shutil.copytree(ROOT / "hydro/data/rm3", d)
+    return d
+
+
+def _edit_line(path, k, new):
+    lines = path.read_text().splitlines(keepends=True)
+    lines[k] = new
+    path.write_text("".join(lines))
+
+
+def test_wamit_nan_token_and_truncated_line_name_file_and_line(rm3_copy):
+    from hydro.wamit import read_wamit
+
+    one = rm3_copy / "rm3.1"
+    lines = one.read_text().splitlines()
+    k = next(i for i, ln in enumerate(lines) if ln.split() and ln.split()[0].startswith("3.14"))
+    good = lines[k]
+    _edit_line(one, k, good.rsplit(None, 1)[0] + "  NaN\n")
+    with pytest.raises(ValueError, match=rf"rm3\.1, line {k + 1}: .*non-finite"):
+        read_wamit(rm3_copy / "rm3", body_names=["float", "spar"])
+    _edit_line(one, k, good.rsplit(None, 1)[0] + "\n")              # damping column lost
+    with pytest.raises(ValueError, match=rf"rm3\.1, line {k + 1}: .*needs 5 .*truncated"):
+        read_wamit(rm3_copy / "rm3", body_names=["float", "spar"])
+    _edit_line(one, k, good[:20] + "\n")                             # cut in the middle
+    with pytest.raises(ValueError, match=rf"rm3\.1, line {k + 1}: .*expected at least 4"):
+        read_wamit(rm3_copy / "rm3", body_names=["float", "spar"])
+    _edit_line(one, k, good[:30] + "E\n")                            # cut inside a number
+    with pytest.raises(ValueError, match=rf"rm3\.1, line {k + 1}: .*not a row of numbers"):
+        read_wamit(rm3_copy / "rm3", body_names=["float", "spar"])
+
+
+@pytest.mark.parametrize("value, shown", [('"water"', "'water'"), ("-1000.0", "-1000.0"),
+                                          ("nan", "nan"), ("true", "True")])
+def test_hydro_rho_must_be_a_positive_number(tmp_path, value, shown):
+    from mfm import ConfigError
+    from mfm.config import load_config
+
+    p = _config_copy(tmp_path, "rm3.toml", **{"body_coupling = true":
+                                             f"body_coupling = true\nrho = {value}"})
+    with pytest.raises(ConfigError, match=rf"hydro\.rho: {shown} is not a positive number.*kg/m³"):
+        load_config(p)
+
+
+def test_binary_config_names_the_file(tmp_path):
+    from mfm import ConfigError
+    from mfm.config import load_config
+
+    p = tmp_path / "model.toml"
+    p.write_bytes(b"\x89PNG\r\n\x1a\n\x00\xff\xfe binary")
+    with pytest.raises(ConfigError, match=r"model\.toml' is not UTF-8 text.*offset 0"):
+        load_config(p)
+    with pytest.raises(ConfigError, match="is a directory"):
+        load_config(tmp_path)
+
+
+def test_empty_or_foreign_netcdf_names_the_file(tmp_path):
+    from hydro import bem
+    from hydro.checks import check_netcdf_file
+
+    empty = tmp_path / "db.nc"
+    empty.write_bytes(b"")
+    with pytest.raises(ValueError, match=r"db\.nc' is empty \(0 bytes\).*mfm hydro"):
+        bem.load(empty)
+    text = tmp_path / "text.nc"
+    text.write_text("not a netcdf")
+    with pytest.raises(ValueError, match=r"text\.nc' \(12 bytes\) is not a NetCDF file"):
+        check_netcdf_file(text)
+    with pytest.raises(FileNotFoundError, match="not found"):
+        check_netcdf_file(tmp_path / "missing.nc")
+    assert check_netcdf_file(ROOT / "hydro/data/sphere.nc").name == "sphere.nc"
+
+
+# ------------------------------------------------------------------------------ stale databases
+def test_edited_hull_radius_makes_the_database_stale(tmp_path):
+    from mfm.bemgen import database_is_stale
+
+    for c in SHIPPED:
+        stale, why = database_is_stale(c)
+        assert not stale, why
+    p = _config_copy(tmp_path, "m4_111.toml", **{"radius = 0.175": "radius = 0.18"})
+    stale, why = database_is_stale(p)
+    assert stale and "body 'float3' radius: 0.175 in the database, 0.18 in the config" in why
+    assert f"mfm hydro {p} --force" in why
+    p = _config_copy(tmp_path, "m4_111.toml", **{"dx = 0.03": "dx = 0.04"})
+    stale, why = database_is_stale(p)
+    assert stale and "[hydro.bem] dx: 0.03 in the database, 0.04 in the config" in why
+
+
+def test_bem_cache_key_covers_the_code_version(monkeypatch):
+    pytest.importorskip("capytaine")
+    from hydro import bem
+
+    spec = [{"name": "s", "shape": "sphere", "radius": 1.0, "origin": [0, 0, 0]}]
+    h0 = bem.settings_hash(spec, {"dx": 0.1})
+    assert bem.code_version().startswith(("0.", "unknown"))
+    monkeypatch.setattr(bem, "code_version", lambda: "9.9.9+edited")
+    assert bem.settings_hash(spec, {"dx": 0.1}) != h0
+
+
+def _box_stl(path, half):
+    """ASCII STL of a closed box [−h, h]² × [−2h, h/2] (12 triangles, outward normals)."""
+    import itertools
+
+    h = half
+    v = np.array(list(itertools.product([-h, h], [-h, h], [-2 * h, h / 2])))
+    faces = []
+    for ax in range(3):
+        for side in (0, 1):
+            q = [i for i in range(8) if (i >> (2 - ax)) & 1 == side]
+            a, b, c, d = q
+            for tri in ((a, b, d), (a, d, c)):
+                p = v[list(tri)]
+                n = np.cross(p[1] - p[0], p[2] - p[0])
+                centre = p.mean(0) - v.mean(0)
+                if n @ centre < 0:
+                    tri = tri[::-1]
+                faces.append(v[list(tri)])
+    lines = ["solid box"]
+    for f in faces:
+        n = np.cross(f[1] - f[0], f[2] - f[0])
+        n = n / np.linalg.norm(n)
+        lines.append(f"facet normal {n[0]} {n[1]} {n[2]}\n outer loop")
+        lines += [f"  vertex {x} {y} {z}" for x, y, z in f]
+        lines.append(" endloop\nendfacet")
+    lines.append("endsolid box")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_edited_stl_is_not_up_to_date(tmp_path, capsys):
+    pytest.importorskip("capytaine")
+    pytest.importorskip("trimesh")
+    from mfm import bemgen
+
+    _box_stl(tmp_path / "hull.stl", 0.1)
+    cfg = tmp_path / "box.toml"
+    cfg.write_text("""
+[hydro]
+database = "box.nc"
+[hydro.bem]
+omega = [3.0, 6.0]
+dx = 0.06
+symmetry = "none"
+[[bodies]]
+name = "box"
+mass = 8.0
+com = [0.0, 0.0, -0.1]
+principal_inertia = [0.05, 0.05, 0.05]
+[bodies.joint]
+type = "planar"
+[bodies.geometry]
+shape = "mesh"
+file = "hull.stl"
+""")
+    out = bemgen.generate(cfg, progress=False, cache=False)
+    ds = xr.open_dataset(out)
+    assert len(ds.attrs["mfm_geometry_sha256"]) == 64 and ds.attrs["mfm_code_version"]
+    ds.close()
+    bemgen.generate(cfg, progress=False, cache=False)
+    assert "up to date" in capsys.readouterr().out
+    assert bemgen.database_is_stale(cfg) == (False, bemgen.database_is_stale(cfg)[1])
+    _box_stl(tmp_path / "hull.stl", 0.11)                  # the config text is unchanged
+    stale, why = bemgen.database_is_stale(cfg)
+    assert stale and "body 'box' file_sha256: contents in the database, other contents" in why
+    with pytest.raises(FileExistsError, match="hull files"):
+        bemgen.generate(cfg, progress=False, cache=False)
+
+
+# ------------------------------------------------------------------------------ swapped bodies
+def _wet(config, names=None):
+    from mfm.config import load_config
+    from mfm.water import open_any_database
+
+    options, bodies = load_config(config)
+    h = options["hydro"]
+    db = open_any_database(config.parent / h["database"], names=names or h.get("names"),
+                           rho=h.get("rho"), g=h.get("g"))
+    available = [str(b) for b in db["body"].values]
+    tagged = [b for b in bodies if "hydro" in b.extra]
+    wet = ([(b.name, b.extra["hydro"]["body"], b.mass, b.com) for b in tagged] if tagged else
+           [(b.name, b.name, b.mass, b.com) for b in bodies if b.name in available])
+    return db, wet
+
+
+def test_swapped_hydro_names_are_found_and_shipped_configs_pass():
+    from hydro.checks import check_body_assignment
+
+    for c in SHIPPED:
+        if "[hydro]" not in c.read_text():
+            continue
+        findings = check_body_assignment(*_wet(c))
+        assert findings == [], (c, [str(f) for f in findings])
+    db, wet = _wet(CONFIGS / "rm3.toml", names=["spar", "float"])
+    (f,) = check_body_assignment(db, wet)
+    assert f.kind == "swap" and set(f.bodies) == {"spar", "float"}
+    assert "look swapped" in f.message and "886691 kg" in f.message and "725.834 m³" in f.message
+    # one body given a far-away hull: a mismatch naming the distance
+    db, wet = _wet(CONFIGS / "sphere.toml")
+    (name, d, m, com), = wet
+    (f,) = check_body_assignment(db, [(name, d, m, com + np.array([5.0, 0, 0]))])
+    assert f.kind == "mismatch" and "CoM–CoB distance 5" in f.message
+
+
+# ------------------------------------------------------------------------------ command line
+def test_cli_module_imports_nothing_heavy_before_parsing():
+    """--help and --version need neither numpy nor jax (mfm/cli.py loaded on its own; the
+    package's __init__ is the other half of a fast `mfm --help`)."""
+    code = ("import importlib.util, sys, io, contextlib\n"
+            "spec = importlib.util.spec_from_file_location('cli_alone', 'mfm/cli.py')\n"
+            "m = importlib.util.module_from_spec(spec); spec.loader.exec_module(m)\n"
+            "for argv in (['--help'], ['--version'], ['simulate', '--help']):\n"
+            "    try:\n"
+            "        m.main(argv)\n"
+            "    except SystemExit as e:\n"
+            "        assert e.code == 0, argv\n"
+            "heavy = [k for k in ('numpy', 'jax', 'xarray', 'matplotlib') if k in sys.modules]\n"
+            "assert not heavy, heavy\n")
+    r = _run(code)
+    assert r.returncode == 0, r.stderr
+    assert "mfm 0." in r.stdout or "mfm unknown" in r.stdout
+    assert "--no-plot" in r.stdout
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["rao", "C", "--omega-min", "0.2", "--omega-max", "2", "--n", "0"], "--n: '0' is out of range; give a whole number ≥ 2"),
+    (["rao", "C", "--omega-min", "0", "--omega-max", "2"], "--omega-min: '0' is out of range; give a positive number"),
+    (["simulate", "C", "--dt", "-0.1"], "--dt: '-0.1' is out of range"),
+    (["simulate", "C", "--dt", "fast"], "--dt: 'fast' is not a number"),
+    (["simulate", "C", "--duration", "nan"], "--duration: 'nan' is not a finite number"),
+    (["simulate", "C", "--save-every", "0"], "--save-every: '0' is out of range"),
+    (["simulate", "C", "--wave", "regular", "--height", "-2", "--period", "8"], "--height: '-2'"),
+])
+def test_cli_argument_checks(argv, match, capsys):
+    from mfm.cli import main
+
+    argv = [str(CONFIGS / "rm3.toml") if a == "C" else a for a in argv]
+    with pytest.raises(SystemExit) as e:
+        main(argv)
+    assert e.value.code == 2
+    assert match in capsys.readouterr().err
+
+
+def test_cli_checks_out_before_the_run(tmp_path, capsys):
+    from mfm.cli import main
+
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    t0 = time.perf_counter()
+    assert main(["simulate", str(CONFIGS / "rm3.toml"), "--duration", "400", "--dt", "0.08",
+                 "--out", str(blocker / "run.nc")]) == 2
+    assert time.perf_counter() - t0 < 5.0                  # nothing was simulated
+    assert "cannot create its folder" in capsys.readouterr().err
+    assert main(["rao", str(CONFIGS / "rm3.toml"), "--omega-min", "0.2", "--omega-max", "2",
+                 "--out", str(tmp_path / "rao.txt")]) == 2
+    assert "give a file ending in .nc" in capsys.readouterr().err
+    assert main(["rao", str(CONFIGS / "rm3.toml"), "--omega-min", "2", "--omega-max", "0.2"]) == 2
+    assert "--omega-max 0.2 must be > --omega-min 2" in capsys.readouterr().err
+
+
+def test_rao_summary_never_calls_the_grid_edge_a_peak():
+    from mfm.cli import _peak_text
+
+    om = np.linspace(0.2, 2.0, 10)
+    assert _peak_text(om, 1 / om, "m/m").startswith("no peak inside the grid (largest |RAO| 5 m/m "
+                                                     "at its lowest frequency 0.2 rad/s")
+    assert "highest" in _peak_text(om, om, "rad/m")
+    a = np.exp(-(om - 1.0) ** 2)
+    assert _peak_text(om, a, "m/m").startswith("peak |RAO| ")
+
+
+def test_info_names_the_coordinates_without_restoring(tmp_path, capsys):
+    """A pendulum (gravity restores its angle) carrying a horizontal slider (nothing restores
+    it): `mfm info` names the slider only."""
+    from mfm.cli import main
+
+    cfg = tmp_path / "slider.toml"
+    cfg.write_text("""
+[[bodies]]
+name = "arm"
+mass = 1.0
+com = [0.0, 0.0, -1.0]
+principal_inertia = [0.1, 0.1, 0.1]
+[bodies.joint]
+type = "revolute"
+axis = [0.0, 1.0, 0.0]
+point = [0.0, 0.0, 0.0]
+[[bodies]]
+name = "cart"
+parent = "arm"
+mass = 0.5
+com = [0.0, 0.0, -1.0]
+principal_inertia = [0.01, 0.01, 0.01]
+[bodies.joint]
+type = "prismatic"
+axis = [1.0, 0.0, 0.0]
+damping = 0.1
+""")
+    assert main(["info", str(cfg)]) == 0
+    out = capsys.readouterr().out
+    assert "no restoring in cart.stroke:" in out and "arm.angle" not in out.split("no restoring")[1]
+    assert "cart.stroke [m]  (damper 0.1 N s/m)" in out and "arm.angle [rad]" in out
+
+
+def test_plot_result_files(tmp_path, capsys):
+    """`mfm simulate` draws its PNG beside the NetCDF; `mfm plot` draws simulation, RAO and
+    batch files."""
+    from hydro.database import split_complex
+    from mfm.cli import main
+
+    nc = tmp_path / "dp.nc"
+    assert main(["simulate", str(CONFIGS / "double_pendulum.toml"), "--duration", "1", "--dt",
+                 "0.01", "--initial", "upper.angle=0.3", "--out", str(nc)]) == 0
+    out = capsys.readouterr().out
+    assert "std 0." in out and " rad, mean" in out and "figure -> " in out
+    assert (tmp_path / "dp.png").read_bytes()[:4] == b"\x89PNG"
+    assert main(["plot", str(nc), "--out", str(tmp_path / "again.png")]) == 0
+    assert "time series" in capsys.readouterr().out
+    om = np.linspace(0.2, 2.0, 20)
+    rao = xr.Dataset({"rao": (("omega", "coordinate"), np.stack([1 / (1 + 1j * om), om + 0j], 1))},
+                     coords={"omega": om, "coordinate": ["a.heave", "a.pitch"]})
+    rao["natural_frequency"] = ("mode", [1.0])
+    split_complex(rao).to_netcdf(tmp_path / "rao.nc")
+    assert main(["plot", str(tmp_path / "rao.nc")]) == 0
+    assert (tmp_path / "rao.png").stat().st_size > 10_000
+    batch = xr.Dataset({"pto_power": (("case", "step", "pto"), np.random.default_rng(0).random((6, 10, 1)))},
+                       coords={"hs": ("case", [1.0, 1.0, 1.0, 2.0, 2.0, 2.0]),
+                               "tp": ("case", [6.0, 8.0, 10.0, 6.0, 8.0, 10.0])})
+    batch.to_netcdf(tmp_path / "batch.nc")
+    assert main(["plot", str(tmp_path / "batch.nc")]) == 0
+    assert "mean power per case" in capsys.readouterr().out
+    xr.Dataset({"x": ("t", [1.0])}).to_netcdf(tmp_path / "other.nc")
+    assert main(["plot", str(tmp_path / "other.nc")]) == 2
+    assert "not an mfm result" in capsys.readouterr().err
+
+
+def test_layouts_in_one_figure_keep_their_own_titles():
+    """notebooks/m4_study's layouts.png titled all three rows "M4 134" (the last suptitle)."""
+    import matplotlib.pyplot as plt
+
+    import mfm
+    from mfm.plotting import plot_layout
+
+    fig, axes = plt.subplots(2, 2)
+    for row, name in zip(axes, ("m4_111", "m4_132")):
+        plot_layout(mfm.load(CONFIGS / f"{name}.toml", hydro=False), ax=row)
+    assert fig._suptitle is None
+    assert axes[0, 0].get_title().startswith("M4 111") and axes[1, 1].get_title().startswith("M4 132")
+    plt.close(fig)
+
+
+def test_m4_study_notebook_stores_its_figures():
+    """A reader on a code host sees the figures: every cell that saves one also shows it."""
+    import re
+
+    import nbformat
+
+    nb = nbformat.read(ROOT / "notebooks/m4_study.ipynb", as_version=4)
+    assert "%matplotlib inline" in nb.cells[1].source
+    saving = [c for c in nb.cells if c.cell_type == "code" and "savefig(" in c.source]
+    assert len(saving) >= 5
+    for c in saving:
+        names = re.findall(r'savefig\(FIGS / "([^"]+)"', c.source)
+        shown = [o for o in c.outputs if "image/png" in o.get("data", {})]
+        assert len(shown) == len(names), names
