@@ -240,9 +240,11 @@ def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: i
     """Natural frequencies (rad/s) and damping ratios, two ways.
 
     eigen: the generalised eigenproblem K φ = ω² M(ω) φ, M(ω) = M + Hᵀ(A(ω) − A∞)H, iterated on ω
-        for each mode (A at that mode's own frequency); coordinates without stiffness have no mode.
-    min_det: local minima of |det Λ(ω)|, Λ = −ω² M(ω) + K, over ``omega_grid`` (seed 000 §2.10),
-        refined parabolically.
+        for each mode (A at that mode's own frequency); coordinates without stiffness have no mode
+        of their own and move freely with the others (condensed out of the mass:
+        M_ss − M_sf M_ff⁻¹ M_fs, the free part of each mode shape −M_ff⁻¹ M_fs φ_s).
+    min_det: local minima of |det Λ(ω)|, Λ = −ω² M_eff(ω) + K_ss, over ``omega_grid``
+        (seed 000 §2.10), refined parabolically.
     damping_ratio: φᵀ C φ / (2 ω φᵀ M(ω) φ) of each mode for the linear damping C (joint dampers,
         hydraulic β, body matrices); radiation_damping_ratio the same with Hᵀ B(ω) H.
 
@@ -257,20 +259,31 @@ def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: i
     K = sys.K
     lo, hi = _frequency_range(sys.loads)
     stiff = [k for k in range(model.n_coordinates) if np.abs(K[:, k]).max() > 1e-9 * np.abs(K).max()]
+    # coordinates without stiffness move freely with the modes (a floating body's surge under
+    # its pitch): condensed out of the mass, M_ss − M_sf M_ff⁻¹ M_fs, not clamped
+    free = [k for k in range(model.n_coordinates) if k not in stiff]
     ix = np.ix_(stiff, stiff)
     Ks = K[ix]
     n = len(stiff)
+
+    def condensed(Mw):
+        """(M_eff (n, n), G (n_free, n)): the free coordinates follow as x_f = G x_s."""
+        if not free:
+            return Mw[ix], np.zeros((0, n))
+        G = -np.linalg.solve(Mw[np.ix_(free, free)], Mw[np.ix_(free, stiff)])
+        return Mw[ix] + Mw[np.ix_(stiff, free)] @ G, G
 
     def M_at(w):
         return _mass_and_damping_at(model, sys, w, options)[0][0]
 
     freqs, modes, zeta, zeta_rad = [], [], [], []
     w_start = hi if math.isfinite(hi) else 1.0
-    lam0 = scipy.linalg.eigh(Ks, M_at(w_start)[ix], eigvals_only=True) if n else []
+    lam0 = scipy.linalg.eigh(Ks, condensed(M_at(w_start))[0], eigvals_only=True) if n else []
     for m in range(n):
         w = math.sqrt(max(lam0[m], 1e-30))
         for _ in range(iterations):
-            lam, vec = scipy.linalg.eigh(Ks, M_at(w)[ix])
+            Me, G = condensed(M_at(w))
+            lam, vec = scipy.linalg.eigh(Ks, Me)
             w_new = math.sqrt(max(lam[m], 1e-30))
             if abs(w_new - w) < 1e-10 * w:
                 break
@@ -278,6 +291,7 @@ def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: i
         freqs.append(w)
         v = np.zeros(model.n_coordinates)
         v[stiff] = vec[:, m]
+        v[free] = G @ vec[:, m]
         modes.append(v)
         Mw, Cr = _mass_and_damping_at(model, sys, w, options)
         mm = float(v @ Mw[0] @ v)
@@ -289,7 +303,7 @@ def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: i
     else:
         grid = np.asarray(omega_grid, dtype=float)
     Mg = _mass_and_damping_at(model, sys, grid, options)[0] if n else np.zeros((len(grid), 0, 0))
-    det = np.array([abs(np.linalg.det((-w**2 * Mg[i] + K)[ix])) for i, w in enumerate(grid)])
+    det = np.array([abs(np.linalg.det(-w**2 * condensed(Mg[i])[0] + Ks)) for i, w in enumerate(grid)])
     mins = []
     for i in range(1, len(grid) - 1):
         if det[i] < det[i - 1] and det[i] <= det[i + 1]:

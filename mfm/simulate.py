@@ -447,7 +447,8 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     t, q, qd, qdd, z, iters = (np.asarray(a) for a in out[:6])
     rec = {k: np.asarray(v) for k, v in out[6].items()}
     settings = dict(duration=duration, n_steps=n_steps, save_every=int(save_every), t0=t0,
-                    complete="true")
+                    complete="true", ramp_s=ramp, memory_s=memory,
+                    sea="still water" if sea is None else repr(sea))
     finite = np.isfinite(q).all(axis=1) & np.isfinite(qd).all(axis=1)
     if not finite.all():
         k = int(np.argmax(~finite))

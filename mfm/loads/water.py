@@ -53,8 +53,9 @@ class Water(Load):
     ``d_cob`` (K, 3) CoB − CoM at q = 0; ``drag`` (K, 3) = ½ ρ C_D A per inertial axis; the
     excitation ``exc_values`` (n, 6K) on the grid ``exc_t0 + j·exc_step`` and the wave elevation
     at the origin ``eta_values`` (n,) on the same grid; ``rad`` the radiation strategy.
-    Static: ``spec`` (the :class:`~hydro.prepare.HydroSpec`), ``dofs``, ``added_mass``, ``sea``
-    (a description of the sea state for the results).
+    Static: ``spec`` (the :class:`~hydro.prepare.HydroSpec`), ``dofs``, ``added_mass``,
+    ``grid_m`` (excitation samples per step). Nothing that differs between sea states is static,
+    so a batch of seas stacks into one structure.
     """
     geometry: BodyPoints
     A_inf: jnp.ndarray
@@ -70,7 +71,6 @@ class Water(Load):
     dofs: tuple[str, ...] = eqx.field(static=True)
     added_mass: str = eqx.field(static=True, default="lhs")
     spec: object = eqx.field(static=True, default=None)
-    settings: tuple = eqx.field(static=True, default=())
     grid_m: int = eqx.field(static=True, default=2)   # excitation samples per step
 
     # the older names, kept for code that reads them
@@ -193,7 +193,7 @@ class Water(Load):
         return {"eta": (eta, {"long_name": "wave elevation at the origin", "units": "m"})}
 
     def provenance(self):
-        out = {"added_mass": self.added_mass, **self.rad.provenance(), **dict(self.settings)}
+        out = {"added_mass": self.added_mass, **self.rad.provenance()}
         if self.spec is not None:
             out.update(self.spec.provenance())
         return out
@@ -296,12 +296,11 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
     geometry = BodyPoints(body_index=spec.body_index, d_ref=jnp.asarray(spec.d_ref),
                           ref0=jnp.asarray(spec.ref0))
     f64 = lambda a: jnp.asarray(a, dtype=jnp.float64)  # noqa: E731
-    settings = (("ramp_s", float(ramp)), ("sea", "still water" if sea is None else repr(sea)))
     return Water(geometry=geometry, A_inf=f64(rad.added_mass_inf(spec)), C_wp=f64(spec.C_wp),
                  buoyancy=f64(spec.rho * spec.g * spec.volume), d_cob=f64(spec.d_cob),
                  drag=f64(spec.drag), exc_t0=f64(t0), exc_step=f64(step), exc_values=f64(exc),
                  eta_values=f64(eta), rad=rad, dofs=spec.dofs, added_mass=added_mass, spec=spec,
-                 settings=settings, grid_m=int(m))
+                 grid_m=int(m))
 
 
 def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_coupling: bool | None = None):
