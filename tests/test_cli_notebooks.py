@@ -1,6 +1,7 @@
 """The command line and the notebooks (executed in smoke mode so they never rot)."""
 
 import os
+
 import nbformat
 import pytest
 import xarray as xr
