@@ -47,7 +47,7 @@ def python_blocks(text: str) -> list[str]:
     return re.findall(r"^```python\n(.*?)^```", text, flags=re.S | re.M)
 
 
-@pytest.mark.slow            # about 5 minutes: four compilations of RM3 and M4 134 with water
+@pytest.mark.slow            # about 6 minutes: four compilations of RM3 and M4 134 with water
 def test_readme_python_blocks_run(tmp_path):
     blocks = python_blocks(README.read_text())
     assert len(blocks) >= 4
