@@ -1,5 +1,7 @@
 """The command line and the notebooks (executed in smoke mode so they never rot)."""
 
+import os
+
 import nbformat
 import pytest
 import xarray as xr
@@ -46,6 +48,9 @@ NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 def test_notebook_runs_in_smoke_mode(path, monkeypatch):
     monkeypatch.setenv("MFM_SMOKE", "1")
     monkeypatch.setenv("MPLBACKEND", "Agg")
+    # the kernel starts in notebooks/: put this checkout first, not whatever `pip install -e`
+    # points at (another worktree's code would be tested otherwise)
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
     nb = nbformat.read(path, as_version=4)
     NotebookClient(nb, timeout=900, kernel_name="python3",
                    resources={"metadata": {"path": str(path.parent)}}).execute()
