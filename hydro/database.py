@@ -343,7 +343,9 @@ def open_any_database(path, *, names=None, rho=None, g=None) -> xr.Dataset:
         if not path.exists():
             raise FileNotFoundError(f"hydro.database: {str(path)!r} not found; generate it with "
                                     "`mfm hydro CONFIG` or fix the path (relative to the config)")
-        raw = read_netcdf(path)
+        from .checks import check_netcdf_file
+
+        raw = read_netcdf(check_netcdf_file(path))
         # ours has A∞ as a variable; capytaine's has it at ω = ∞ (complex dims rejoined by both)
         return _ours(raw) if "added_mass_inf" in raw.data_vars else from_capytaine(raw)
     from hydro.wamit import read_wamit

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import warnings
 from pathlib import Path
 
 import jax.numpy as jnp
@@ -93,8 +94,15 @@ def load(path: str | Path, hydro: bool = True, body_coupling: bool | None = None
     model = dataclasses.replace(model, source=str(path),
                                 source_sha256=hashlib.sha256(Path(path).read_bytes()).hexdigest())
     if hydro and "hydro" in options:
+        from hydro.database import HydroDatabaseWarning
+
+        from .bemgen import database_is_stale
         from .loads.water import load_hydro_spec
 
+        # a database made from other hulls or BEM settings than the config has now
+        stale, why = database_is_stale(path)
+        if stale:
+            warnings.warn(why, HydroDatabaseWarning, stacklevel=2)
         model = dataclasses.replace(model, hydro=load_hydro_spec(
             model, bodies, options["hydro"], Path(path).parent, body_coupling))
     # loads in registry order; each sees the model with the loads before it (a damping ratio is

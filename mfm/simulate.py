@@ -431,6 +431,14 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                         added_mass=added_mass, integrator=integ) + _as_loads(loads)
     q0 = _initial_vector(model, q0, "q0")
     qd0 = _initial_vector(model, qd0, "qd0")
+    no_restoring = []
+    if check_stability:
+        # one Jacobian of the dynamics at q0 gives the shortest period and the coordinates that
+        # nothing pulls back (a column of zeros: they drift, e.g. an unmoored body's surge)
+        Jq = np.asarray(_stiffness_jacobian(model, loads, jnp.asarray(q0, jnp.float64)))
+        scale = max(float(np.abs(Jq).max()), 1e-300)
+        no_restoring = [c for k, c in enumerate(model.coordinates)
+                        if np.abs(Jq[:, k]).max() <= 1e-12 * scale]
     if check_stability and math.isfinite(integ.stability_limit):
         T_min = shortest_natural_period(model, q0, loads)
         if math.isfinite(T_min) and 2 * math.pi * dt / T_min > integ.stability_limit:
@@ -448,7 +456,8 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     rec = {k: np.asarray(v) for k, v in out[6].items()}
     settings = dict(duration=duration, n_steps=n_steps, save_every=int(save_every), t0=t0,
                     complete="true", ramp_s=ramp, memory_s=memory,
-                    sea="still water" if sea is None else repr(sea))
+                    sea="still water" if sea is None else repr(sea),
+                    no_restoring=", ".join(no_restoring) if check_stability else "not checked")
     finite = np.isfinite(q).all(axis=1) & np.isfinite(qd).all(axis=1)
     if not finite.all():
         k = int(np.argmax(~finite))

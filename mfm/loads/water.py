@@ -32,6 +32,7 @@ force Hᵀ X(ω, β).
 """
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import equinox as eqx
@@ -305,8 +306,11 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
 
 def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_coupling: bool | None = None):
     """Build a model's :class:`~hydro.prepare.HydroSpec` from the parsed ``[hydro]`` table."""
-    from hydro.database import select_bodies
+    from hydro.checks import check_body_assignment
+    from hydro.database import HydroDatabaseWarning, select_bodies
     from hydro.prepare import HydroSpec, open_any_database
+
+    from ..tree import ConfigError
 
     path = Path(options["database"])
     if not path.is_absolute():
@@ -327,6 +331,14 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
         raise ValueError(f"hydro: database bodies {missing} named by the config are not in "
                          f"{str(path)!r}; available: {available}")
     db = select_bodies(db, [db_name for _, db_name, _ in wet])
+    # each config body got its own hull's data: volumes and centres of buoyancy against the
+    # config's masses and centres of mass (hydro.names in the wrong order is an error)
+    by_name = {b.name: b for b in bodies}
+    for f in check_body_assignment(db, [(n, d, by_name[n].mass, by_name[n].com) for n, d, _ in wet],
+                                   rho=options.get("rho")):
+        if f.kind == "swap":
+            raise ConfigError(f"hydro: {f}")
+        warnings.warn(str(f), HydroDatabaseWarning, stacklevel=3)
     idx = [model.body_index(name) for name, _, _ in wet]
     com0 = np.asarray(model.com)[idx]
     coupling = options.get("body_coupling", True) if body_coupling is None else body_coupling
