@@ -1,0 +1,64 @@
+"""Published results and the notebooks' stated findings, asserted.
+
+- Seed 001 (Lande-Sudall et al., MFM for M4), §6.4, Fig. 12 discussion: "T = 1 s ... corresponds
+  to the device's eigenfrequency". notebooks/m4_study.ipynb states it more precisely: "the pitch
+  mode of the whole device at 0.98 s in all three layouts; the stern floats pitching about their
+  hinges sit at 1.38 s (111) to 1.71 s (134)". Asserted here on M4 111 (134's and 132's modes
+  cost a minute each; 111 carries both kinds of mode).
+- notebooks/quickstart.ipynb: "The elbow damper drains energy; the total energy can only go down."
+
+Not asserted here (too slow for the suite): m4_study's TD–FD table on 134 ("22 of 24 periods
+within 1 %", 24 runs of 50 T on the eight-float model) and its power and CWR findings (100 Tp
+JONSWAP sweeps); the TD–FD agreement is covered on smaller models by tests/test_water.py.
+"""
+import numpy as np
+import pytest
+from conftest import CONFIGS
+
+import mfm
+
+pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
+
+
+@pytest.fixture(scope="module")
+def m4_111_periods():
+    model = mfm.load(CONFIGS / "m4_111.toml")
+    # about q = 0: the equilibrium of 111 is within 5e-5 rad of it (a 1e-5 change of the periods);
+    # min |det| on a 10-point grid only (its cost is one A(ω) interpolation a point)
+    nat = mfm.natural_frequencies(model, q0=np.zeros(model.n_coordinates),
+                                  omega_grid=np.linspace(4.0, 8.5, 10))
+    T = 2 * np.pi / nat["eigen"]
+    hinge = model.coordinate_index("float3.angle")
+    modes = nat["modes"] / np.abs(nat["modes"]).max(axis=0)
+    return T, modes, hinge
+
+
+def test_m4_device_eigenperiod_seed_001(m4_111_periods):
+    T, modes, hinge = m4_111_periods
+    # the seed's "eigenfrequency at T = 1 s": its regular waves are 0.1 s apart near there, so
+    # ±5 %; the device mode is the one that moves the whole frame (root pitch), not the hinge most
+    device = [k for k in range(len(T)) if abs(modes[hinge, k]) < 0.99]
+    assert any(abs(T[k] - 1.0) < 0.05 for k in device), T
+
+
+def test_m4_study_natural_periods_as_stated(m4_111_periods):
+    T, modes, hinge = m4_111_periods
+    # notebook: device pitch "0.98–0.99 s" (stated to 2 decimals: ±0.005 around the range) and the
+    # stern float about its hinge "1.38 s (111)" (±0.005)
+    stern = int(np.argmax(np.abs(modes[hinge])))
+    assert T[stern] == pytest.approx(1.38, abs=0.005)
+    device = sorted(T[k] for k in range(len(T)) if k != stern)
+    assert any(0.975 <= t <= 0.995 for t in device), T
+
+
+def test_quickstart_energy_only_goes_down():
+    model = mfm.load(CONFIGS / "double_pendulum.toml")
+    ds = mfm.simulate(model, duration=5.0, dt=0.005, q0={"upper.angle": 1.0}, integrator="rk4")
+    E = (ds.kinetic_energy + ds.potential_energy).values
+    # never up beyond rk4's energy error at dt = 5 ms (1e-9 J a step, where the damper is idle)
+    assert np.all(np.diff(E) < 1e-9)
+    # and what goes is what the damper absorbs, ∫ c q̇² dt (trapezoid on the 5 ms grid: 1e-4)
+    P = ds.pto_power.sum("pto").values
+    absorbed = np.sum(0.5 * (P[1:] + P[:-1]) * np.diff(ds.time.values))
+    assert absorbed > 1e-3
+    assert E[0] - E[-1] == pytest.approx(absorbed, rel=1e-4)
