@@ -21,7 +21,10 @@ from hydro import bem, geometry  # noqa: E402,F401
 
 # database schema, WAMIT reader, radiation memory (K(t), Ogilvie), state space.
 from hydro import database, radiation, statespace, wamit  # noqa: E402,F401
-from hydro.database import from_capytaine, open_database, select_bodies, to_netcdf, validate  # noqa: E402,F401
+from hydro.database import (  # noqa: E402,F401
+    from_capytaine, open_any_database, open_database, read_netcdf, select_bodies, to_netcdf, validate,
+    write_netcdf,
+)
 from hydro.wamit import read_wamit  # noqa: E402,F401
 from hydro.radiation import (  # noqa: E402,F401
     added_mass_from_irf, check_grid, damping_from_irf, impulse_response, memory_length,

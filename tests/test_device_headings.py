@@ -115,8 +115,9 @@ def test_frequency_response_at_heading(setup):
     model, db = setup
     omega = db.omega.values[5:40:5]
     beta = math.radians(60.0)
-    head = mfm.frequency_response(model, omega, heading=0.0).rao
-    obl = mfm.frequency_response(model, omega, heading=beta).rao
+    q0 = np.zeros(model.n_coordinates)                   # the sphere's equilibrium (m = ρV)
+    head = mfm.frequency_response(model, omega, heading=0.0, q0=q0).rao
+    obl = mfm.frequency_response(model, omega, heading=beta, q0=q0).rao
     # 1e-10: the planar sphere's surge and pitch see X cos β, its heave X; nothing else changes
     np.testing.assert_allclose(obl.sel(coordinate=["sphere.surge", "sphere.pitch"]).values,
                                math.cos(beta) * head.sel(coordinate=["sphere.surge", "sphere.pitch"]).values,
