@@ -34,4 +34,4 @@ from hydro.statespace import StateSpaceRadiation, fit_state_space, fitted_impeda
 # a database made ready for both domains (symmetry, A∞, K(t), fits, convolution weights), and one
 # function that opens any database file by its type
 from hydro import prepare  # noqa: E402,F401
-from hydro.prepare import HydroSpec, open_any_database  # noqa: E402,F401
+from hydro.prepare import HydroSpec  # noqa: E402,F401

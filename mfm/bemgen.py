@@ -313,8 +313,6 @@ def database_is_stale(config_path, database=None) -> tuple[bool, str]:
     CONFIG --force``); ``(False, "…")`` says why it is up to date or why it cannot be checked (a
     WAMIT database, or a config without ``[bodies.geometry]`` tables: nothing recorded to compare).
     """
-    import xarray as xr
-
     config_path = Path(config_path)
     options, bodies = load_config(config_path)
     hydro = options.get("hydro") or {}
@@ -330,9 +328,10 @@ def database_is_stale(config_path, database=None) -> tuple[bool, str]:
         return False, (f"{config_path} has no [bodies.geometry] table: the database was not made "
                        "from this config's hulls; not checked")
     from hydro.checks import check_netcdf_file
+    from hydro.database import read_netcdf
 
-    with xr.open_dataset(check_netcdf_file(database)) as f:
-        attrs = dict(f.attrs)
+    # read from memory: a file the user holds open must not get a second HDF5 handle
+    attrs = dict(read_netcdf(check_netcdf_file(database)).attrs)
     specs = body_specs(config_path, raw, bodies)
     diffs = []
     if "mfm_geometry" in attrs:
@@ -439,9 +438,9 @@ def generate(config_path, *, out=None, force=False, progress=True, n_threads=Non
     if out.exists() and not force:
         stored = None
         try:
-            import xarray as xr
-            with xr.open_dataset(out) as f:
-                stored = f.attrs.get("mfm_generate_key")
+            from hydro.database import read_netcdf
+
+            stored = read_netcdf(out).attrs.get("mfm_generate_key")
         except Exception:  # noqa: BLE001 - unreadable: treat as foreign
             pass
         if stored == key:

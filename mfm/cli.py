@@ -302,16 +302,15 @@ def cmd_plot(args):
     src = Path(args.config)
     if src.suffix == ".nc":
         out = _writable(args.out or src.with_suffix(".png"), "--out", (".png",))
-        import xarray as xr
-
         from mfm.plotting import save_result_plot
 
         if not src.exists():
             raise FileNotFoundError(f"result file {str(src)!r} not found")
         from hydro.checks import check_netcdf_file
 
-        with xr.open_dataset(check_netcdf_file(src)) as f:
-            ds = f.load()
+        from hydro.database import read_netcdf
+
+        ds = read_netcdf(check_netcdf_file(src))
         kind = save_result_plot(ds, out, dpi=args.dpi)
         print(f"{kind} of {src} -> {out}")
         return
