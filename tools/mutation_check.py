@@ -54,6 +54,7 @@ HEAD = ("tests/test_device_headings.py",)
 HEAD_REG = (_H + "test_regular_wave_excitation_at_heading", _H + "test_spread_sea_force_spectrum_against_hand_sum")
 HEAD_SPREAD = (_H + "test_spreading_directions_follow_cos2s", _H + "test_spread_sea_force_spectrum_against_hand_sum")
 HEAD_FR = (_H + "test_frequency_response_at_heading",)
+PLUG = ("tests/test_loads_plugins.py",)
 
 MUTANTS = [
     # ---------------------------------------------------------------- PTOs (issue 16 bugs 1, 2)
@@ -69,32 +70,35 @@ MUTANTS = [
     Mutant("pto-row-sum", "stroke-rate row g = uᵀ(H_a + H_b) instead of uᵀ(H_a − H_b)",
            'g = jnp.einsum("pa,paq->pq", u, Ha - Hb)', 'g = jnp.einsum("pa,paq->pq", u, Ha + Hb)', PTO),
     Mutant("pto-power-abs", "absorbed power β|ẇ| instead of β ẇ²",
-           '"hydraulic_power": self.beta * wd**2', '"hydraulic_power": self.beta * jnp.abs(wd)', PTO),
+           '"hydraulic_power": absorbed_power(self.beta, wd)}',
+           '"hydraulic_power": self.beta * jnp.abs(wd)}', PTO),
     Mutant("pto-bias-b-dropped", "the second end's velocity-product acceleration left out of ġq̇",
            "jnp.sum(u * (aa - ab), axis=1)", "jnp.sum(u * aa, axis=1)", PTO),
     # ------------------------------------------------------ moorings and point loads (bug 3)
     Mutant("mooring-lever-dropped", "planted bug 3: the mooring force applied at the CoM (lever arm dropped)",
-           "return LoadOutput(body=self.points.to_body_wrench(F, kin, model.n_bodies))",
-           "return LoadOutput(body=self.points.to_body_wrench(F, kin, model.n_bodies, "
+           "return LoadOutput(body=self.points.to_body_wrench(F, ctx.kin, ctx.model.n_bodies))",
+           "return LoadOutput(body=self.points.to_body_wrench(F, ctx.kin, ctx.model.n_bodies, "
            "point_offset=jnp.zeros_like(self.points.d_ref)))", MOOR),
     Mutant("mooring-axes-swapped", "mooring stiffness applied to the axes in reverse order (x ↔ z)",
-           "f = -self.stiffness * (self.points.positions(kin)", "f = -self.stiffness[:, ::-1] * (self.points.positions(kin)", MOOR),
+           "f = -self.stiffness * (self.points.positions(ctx.kin)",
+           "f = -self.stiffness[:, ::-1] * (self.points.positions(ctx.kin)", MOOR),
     Mutant("point-moment-sign", "moment of a point force about the CoM with the wrong sign (ρ × f)",
            "mb = jnp.einsum(\"kba,kb->ka\", R, m + jnp.cross(rho, f))",
            "mb = jnp.einsum(\"kba,kb->ka\", R, m - jnp.cross(rho, f))", MOOR),
     # ------------------------------------------ frequency domain and equilibrium (bug 4)
     Mutant("natfreq-stiffness-scaled", "planted bug 4: every natural frequency 10 % high (K × 1.21 inside natural_frequencies)",
-           "    q0, M0, K, C, H0 = linearise(model, q0)\n    spec = model.hydro\n",
-           "    q0, M0, K, C, H0 = linearise(model, q0)\n    K = 1.21 * K\n    spec = model.hydro\n", NATFREQ),
+           "    sys = linear_system(model, q0, loads=loads)\n    K = sys.K\n",
+           "    sys = linear_system(model, q0, loads=loads)\n    K = 1.21 * sys.K\n", NATFREQ),
     Mutant("fr-damping-sign", "frequency response with +iω(B + C): the e^{+iωt} convention's impedance",
-           "Z = -w**2 * (M0[None] + Aq) - 1j * w * (Bq + C[None]) + K[None]",
-           "Z = -w**2 * (M0[None] + Aq) + 1j * w * (Bq + C[None]) + K[None]", FRESP),
+           "Z = np.einsum(\"ai,wab,bj->wij\", H0, -w**2 * A_rel - 1j * w * np.asarray(B), H0)",
+           "Z = np.einsum(\"ai,wab,bj->wij\", H0, -w**2 * A_rel + 1j * w * np.asarray(B), H0)", FRESP),
     Mutant("fr-joint-damper-dropped", "frequency response without the joint dampers C",
-           "(Bq + C[None])", "(Bq)", FRESP),
+           "- 1j * w * sys.C[None]", "- 0.0 * w * sys.C[None]", FRESP),
     Mutant("fr-excitation-conj", "frequency response with the conjugate excitation (WAMIT's convention)",
-           'F = np.einsum("ai,wa->wi", H0, X)', 'F = np.einsum("ai,wa->wi", H0, X.conj())', FRESP),
+           'force=np.einsum("ai,wa->wi", H0, X))', 'force=np.einsum("ai,wa->wi", H0, X.conj()))', FRESP),
     Mutant("linearise-about-zero", "stiffness taken at q = 0 instead of the equilibrium",
-           "K = -np.asarray(jax.jacfwd(G)(q0))", "K = -np.asarray(jax.jacfwd(G)(jnp.zeros_like(q0)))", LINEAR),
+           "K = -np.asarray(jax.jacfwd(lambda q: Q(q, zero))(q0))",
+           "K = -np.asarray(jax.jacfwd(lambda q: Q(q, zero))(jnp.zeros_like(q0)))", LINEAR),
     Mutant("fr-heading-ignored", "frequency response in head seas whatever the heading",
            "heading=np.full_like(omega, heading)", "heading=np.full_like(omega, 0.0)", HEAD_FR),
     # -------------------------------------------------------------------------- hydrostatics
@@ -136,6 +140,18 @@ MUTANTS = [
            "np.exp(1j * (p0 + s * dp))", "np.exp(1j * (p0 - s * dp))", HEAD_REG),
     Mutant("excitation-time-sign", "excitation time series with e^{+iωt} (sin term sign)",
            "out[i:i + step] = np.cos(wt) @ cr + np.sin(wt) @ ci", "out[i:i + step] = np.cos(wt) @ cr - np.sin(wt) @ ci", HEAD_REG),
+    # ------------------------------------------- the plug-in loads (body matrices, joint loads, points)
+    Mutant("body-matrix-damping-sign", "a body matrix's damping pushing with the velocity (−K ξ + D ξ̇)",
+           "+ jnp.einsum(\"pab,pb->pa\", self.damping, v.reshape(-1, 6)))",
+           "- jnp.einsum(\"pab,pb->pa\", self.damping, v.reshape(-1, 6)))", PLUG),
+    Mutant("critical-damping-factor", "critical damping without its factor 2 (c = ζ √(k m))",
+           "return 2.0 * float(ratio) * math.sqrt(k * m)", "return float(ratio) * math.sqrt(k * m)", PLUG),
+    Mutant("joint-load-sign", "a joint load acting against its stated direction",
+           "return LoadOutput(tau=self.values)", "return LoadOutput(tau=-self.values)", PLUG),
+    Mutant("point-acceleration-bias-dropped", "a body point's acceleration without its Ḣ q̇ term",
+           "acc = (H @ ctx.qdd + bias).reshape(P, 6)[:, :3]", "acc = (H @ ctx.qdd).reshape(P, 6)[:, :3]", PLUG),
+    Mutant("free-coordinates-clamped", "natural frequencies with the coordinates without stiffness clamped",
+           "return Mw[ix] + Mw[np.ix_(stiff, free)] @ G, G", "return Mw[ix], G", NATFREQ + (_F + "test_sphere_pitch_natural_frequency_with_surge_free",)),
 ]
 
 IGNORE = shutil.ignore_patterns(".git", ".venv", "__pycache__", "*.pyc", ".pytest_cache", "out",
