@@ -22,7 +22,7 @@ from hydro import bem, geometry  # noqa: E402,F401
 # database schema, WAMIT reader, radiation memory (K(t), Ogilvie), state space.
 from hydro import database, radiation, statespace, wamit  # noqa: E402,F401
 from hydro.database import (  # noqa: E402,F401
-    from_capytaine, open_any_database, open_database, read_netcdf, select_bodies, to_netcdf, validate,
+    from_capytaine, open_database, read_netcdf, select_bodies, to_netcdf, validate,
     write_netcdf,
 )
 from hydro.wamit import read_wamit  # noqa: E402,F401
@@ -34,4 +34,4 @@ from hydro.statespace import StateSpaceRadiation, fit_state_space, fitted_impeda
 # a database made ready for both domains (symmetry, A∞, K(t), fits, convolution weights), and one
 # function that opens any database file by its type
 from hydro import prepare  # noqa: E402,F401
-from hydro.prepare import HydroSpec  # noqa: E402,F401
+from hydro.prepare import HydroSpec, open_any_database  # noqa: E402,F401

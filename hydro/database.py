@@ -332,36 +332,6 @@ def _ours(ds: xr.Dataset) -> xr.Dataset:
     return ds
 
 
-def open_any_database(path, *, names=None, rho=None, g=None) -> xr.Dataset:
-    """Any hydro database file as the internal schema, in memory: our NetCDF (:func:`to_netcdf`),
-    a capytaine NetCDF (``mfm hydro``, ``hydro.bem.save``, ``cpt.export_dataset``; converted by
-    :func:`from_capytaine`), or WAMIT output (``.out`` with its ``.1``/``.3``/``.hst``; `names`
-    the bodies in file order, `rho` and `g` as :func:`hydro.wamit.read_wamit` takes them). A NetCDF
-    file is read once, whole (:func:`read_netcdf`): safe while the process holds it open."""
-    path = Path(path)
-    if path.suffix == ".nc":
-        if not path.exists():
-            raise FileNotFoundError(f"hydro.database: {str(path)!r} not found; generate it with "
-                                    "`mfm hydro CONFIG` or fix the path (relative to the config)")
-        from .checks import check_netcdf_file
-
-        raw = read_netcdf(check_netcdf_file(path))
-        # ours has A∞ as a variable; capytaine's has it at ω = ∞ (complex dims rejoined by both)
-        return _ours(raw) if "added_mass_inf" in raw.data_vars else from_capytaine(raw)
-    from hydro.wamit import read_wamit
-
-    stem = path.with_suffix("") if path.suffix in (".out", ".1", ".3", ".hst") else path
-    if not stem.with_suffix(".out").exists():
-        raise FileNotFoundError(f"hydro.database: {str(path)!r}: no WAMIT output {stem}.out and not "
-                                "a .nc file; accepted: a NetCDF database or a WAMIT .out/.1/.3/.hst set")
-    kw = {}
-    if rho is not None:
-        kw["rho"] = float(rho)
-    if g is not None:
-        kw["g"] = float(g)
-    return read_wamit(stem, body_names=names, **kw)
-
-
 # ---------------------------------------------------------------------------------- capytaine
 def from_capytaine(ds: xr.Dataset, body_names=None) -> xr.Dataset:
     """Convert a capytaine 3 dataset to the internal schema.

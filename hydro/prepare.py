@@ -4,8 +4,8 @@
 A(ω), B(ω), A∞ (reciprocity), applies the body-coupling mask, corrects A∞ to be consistent with
 A(ω) and B(ω), and computes on demand (cached) the impulse response K(t), its memory length, the
 convolution weights of a time step and the passive state-space fit. :func:`modal_form` realises a
-fit in modal form; :func:`~hydro.database.open_any_database` (importable from here too) opens any
-database file by its type. Nothing here imports :mod:`mfm`: the mechanics hands in where each
+fit in modal form; :func:`open_any_database` opens any database file by its type (above the
+schema and the readers, so none of them imports another in a circle). Nothing here imports :mod:`mfm`: the mechanics hands in where each
 body's reference point sits (``com0``, ``body_index``) and which dofs its joints move (``moving``).
 """
 from __future__ import annotations
@@ -17,8 +17,9 @@ from typing import Sequence
 import numpy as np
 import xarray as xr
 
-# one function opens any database file by its type (read whole, from memory); kept importable here
-from .database import open_any_database  # noqa: F401
+from .checks import check_netcdf_file
+from .database import _ours, from_capytaine, read_netcdf
+from .wamit import read_wamit
 
 
 class HydroSpec:
@@ -269,3 +270,31 @@ def modal_form(ss):
     if not poles:
         return np.zeros(0, complex), np.zeros((0, 0), complex), (), ()
     return np.concatenate(poles), np.concatenate(cols, axis=1), tuple(ins), outs
+
+
+def open_any_database(path, *, names=None, rho=None, g=None) -> xr.Dataset:
+    """Any hydro database file as the internal schema, in memory: our NetCDF (:func:`to_netcdf`),
+    a capytaine NetCDF (``mfm hydro``, ``hydro.bem.save``, ``cpt.export_dataset``; converted by
+    :func:`from_capytaine`), or WAMIT output (``.out`` with its ``.1``/``.3``/``.hst``; `names`
+    the bodies in file order, `rho` and `g` as :func:`hydro.wamit.read_wamit` takes them). A NetCDF
+    file is read once, whole (:func:`read_netcdf`): safe while the process holds it open."""
+    path = Path(path)
+    if path.suffix == ".nc":
+        if not path.exists():
+            raise FileNotFoundError(f"hydro.database: {str(path)!r} not found; generate it with "
+                                    "`mfm hydro CONFIG` or fix the path (relative to the config)")
+
+        raw = read_netcdf(check_netcdf_file(path))
+        # ours has A∞ as a variable; capytaine's has it at ω = ∞ (complex dims rejoined by both)
+        return _ours(raw) if "added_mass_inf" in raw.data_vars else from_capytaine(raw)
+
+    stem = path.with_suffix("") if path.suffix in (".out", ".1", ".3", ".hst") else path
+    if not stem.with_suffix(".out").exists():
+        raise FileNotFoundError(f"hydro.database: {str(path)!r}: no WAMIT output {stem}.out and not "
+                                "a .nc file; accepted: a NetCDF database or a WAMIT .out/.1/.3/.hst set")
+    kw = {}
+    if rho is not None:
+        kw["rho"] = float(rho)
+    if g is not None:
+        kw["g"] = float(g)
+    return read_wamit(stem, body_names=names, **kw)

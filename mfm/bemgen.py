@@ -358,7 +358,7 @@ def database_is_stale(config_path, database=None) -> tuple[bool, str]:
 def _check_database(path: Path, config_path: Path, options: dict, bodies) -> None:
     """Load ``path`` the way ``mfm.load(config)`` does (open_any_database → from_capytaine →
     schema checks → the config's bodies on the tree)."""
-    from .build import compile_tree
+    from .compile import compile_tree
     from .loads.water import load_hydro_spec
 
     model = compile_tree(bodies, name=options["name"], gravity=options["gravity"])

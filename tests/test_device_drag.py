@@ -21,7 +21,7 @@ from conftest import CONFIGS, ROOT
 from scipy.integrate import solve_ivp
 
 import mfm
-from hydro.database import open_any_database
+from hydro.prepare import open_any_database
 
 pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 

@@ -18,7 +18,7 @@ import pytest
 from conftest import CONFIGS, ROOT
 
 import mfm
-from hydro.database import open_any_database
+from hydro.prepare import open_any_database
 
 pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 

@@ -22,7 +22,8 @@ from conftest import CONFIGS, ROOT
 
 import hydro
 import mfm
-from hydro.database import open_any_database, to_netcdf
+from hydro.database import to_netcdf
+from hydro.prepare import open_any_database
 
 pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 

@@ -15,7 +15,7 @@ import scipy.linalg
 from conftest import ROOT
 
 import mfm
-from hydro.database import open_any_database
+from hydro.prepare import open_any_database
 
 pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 

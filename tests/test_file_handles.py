@@ -50,10 +50,10 @@ def test_hydro_readers_with_the_database_held_open():
     # every hydro reader of a NetCDF database, each several times, while the file is held open
     r = run_python(f"""
         import xarray as xr
-        from hydro import bem, database
+        from hydro import bem, database, prepare
         ds = xr.open_dataset({str(SPHERE_NC)!r})
         for _ in range(3):
-            a = database.open_any_database({str(SPHERE_NC)!r})
+            a = prepare.open_any_database({str(SPHERE_NC)!r})
             b = bem.load({str(SPHERE_NC)!r})
             c = database.read_netcdf({str(SPHERE_NC)!r})
         assert a.sizes["omega"] == ds.sizes["omega"] - 1  # ω = ∞ moved into added_mass_inf

