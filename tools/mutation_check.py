@@ -184,7 +184,7 @@ def run_mutant(copy: Path, m: Mutant, timeout: float) -> tuple[str, str, float]:
     env = dict(os.environ, PYTHONPATH=str(copy), MPLBACKEND="Agg")
     t0 = time.perf_counter()
     try:
-        r = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
+        r = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-n", "0", "-p", "no:cacheprovider",
                             *m.tests], cwd=copy, env=env, capture_output=True, text=True,
                            timeout=timeout)
         rc = r.returncode
