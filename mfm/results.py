@@ -89,7 +89,7 @@ def _rate(u, n):
     return {"rad": "rad/s", "m": "m/s"}[u] if n == 1 else {"rad": "rad/s2", "m": "m/s2"}[u]
 
 
-def _coordinate_attrs(model, what, n=0):
+def _coordinate_attrs(model, n=0):
     units = coordinate_units(model)
     kinds = sorted(set(units))
     u = kinds[0] if len(kinds) == 1 else None
@@ -165,9 +165,9 @@ def time_series(model, loads, integ, dt, t, q, qd, qdd, iters, rec, settings) ->
     """The dataset of one run (:func:`mfm.simulate`)."""
     ds = xr.Dataset(
         {
-            "q": (("time", "coordinate"), q, _coordinate_attrs(model, "q", 0)),
-            "qd": (("time", "coordinate"), qd, _coordinate_attrs(model, "qd", 1)),
-            "qdd": (("time", "coordinate"), qdd, _coordinate_attrs(model, "qdd", 2)),
+            "q": (("time", "coordinate"), q, _coordinate_attrs(model, 0)),
+            "qd": (("time", "coordinate"), qd, _coordinate_attrs(model, 1)),
+            "qdd": (("time", "coordinate"), qdd, _coordinate_attrs(model, 2)),
             "body_position": (("time", "body", "axis"), rec["body_position"],
                               {"long_name": "centre of mass position, inertial axes", "units": "m"}),
             "body_rotation": (("time", "body", "angle"), rec["body_rotation"],
@@ -204,8 +204,8 @@ def batch(model, models, loads, integ, t, q, qd, dts, settings, save_every, labe
     B = q.shape[0]
     ds = xr.Dataset(
         {"time": (("case", "step"), t, {"units": "s"}),
-         "q": (("case", "step", "coordinate"), q, _coordinate_attrs(model, "q", 0)),
-         "qd": (("case", "step", "coordinate"), qd, _coordinate_attrs(model, "qd", 1)),
+         "q": (("case", "step", "coordinate"), q, _coordinate_attrs(model, 0)),
+         "qd": (("case", "step", "coordinate"), qd, _coordinate_attrs(model, 1)),
          "dt": (("case",), np.broadcast_to(dts, (B,)).copy(), {"units": "s"})},
         coords={"case": np.arange(B), **_coordinate_coords(model)},
         attrs={"title": f"mfm batch of {B} runs of {model.name}",
@@ -233,7 +233,6 @@ def frequency(model, loads, omega, x, q0, kin0, heading, settings, extra) -> xr.
                            np.einsum("nab,nbi,wi->wna", R, Bm[:, 3:], x)], axis=2)
     damped = [k for k in range(model.n_coordinates) if float(model.damping[k]) > 0]
     c = np.asarray(model.damping)[damped]
-    units = coordinate_units(model)
     ds = xr.Dataset(
         {"rao": (("omega", "coordinate"), x, {"long_name": "coordinate RAO per metre of wave "
                                              "amplitude, x(t) = Re[x e^{-i omega t}]",
@@ -256,7 +255,6 @@ def frequency(model, loads, omega, x, q0, kin0, heading, settings, extra) -> xr.
                             convention="exp(-i omega t)", **settings)})
     if model.hydro is not None:
         ds.attrs["source"] = model.hydro.source
-    del units
     for out in extra:
         out = dict(out)
         coords = out.pop("coords", {})

@@ -296,7 +296,10 @@ def shortest_natural_period(model: Model, q, loads=()) -> float:
     """Estimate of the shortest natural period (s) at configuration q (q̇ = 0): 2π/√λ_max with λ
     the eigenvalues of −∂q̈/∂q (jax Jacobian of the full dynamics: its mass matrix, added mass
     included, and every restoring load). Returns inf when nothing is restoring."""
-    Jq = _stiffness_jacobian(model, _as_loads(loads), jnp.asarray(q, jnp.float64))
+    return _period_from_jacobian(_stiffness_jacobian(model, _as_loads(loads), jnp.asarray(q, jnp.float64)))
+
+
+def _period_from_jacobian(Jq) -> float:
     lam = np.linalg.eigvals(-np.asarray(Jq)).real
     lam_max = lam.max() if lam.size else 0.0
     return math.inf if lam_max <= 0 else 2.0 * math.pi / math.sqrt(lam_max)
@@ -440,7 +443,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
         no_restoring = [c for k, c in enumerate(model.coordinates)
                         if np.abs(Jq[:, k]).max() <= 1e-12 * scale]
     if check_stability and math.isfinite(integ.stability_limit):
-        T_min = shortest_natural_period(model, q0, loads)
+        T_min = _period_from_jacobian(Jq)
         if math.isfinite(T_min) and 2 * math.pi * dt / T_min > integ.stability_limit:
             warnings.warn(
                 f"dt = {dt:.4g} s is beyond the stability limit of {integ.name}: the shortest natural "
