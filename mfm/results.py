@@ -161,6 +161,23 @@ def _joint_dampers(ds, model, damping, q, qd, dim):
 
 
 # ------------------------------------------------------------------------------- time domain
+# what every run records per sample besides q, q̇, q̈ (mfm.simulate._record): dims after time, attrs
+RECORD_DIMS = {
+    "body_position": (("body", "axis"), {"long_name": "centre of mass position, inertial axes",
+                                         "units": "m"}),
+    "body_rotation": (("body", "angle"), {"long_name": "body orientation as roll, pitch, yaw with "
+                                          "R = Rz(yaw) Ry(pitch) Rx(roll)", "units": "rad"}),
+    "joint_force": (("body", "axis"), {"long_name": "force the joint of each body transmits from "
+                                       "its parent (or the inertial frame) to the body, inertial "
+                                       "axes", "units": "N"}),
+    "joint_moment": (("body", "axis"), {"long_name": "moment the joint of each body transmits, "
+                                        "about the joint point, inertial axes", "units": "N m"}),
+    "kinetic_energy": ((), {"units": "J"}),
+    "potential_energy": ((), {"long_name": "gravity and joint springs", "units": "J"}),
+}
+RECORD_COORDS = {"axis": ["x", "y", "z"], "angle": ["roll", "pitch", "yaw"]}
+
+
 def time_series(model, loads, integ, dt, t, q, qd, qdd, iters, rec, settings) -> xr.Dataset:
     """The dataset of one run (:func:`mfm.simulate`)."""
     ds = xr.Dataset(
@@ -168,26 +185,12 @@ def time_series(model, loads, integ, dt, t, q, qd, qdd, iters, rec, settings) ->
             "q": (("time", "coordinate"), q, _coordinate_attrs(model, 0)),
             "qd": (("time", "coordinate"), qd, _coordinate_attrs(model, 1)),
             "qdd": (("time", "coordinate"), qdd, _coordinate_attrs(model, 2)),
-            "body_position": (("time", "body", "axis"), rec["body_position"],
-                              {"long_name": "centre of mass position, inertial axes", "units": "m"}),
-            "body_rotation": (("time", "body", "angle"), rec["body_rotation"],
-                              {"long_name": "body orientation as roll, pitch, yaw with "
-                               "R = Rz(yaw) Ry(pitch) Rx(roll)", "units": "rad"}),
-            "joint_force": (("time", "body", "axis"), rec["joint_force"],
-                            {"long_name": "force the joint of each body transmits from its parent "
-                             "(or the inertial frame) to the body, inertial axes", "units": "N"}),
-            "joint_moment": (("time", "body", "axis"), rec["joint_moment"],
-                             {"long_name": "moment the joint of each body transmits, about the joint "
-                              "point, inertial axes", "units": "N m"}),
-            "kinetic_energy": (("time",), rec["kinetic_energy"], {"units": "J"}),
-            "potential_energy": (("time",), rec["potential_energy"],
-                                 {"long_name": "gravity and joint springs", "units": "J"}),
+            **{k: (("time",) + dims, rec[k], dict(attrs)) for k, (dims, attrs) in RECORD_DIMS.items()},
             "iterations": (("time",), iters, {"long_name": "corrector iterations of the step",
                                               "units": "1"}),
         },
         coords={"time": ("time", t, {"units": "s"}), **_coordinate_coords(model),
-                "body": list(model.body_names), "axis": ["x", "y", "z"],
-                "angle": ["roll", "pitch", "yaw"]},
+                "body": list(model.body_names), **RECORD_COORDS},
         attrs={"title": f"mfm simulation of {model.name}",
                **provenance(model, loads, integrator=integ.name, integrator_settings=repr(integ),
                             dt=float(dt), dt_units="s", **settings)},
@@ -198,9 +201,11 @@ def time_series(model, loads, integ, dt, t, q, qd, qdd, iters, rec, settings) ->
     return ds
 
 
-def batch(model, models, loads, integ, t, q, qd, dts, settings, save_every, labels=None) -> xr.Dataset:
+def batch(model, models, loads, integ, t, q, qd, dts, settings, save_every, labels=None,
+          recorded=None) -> xr.Dataset:
     """The dataset of :func:`mfm.simulate_batch`: (case, step, …); ``labels`` per-case values
-    (e.g. each sea state's Hs, Tp) as coordinates on ``case``."""
+    (e.g. each sea state's Hs, Tp) as coordinates on ``case``; ``recorded`` the per-sample outputs
+    asked for by name (case, step, …)."""
     B = q.shape[0]
     ds = xr.Dataset(
         {"time": (("case", "step"), t, {"units": "s"}),
@@ -221,6 +226,17 @@ def batch(model, models, loads, integ, t, q, qd, dts, settings, save_every, labe
             per_case[i].update(ld.batch_outputs(save_every, q.shape[1]))
     for name, (_, attrs) in per_case[0].items():
         ds[name] = (("case", "step"), np.stack([per_case[i][name][0] for i in range(B)]), attrs)
+    if recorded:
+        specs = dict(RECORD_DIMS)
+        coords = {"body": list(model.body_names), **RECORD_COORDS}
+        for ld in loads[0]:
+            spec = dict(ld.outputs())
+            coords.update(spec.pop("coords", {}))
+            specs.update(spec)
+        for name, values in recorded.items():
+            dims, attrs = specs[name]
+            ds = ds.assign_coords({d: coords[d] for d in dims if d in coords and d not in ds.coords})
+            ds[name] = (("case", "step") + tuple(dims), values, dict(attrs))
     return ds
 
 

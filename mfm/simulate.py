@@ -172,6 +172,26 @@ def _record(model, loads, s, mem):
                 joint_moment=m_j, kinetic_energy=T, potential_energy=V, qdd=ev.qdd, **diag)
 
 
+def _output_names(outputs) -> tuple:
+    if isinstance(outputs, str):
+        outputs = (outputs,)
+    try:
+        names = tuple(outputs)
+    except TypeError:
+        raise ValueError(f"outputs: {outputs!r}; give a sequence of output names") from None
+    if not all(isinstance(n, str) for n in names):
+        raise ValueError(f"outputs: {outputs!r}; give a sequence of output names (strings)")
+    return tuple(dict.fromkeys(names))
+
+
+def _recordable(model, loads) -> set:
+    """Names :func:`_record` produces for this model and loads (without tracing it)."""
+    names = set(results.RECORD_DIMS)
+    for ld in loads:
+        names |= {k for k in ld.outputs() if k != "coords"}
+    return names
+
+
 def _rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_every, record):
     TRACES["rollout"] += 1
     mem0 = _init_memories(model, loads, t0, q0, qd0, dt)
@@ -184,7 +204,11 @@ def _rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_e
 
     def saved(s, mem):
         out = (s.t, s.q, s.qd, s.qdd, s.z, s.iterations)
-        return out + ((_record(model, loads, s, mem),) if record else ())
+        if not record:
+            return out
+        rec = _record(model, loads, s, mem)
+        # a tuple of names keeps only those outputs (the compiler drops the work of the others)
+        return out + ((rec if record is True else {k: rec[k] for k in record}),)
 
     def block(carry, _):
         carry, _ = jax.lax.scan(one_step, carry, None, length=save_every)
@@ -208,7 +232,8 @@ def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=
     array parameter of ``model`` or ``loads``, ``dt``, ``q0``, ``qd0`` reuses the compiled code, and
     the function can be ``jax.vmap``-ed over a batched model or ``jax.grad``-ed (RK4, semi-implicit
     and Newmark; Beeman's while loop is forward-mode only). ``record=True`` appends a dict of
-    per-sample outputs (poses, joint reactions, energies, load diagnostics) as a 7th item.
+    per-sample outputs (poses, joint reactions, energies, load diagnostics) as a 7th item; a tuple
+    of output names (e.g. ``("point_acceleration",)``) records only those.
     """
     loads = _as_loads(loads)
     integ = _integrators.get(integrator)
@@ -492,7 +517,7 @@ def _sea_labels(seas):
 def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
                    radiation: str = "state_space", state_space_options: dict | None = None,
                    memory: float | None = None, save_every: int = 1, t0: float = 0.0,
-                   q0=None, qd0=None, loads=None) -> xr.Dataset:
+                   q0=None, qd0=None, loads=None, outputs=(), vary_loads=None) -> xr.Dataset:
     """Many runs of one topology in one compiled, ``jax.vmap``-ed call: a sweep over sea states,
     time steps and model parameters (a power matrix, a T_p sweep at dt = T_p/200, a hinge-height
     study) without retracing.
@@ -505,6 +530,15 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     radiation: "state_space" (default; its arrays have one shape whatever dt), "none", or
         "convolution" (only when every case has the same number of lags, e.g. one dt).
     loads: extra loads for every case (as in :func:`simulate`).
+    vary_loads: a function ``(case_index, loads) -> loads`` that changes load parameters per case
+        (arrays only, e.g. ``equinox.tree_at`` on the water's ``drag`` for a drag-coefficient sweep,
+        or on a wind load's speed): the cases stay one compiled, vmapped call. ``loads`` is the
+        case's tuple (its water first, then the model's and the extra loads); the structure must
+        not change.
+    outputs: names of per-sample outputs to record as well (a load's diagnostics such as
+        ``point_acceleration`` of the ``[[points]]``, or ``body_rotation``, ``joint_force``, ...:
+        the names :func:`simulate` records); only what is named is computed and kept, as
+        (case, step, ...) arrays.
     Sequences of length > 1 must agree in length B; length-1 arguments are broadcast.
 
     Returns an :class:`xarray.Dataset` with dimensions (case, step, coordinate): ``time``
@@ -543,12 +577,18 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
         raise ValueError("model: the models of a batch must share one topology and one hydro "
                          "spec (make them from one Model with equinox.tree_at)")
     integ = _integrators.get(integrator)
+    outputs = _output_names(outputs)
     extra = _as_loads(loads)
     loads = [model_loads(pick(models, i), pick(seas, i), dt=float(pick(dts, i)),
                          duration=n_steps * float(pick(dts, i)), t0=t0, ramp=float(pick(ramps, i)),
                          radiation=radiation, memory=memory,
                          state_space_options=state_space_options, integrator=integ) + extra
              for i in range(B)]
+    if vary_loads is not None:
+        if not callable(vary_loads):
+            raise ValueError(f"vary_loads: {vary_loads!r}; give a function (case_index, loads) -> "
+                             "loads")
+        loads = [tuple(vary_loads(i, ld)) for i, ld in enumerate(loads)]
     defs = {jax.tree_util.tree_structure(ld) for ld in loads}
     if len(defs) > 1:
         raise ValueError("simulate_batch: the cases' loads differ in structure (with "
@@ -562,9 +602,15 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
     batched_model = stack([pick(models, i) for i in range(B)]) if len(models) > 1 else m0
 
+    known = _recordable(m0, loads[0])
+    bad = [n for n in outputs if n not in known]
+    if bad:
+        raise ValueError(f"outputs: {bad} are not outputs of this model and its loads; accepted: "
+                         f"{sorted(known)}")
+
     def one(m_, lds, d):
         return _rollout_jit(m_, lds, q0, qd0, z0, jnp.asarray(t0, jnp.float64), d, n_steps=int(n_steps),
-                            integrator=integ, save_every=int(save_every), record=False)
+                            integrator=integ, save_every=int(save_every), record=outputs or False)
 
     out = jax.vmap(one, in_axes=(0 if len(models) > 1 else None, 0, 0))(
         batched_model, stack(loads), jnp.asarray(np.broadcast_to(dts, (B,)).copy()))
@@ -578,5 +624,6 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     settings = dict(radiation=radiation, n_steps=int(n_steps), t0=t0,
                     ramp_s=repr(ramps.tolist()), seas=repr(seas))
     labels = _sea_labels(seas) if len(seas) == B else {}
+    recorded = {k: np.asarray(v) for k, v in out[6].items()} if outputs else {}
     return results.batch(m0, [pick(models, i) for i in range(B)], loads, integ, t, q, qd, dts,
-                         settings, save_every, labels)
+                         settings, save_every, labels, recorded)

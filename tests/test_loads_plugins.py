@@ -274,3 +274,51 @@ def test_integrator_stage_offsets_drive_the_convolution():
     assert ld.rad.W_lag.shape[0] == 3 and ld.rad.stage_offsets == (0.0, 0.5, 1.0)
     ld = model_loads(m, None, dt=0.01, duration=0.1, memory=1.0, integrator="newmark")[0]
     assert ld.rad.stage_offsets == (0.0, 1.0)
+
+
+def test_simulate_batch_records_named_outputs_as_simulate_does():
+    # outputs=(...) in a batch: the same numbers simulate records (one compiled model, two seas),
+    # to round-off (1e-9 of the peak: vmapped against single evaluation); unknown names are errors
+    m = mfm.load(CONFIGS / "sphere.toml")
+    probe = BodyPointOutputs.create(m, {"hub": ("sphere", [0.0, 0.0, 1.7])})
+    seas = [hydro.Regular(height=0.05, period=T) for T in (2.5, 3.0)]
+    ds = mfm.simulate_batch(m, seas, dt=0.01, n_steps=300, ramp=1.0, loads=probe,
+                            outputs=("point_acceleration", "body_rotation"))
+    assert ds.point_acceleration.dims == ("case", "step", "point", "axis")
+    assert ds.point_acceleration.attrs["units"] == "m/s2"
+    assert "joint_force" not in ds
+    for i, sea in enumerate(seas):
+        one = mfm.simulate(m, sea, duration=3.0, dt=0.01, ramp=1.0, loads=probe,
+                           radiation="state_space")
+        for name in ("point_acceleration", "body_rotation"):
+            ref = one[name].values
+            assert np.abs(ds[name].values[i] - ref).max() <= 1e-9 * np.abs(ref).max(), name
+    with pytest.raises(ValueError, match="outputs: \\['hub_speed'\\]"):
+        mfm.simulate_batch(m, seas, dt=0.01, n_steps=10, outputs=("hub_speed",))
+
+
+def test_simulate_batch_varies_load_parameters_per_case(tmp_path):
+    # vary_loads: the water's drag set per case equals a model whose config has that drag (one
+    # compiled batch against two loads of the config); the structure must not change
+    import equinox as eqx
+    text = (CONFIGS / "sphere.toml").read_text().replace('"../hydro/data/sphere.nc"',
+                                                           f'"{SPHERE_DB.as_posix()}"')
+    assert "[bodies.hydro]" not in text
+    text += '\n[bodies.hydro]\ndrag_coefficient = [1.0, 1.0, 1.0]\ndrag_area = [3.0, 3.0, 3.0]\n'
+    (tmp_path / "drag.toml").write_text(text)
+    m = mfm.load(CONFIGS / "sphere.toml")
+    md = mfm.load(tmp_path / "drag.toml")
+    sea = hydro.Regular(height=0.3, period=3.0)
+    scale = [0.0, 1.0]
+
+    def with_drag(i, loads):
+        water = loads[0]
+        return (eqx.tree_at(lambda w: w.drag, water, water.drag + scale[i] * 0.5 * 1000.0 * 3.0),) + loads[1:]
+
+    ds = mfm.simulate_batch(m, [sea, sea], dt=0.02, n_steps=300, ramp=1.0, vary_loads=with_drag)
+    for i, mm in enumerate((m, md)):
+        one = mfm.simulate(mm, sea, duration=6.0, dt=0.02, ramp=1.0, radiation="state_space")
+        assert np.abs(ds.q.values[i] - one.q.values).max() <= 1e-9 * np.abs(one.q.values).max()
+    assert np.abs(ds.q.values[1] - ds.q.values[0]).max() > 1e-3 * np.abs(ds.q.values[0]).max()
+    with pytest.raises(ValueError, match="vary_loads"):
+        mfm.simulate_batch(m, sea, dt=0.02, n_steps=10, vary_loads="drag")
