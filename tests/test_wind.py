@@ -207,7 +207,8 @@ GOOD = {"body": '"platform"', "hub": "[0, 0, 90]", "rotor_radius": "63", "wind_s
     ("thrust_coefficient", "5.0", r"wind_thrust\[0\]\.thrust_coefficient: 5\.0; give a number in"),
     ("thrust_coefficient", "[0.7]", r"wind_thrust\[0\]\.thrust_coefficient: \[0\.7\]"),
     ("thrust_coefficient", '"missing.csv"', r"wind_thrust\[0\]\.thrust_coefficient: .*missing\.csv"),
-    ("thrust_coefficient", '"bad.csv"', r"wind_thrust\[0\]\.thrust_coefficient: .*needs columns wind_speed_mps and Ct"),
+    ("thrust_coefficient", '"bad.csv"',
+     r"wind_thrust\[0\]\.thrust_coefficient: .*needs columns wind_speed_mps and Ct"),
     ("thrust_coefficient", '"down.csv"', r"wind_thrust\[0\]\.thrust_coefficient: .*must increase"),
 ])
 def test_config_errors_name_the_key(tmp_path, key, value, match):
@@ -288,9 +289,11 @@ def test_vmap_over_wind_speeds():
     batch = jax.vmap(w.with_wind_speed)(jnp.asarray(Us))
     kin = mfm.kinematics(m, jnp.zeros(1), jnp.zeros(1))
 
+    zero = jnp.zeros(1)
+
     @jax.jit
     def surge_force(ld):
-        return ld.evaluate(mfm.loads.Context(m, 0.0, jnp.zeros(1), jnp.zeros(1), jnp.zeros(0), kin)).body[0, 0]
+        return ld.evaluate(mfm.loads.Context(m, 0.0, zero, zero, jnp.zeros(0), kin)).body[0, 0]
 
     got = np.asarray(jax.vmap(surge_force)(batch))
     expected = np.array([thrust(U) for U in Us])
