@@ -6,7 +6,7 @@ frequency domain from one definition.
   :func:`mfm.simulate.model_loads`), radiation as a strategy (:mod:`mfm.loads.radiation`);
 - :class:`PointSprings` (``[[moorings]]``), :class:`HydraulicPTO` (``[[ptos]]``),
   :class:`LinearBodyMatrix` (``[[body_matrices]]``), :class:`JointLoad` (``[[joint_loads]]``),
-  :class:`BodyPointOutputs` (``[[points]]``);
+  :class:`BodyPointOutputs` (``[[points]]``), :class:`WindThrust` (``[[wind_thrust]]``);
 - :class:`BodyWrench`, :class:`CoordinateForceSeries`: loads given directly (``loads=``).
 """
 from .base import Context, FrequencyTerms, Load, LoadOutput
@@ -17,7 +17,8 @@ from .joint_load import JointLoad
 from .mooring import PointSprings
 from .probes import BodyPointOutputs
 from .registry import TABLES, load_class
+from .wind import WindThrust
 
 __all__ = ["BodyPointOutputs", "BodyWrench", "Context", "CoordinateForceSeries", "FrequencyTerms",
            "HydraulicPTO", "JointLoad", "LinearBodyMatrix", "Load", "LoadOutput", "PointSprings",
-           "TABLES", "load_class"]
+           "TABLES", "WindThrust", "load_class"]
