@@ -15,6 +15,7 @@ TABLES = {
     "body_matrices": ("mfm.loads.body_matrix", "LinearBodyMatrix"),
     "joint_loads": ("mfm.loads.joint_load", "JointLoad"),
     "points": ("mfm.loads.probes", "BodyPointOutputs"),
+    "catenary_lines": ("mfm.loads.catenary", "CatenaryLines"),
 }
 
 
