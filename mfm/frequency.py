@@ -95,14 +95,26 @@ def _equilibrium(model, loads, q_guess=None, tol=1e-10, max_iter=50):
                                                  gravity_loads(model))))),
                 float(jnp.max(model.mass)) * float(model.gravity))
     it = 0
+    q_ok = q
     for it in range(max_iter):
         g = np.asarray(Gj(q))
+        if not np.isfinite(g).all():
+            break
+        q_ok = q
         if np.abs(g).max() < tol * scale:
             break
         J = np.asarray(Jj(q))
         step = np.linalg.lstsq(J, -g, rcond=1e-10)[0]
         q = q + jnp.asarray(step)
     g = np.asarray(Gj(q))
+    if not np.isfinite(g).all():
+        # a load undefined there (a catenary line's fairlead outside its table): say which
+        for q_at in (q, q_ok):
+            for ld in loads:
+                cause = ld.describe_nonfinite(model, np.asarray(q_at), np.zeros(model.n_coordinates))
+                if cause:
+                    raise ValueError(f"no static equilibrium of {model.name!r} found: the static "
+                                     f"loads went non-finite at q = {np.asarray(q).tolist()}. {cause}")
     J = np.asarray(Jj(q))
     free = [model.coordinates[k] for k in range(model.n_coordinates)
             if np.abs(J[:, k]).max() < 1e-12 * scale]

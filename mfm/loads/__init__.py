@@ -6,11 +6,13 @@ frequency domain from one definition.
   :func:`mfm.simulate.model_loads`), radiation as a strategy (:mod:`mfm.loads.radiation`);
 - :class:`PointSprings` (``[[moorings]]``), :class:`HydraulicPTO` (``[[ptos]]``),
   :class:`LinearBodyMatrix` (``[[body_matrices]]``), :class:`JointLoad` (``[[joint_loads]]``),
-  :class:`BodyPointOutputs` (``[[points]]``), :class:`WindThrust` (``[[wind_thrust]]``);
+  :class:`BodyPointOutputs` (``[[points]]``), :class:`WindThrust` (``[[wind_thrust]]``),
+  :class:`CatenaryLines` (``[[catenary_lines]]``: quasi-static MoorPy lines, tabulated);
 - :class:`BodyWrench`, :class:`CoordinateForceSeries`: loads given directly (``loads=``).
 """
 from .base import Context, FrequencyTerms, Load, LoadOutput
 from .body_matrix import LinearBodyMatrix
+from .catenary import CatenaryLines
 from .generic import BodyWrench, CoordinateForceSeries
 from .hydraulic_pto import HydraulicPTO
 from .joint_load import JointLoad
@@ -19,6 +21,6 @@ from .probes import BodyPointOutputs
 from .registry import TABLES, load_class
 from .wind import WindThrust
 
-__all__ = ["BodyPointOutputs", "BodyWrench", "Context", "CoordinateForceSeries", "FrequencyTerms",
-           "HydraulicPTO", "JointLoad", "LinearBodyMatrix", "Load", "LoadOutput", "PointSprings",
+__all__ = ["BodyPointOutputs", "BodyWrench", "CatenaryLines", "Context", "CoordinateForceSeries",
+           "FrequencyTerms", "HydraulicPTO", "JointLoad", "LinearBodyMatrix", "Load", "LoadOutput", "PointSprings",
            "TABLES", "WindThrust", "load_class"]

@@ -16,6 +16,7 @@ TABLES = {
     "joint_loads": ("mfm.loads.joint_load", "JointLoad"),
     "points": ("mfm.loads.probes", "BodyPointOutputs"),
     "wind_thrust": ("mfm.loads.wind", "WindThrust"),
+    "catenary_lines": ("mfm.loads.catenary", "CatenaryLines"),
 }
 
 
