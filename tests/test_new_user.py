@@ -291,23 +291,31 @@ def test_swapped_hydro_names_are_found_and_shipped_configs_pass():
 
 
 # ------------------------------------------------------------------------------ command line
-def test_cli_module_imports_nothing_heavy_before_parsing():
-    """--help and --version need neither numpy nor jax (mfm/cli.py loaded on its own; the
-    package's __init__ is the other half of a fast `mfm --help`)."""
-    code = ("import importlib.util, sys, io, contextlib\n"
-            "spec = importlib.util.spec_from_file_location('cli_alone', 'mfm/cli.py')\n"
-            "m = importlib.util.module_from_spec(spec); spec.loader.exec_module(m)\n"
+def test_help_and_version_import_neither_mfm_nor_jax():
+    """The console script's entry (pyproject's [project.scripts]) answers --help and --version
+    with the standard library only: mfm/__init__ (jax, ~2 s) is not run."""
+    import tomllib
+
+    entry = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["scripts"]["mfm"]
+    module, func = entry.split(":")
+    code = ("import sys, importlib\n"
+            f"main = getattr(importlib.import_module({module!r}), {func!r})\n"
             "for argv in (['--help'], ['--version'], ['simulate', '--help']):\n"
             "    try:\n"
-            "        m.main(argv)\n"
+            "        main(argv)\n"
             "    except SystemExit as e:\n"
             "        assert e.code == 0, argv\n"
-            "heavy = [k for k in ('numpy', 'jax', 'xarray', 'matplotlib') if k in sys.modules]\n"
+            "heavy = [k for k in ('mfm', 'numpy', 'jax', 'xarray', 'matplotlib') if k in sys.modules]\n"
             "assert not heavy, heavy\n")
     r = _run(code)
     assert r.returncode == 0, r.stderr
     assert "mfm 0." in r.stdout or "mfm unknown" in r.stdout
     assert "--no-plot" in r.stdout
+    # the old entry points are the same function
+    import mfm.cli
+    import mfm_cli
+
+    assert mfm.cli.main is mfm_cli.main
 
 
 @pytest.mark.parametrize("argv, match", [
