@@ -34,6 +34,24 @@ NONNEGATIVE = _number("a number ≥ 0", minimum=0.0, strict=False)
 FINITE = _number("a finite number")
 
 
+# the bar of `mfm simulate --progress auto`: a short run shows none, a log gets a line a while
+PROGRESS_DELAY_TTY, PROGRESS_DELAY_LOG, PROGRESS_INTERVAL_LOG = 2.0, 5.0, 10.0
+
+
+def progress_option(choice: str, stream=None):
+    """``mfm simulate --progress`` as the ``progress`` argument of :func:`mfm.simulate`."""
+    if choice == "off":
+        return False
+    if choice == "on":
+        return True
+    if choice != "auto":
+        raise ValueError(f"--progress {choice!r}; accepted: auto, on, off")
+    stream = sys.stderr if stream is None else stream
+    if getattr(stream, "isatty", lambda: False)():
+        return {"delay": PROGRESS_DELAY_TTY}
+    return {"delay": PROGRESS_DELAY_LOG, "mininterval": PROGRESS_INTERVAL_LOG}
+
+
 def _count(minimum):
     return _number(f"a whole number ≥ {minimum}", minimum=minimum, strict=False, integer=True)
 
@@ -93,6 +111,10 @@ def build_parser():
     p.add_argument("--out", default="out/simulation.nc", help="NetCDF output (default out/simulation.nc)")
     p.add_argument("--no-plot", action="store_true",
                    help="do not draw the figure (PNG beside --out: q, PTO power, spectra)")
+    p.add_argument("--progress", choices=["auto", "on", "off"], default="auto",
+                   help="progress bar on stderr; auto (default): on a terminal once the run has "
+                   f"taken {PROGRESS_DELAY_TTY:g} s, elsewhere (a log, a pipe) once it has taken "
+                   f"{PROGRESS_DELAY_LOG:g} s, refreshed every {PROGRESS_INTERVAL_LOG:g} s")
     p.set_defaults(func="cmd_simulate")
     p = sub.add_parser("rao", help="frequency-domain RAOs and natural frequencies (NetCDF)")
     p.add_argument("config")

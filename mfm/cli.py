@@ -10,7 +10,7 @@ import sys
 import time
 from pathlib import Path
 
-from mfm_cli import build_parser, main  # noqa: F401  (the entry point, re-exported)
+from mfm_cli import build_parser, main, progress_option  # noqa: F401  (main: re-exported)
 
 LENGTH_SUFFIXES = ("surge", "sway", "heave", "stroke")
 
@@ -174,7 +174,8 @@ def cmd_simulate(args):
         ds = mfm.simulate(model, sea, duration=args.duration, dt=args.dt, integrator=args.integrator,
                           q0=_pairs(args.initial, "--initial"),
                           qd0=_pairs(args.initial_velocity, "--initial-velocity"),
-                          save_every=args.save_every, ramp=args.ramp, radiation=args.radiation)
+                          save_every=args.save_every, ramp=args.ramp, radiation=args.radiation,
+                          progress=progress_option(args.progress))
     except mfm.SimulationError as e:
         # keep what was computed: the run up to the last finite sample, marked incomplete
         if e.dataset is not None:
