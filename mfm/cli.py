@@ -202,11 +202,24 @@ def cmd_simulate(args):
     if "pto_power" in ds:
         for p in ds.pto.values:
             print(f"  mean power of {p}: {float(half.pto_power.sel(pto=p).mean()):.6g} W")
+    print("  " + _restoring_text(ds.attrs.get("no_restoring", "not checked")))
     if not args.no_plot:
         from mfm.plotting import save_result_plot
 
         save_result_plot(ds, png)
         print(f"  figure -> {png}")
+
+
+def _restoring_text(no_restoring: str) -> str:
+    """The run summary's line on free drift, from the dataset's ``no_restoring`` attribute (the
+    coordinates :func:`mfm.simulate` found nothing pulls back, at q0)."""
+    if no_restoring == "not checked":
+        return "restoring not checked (check_stability=False)"
+    if not no_restoring:
+        return "every coordinate has restoring (at q0)"
+    return (f"no restoring in {no_restoring} (at q0): nothing pulls back, so its mean and last "
+            "values are a drift after the start-up transient (wave drift, any mean load), not an "
+            "offset; add a mooring ([[moorings]]) or a joint spring if it must stay bounded")
 
 
 def _peak_text(omega, a, unit):

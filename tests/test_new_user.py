@@ -398,6 +398,26 @@ damping = 0.1
     assert "cart.stroke [m]  (damper 0.1 N s/m)" in out and "arm.angle [rad]" in out
 
 
+def test_rm3_spar_surge_drift_said_by_info_and_the_run_summary(tmp_path, capsys):
+    """RM3 has no surge restoring (no mooring): `mfm info` and the `mfm simulate` summary name
+    spar.surge, and only it; the result file carries the same list."""
+    from mfm.cli import main
+
+    assert main(["info", str(CONFIGS / "rm3.toml")]) == 0
+    out = capsys.readouterr().out
+    assert "with the water" in out
+    line, = [ln for ln in out.splitlines() if "no restoring in" in ln]
+    assert line.startswith("  no restoring in spar.surge: nothing pulls")
+    nc = tmp_path / "rm3.nc"
+    assert main(["simulate", str(CONFIGS / "rm3.toml"), "--duration", "2", "--dt", "0.1",
+                 "--no-plot", "--out", str(nc)]) == 0
+    out = capsys.readouterr().out
+    line, = [ln for ln in out.splitlines() if "restoring" in ln]
+    assert line.startswith("  no restoring in spar.surge (at q0): nothing pulls back, so its mean")
+    with xr.open_dataset(nc) as ds:
+        assert ds.attrs["no_restoring"] == "spar.surge"
+
+
 def test_plot_result_files(tmp_path, capsys):
     """`mfm simulate` draws its PNG beside the NetCDF; `mfm plot` draws simulation, RAO and
     batch files."""
@@ -546,6 +566,8 @@ def test_cli_progress_choice(tmp_path, capsys):
     argv = ["simulate", str(CONFIGS / "double_pendulum.toml"), "--duration", "0.5", "--dt", "0.01",
             "--no-plot", "--out", str(tmp_path / "dp.nc")]
     assert main(argv + ["--progress", "on"]) == 0
-    assert "50/50" in capsys.readouterr().err
+    out, err = capsys.readouterr()
+    assert "50/50" in err
+    assert "  every coordinate has restoring (at q0)" in out
     assert main(argv) == 0                                   # auto, not a terminal, a short run
     assert "50/50" not in capsys.readouterr().err
