@@ -297,8 +297,14 @@ def _run_chunked(start, chunk, n_blocks, save_every, bar, time_axis):
             pieces.append(traj)
             done += take
             if done == take:
-                bar.set_postfix_str("")
-            bar.update(take * save_every)
+                # the first chunk compiled: rate, elapsed and ETA count from here, else the
+                # compilation (seconds to a minute) shows as slow steps and a far-off ETA
+                compiled = bar.format_dict["elapsed"]
+                bar.reset(total=bar.total)
+                bar.initial = bar.n = bar.last_print_n = take * save_every
+                bar.set_postfix_str(f"compiled in {compiled:.0f} s")
+            else:
+                bar.update(take * save_every)
             if not (np.isfinite(traj[1]).all() and np.isfinite(traj[2]).all()):
                 break
     finally:
