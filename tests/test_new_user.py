@@ -544,6 +544,10 @@ def test_progress_bar_keeps_a_diverging_run_and_a_batch_exact(capsys):
     kw = dict(dt=[0.01, 0.02], n_steps=211, q0={"upper.angle": 0.5})
     _same_numbers(mfm.simulate_batch(m, None, **kw), mfm.simulate_batch(m, None, progress=True, **kw))
     assert "× 2" in capsys.readouterr().err
+    models = [m, m.replace(damping=m.damping + 0.3)]         # a batch over models too
+    kw = dict(dt=0.01, n_steps=211, q0={"upper.angle": 0.5})
+    _same_numbers(mfm.simulate_batch(models, None, **kw),
+                  mfm.simulate_batch(models, None, progress=True, **kw))
 
 
 def test_cli_progress_choice(tmp_path, capsys):
