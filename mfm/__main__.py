@@ -1,6 +1,7 @@
-"""``python -m mfm ...`` is the ``mfm`` command."""
+"""``python -m mfm ...`` is the ``mfm`` command (it imports the package, jax included, first:
+the ``mfm`` console script answers ``--help`` faster)."""
 import sys
 
-from mfm.cli import main
+from mfm_cli import main
 
 sys.exit(main())

@@ -1,15 +1,16 @@
-"""Command line: ``mfm info | simulate | rao | hydro | plot``.
+"""Command line: ``mfm info | simulate | rao | hydro | plot``: the commands.
 
-Nothing heavy (numpy, jax, xarray, matplotlib) is imported before the arguments are parsed, so
-``mfm --help`` and a mistyped argument answer at once; each command imports what it needs.
+The parser and the entry point are in the top-level module :mod:`mfm_cli` (importing this module
+imports the ``mfm`` package, and with it jax); ``main`` and ``build_parser`` are re-exported
+here. Each command imports the rest of what it needs (xarray, matplotlib, hydro) itself.
 """
 from __future__ import annotations
 
-import argparse
-import math
 import sys
 import time
 from pathlib import Path
+
+from mfm_cli import build_parser, main, progress_option  # noqa: F401  (main: re-exported)
 
 LENGTH_SUFFIXES = ("surge", "sway", "heave", "stroke")
 
@@ -18,44 +19,6 @@ def _unit(coordinate: str) -> str:
     """SI unit of a coordinate from its name: root surge/sway/heave and prismatic strokes are
     lengths, everything else (roll, pitch, yaw, revolute angles) angles."""
     return "m" if coordinate.rsplit(".", 1)[-1] in LENGTH_SUFFIXES else "rad"
-
-
-def _number(kind, *, minimum=None, strict=True, integer=False):
-    """argparse type: a finite number (> or ≥ minimum); the error names the value and the range."""
-    def parse(text):
-        try:
-            v = int(text) if integer else float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not {'a whole number' if integer else 'a number'}") from None
-        if not math.isfinite(v):
-            raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
-        if minimum is not None and (v <= minimum if strict else v < minimum):
-            raise argparse.ArgumentTypeError(f"{text!r} is out of range; give {kind}")
-        return v
-    parse.__name__ = kind               # argparse names the type in some messages
-    return parse
-
-
-POSITIVE = _number("a positive number", minimum=0.0)
-NONNEGATIVE = _number("a number ≥ 0", minimum=0.0, strict=False)
-FINITE = _number("a finite number")
-
-
-def _count(minimum):
-    return _number(f"a whole number ≥ {minimum}", minimum=minimum, strict=False, integer=True)
-
-
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    def v(pkg):
-        try:
-            return version(pkg)
-        except PackageNotFoundError:
-            return "not installed"
-
-    return (f"mfm {v('mfm')} (python {sys.version.split()[0]}, jax {v('jax')}, capytaine "
-            f"{v('capytaine')}: the BEM extra, only for `mfm hydro`)")
 
 
 def _writable(path, what="--out", suffixes=(".nc",)) -> Path:
@@ -211,7 +174,8 @@ def cmd_simulate(args):
         ds = mfm.simulate(model, sea, duration=args.duration, dt=args.dt, integrator=args.integrator,
                           q0=_pairs(args.initial, "--initial"),
                           qd0=_pairs(args.initial_velocity, "--initial-velocity"),
-                          save_every=args.save_every, ramp=args.ramp, radiation=args.radiation)
+                          save_every=args.save_every, ramp=args.ramp, radiation=args.radiation,
+                          progress=progress_option(args.progress))
     except mfm.SimulationError as e:
         # keep what was computed: the run up to the last finite sample, marked incomplete
         if e.dataset is not None:
@@ -238,11 +202,24 @@ def cmd_simulate(args):
     if "pto_power" in ds:
         for p in ds.pto.values:
             print(f"  mean power of {p}: {float(half.pto_power.sel(pto=p).mean()):.6g} W")
+    print("  " + _restoring_text(ds.attrs.get("no_restoring", "not checked")))
     if not args.no_plot:
         from mfm.plotting import save_result_plot
 
         save_result_plot(ds, png)
         print(f"  figure -> {png}")
+
+
+def _restoring_text(no_restoring: str) -> str:
+    """The run summary's line on free drift, from the dataset's ``no_restoring`` attribute (the
+    coordinates :func:`mfm.simulate` found nothing pulls back, at q0)."""
+    if no_restoring == "not checked":
+        return "restoring not checked (check_stability=False)"
+    if not no_restoring:
+        return "every coordinate has restoring (at q0)"
+    return (f"no restoring in {no_restoring} (at q0): nothing pulls back, so its mean and last "
+            "values are a drift after the start-up transient (wave drift, any mean load), not an "
+            "offset; add a mooring ([[moorings]]) or a joint spring if it must stay bounded")
 
 
 def _peak_text(omega, a, unit):
@@ -322,91 +299,6 @@ def cmd_plot(args):
     fig = plot_layout(model)
     fig.savefig(out, dpi=args.dpi)
     print(f"layout of {model.name} -> {out}")
-
-
-def build_parser():
-    ap = argparse.ArgumentParser(prog="mfm", description="Floating multi-body systems by the Moving "
-                                 "Frame Method. Units are SI (m, rad, s, kg, N, W); headings in "
-                                 "degrees on the command line.")
-    ap.add_argument("--version", action="version", version=_version())
-    sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    p = sub.add_parser("info", help="print the tree, coordinates, masses and which coordinates "
-                       "have no restoring")
-    p.add_argument("config")
-    p.add_argument("--no-hydro", action="store_true", help="mechanics only (skip the database)")
-    p.add_argument("--no-restoring", action="store_true",
-                   help="skip the static-stiffness check (it compiles the model: ~10-30 s)")
-    p.set_defaults(func=cmd_info)
-    p = sub.add_parser("simulate", help="simulate a config; write the results as NetCDF and a "
-                       "figure beside them (PNG)")
-    p.add_argument("config")
-    p.add_argument("--duration", type=POSITIVE, default=10.0, help="s (default 10)")
-    p.add_argument("--dt", type=POSITIVE, default=0.01, help="time step, s (default 0.01)")
-    p.add_argument("--integrator", default="rk4", choices=["rk4", "beeman", "semi_implicit", "newmark"])
-    p.add_argument("--initial", action="append", metavar="NAME=VALUE",
-                   help="initial coordinate (m or rad), repeatable, e.g. --initial upper.angle=0.3")
-    p.add_argument("--initial-velocity", action="append", metavar="NAME=VALUE",
-                   help="initial rate (m/s or rad/s), repeatable")
-    p.add_argument("--save-every", type=_count(1), default=1, help="keep every k-th step")
-    p.add_argument("--wave", choices=["regular", "jonswap"], help="sea state (default: still water)")
-    p.add_argument("--height", type=POSITIVE, help="regular wave height H, m")
-    p.add_argument("--period", type=POSITIVE, help="regular wave period T, s")
-    p.add_argument("--hs", type=POSITIVE, help="JONSWAP significant wave height, m")
-    p.add_argument("--tp", type=POSITIVE, help="JONSWAP peak period, s")
-    p.add_argument("--gamma", type=_number("a number ≥ 1", minimum=1.0, strict=False), default=3.3,
-                   help="JONSWAP peak enhancement (default 3.3)")
-    p.add_argument("--seed", type=_count(0), default=0, help="random phases seed (default 0)")
-    p.add_argument("--components", type=_count(1), help="number of wave components")
-    p.add_argument("--heading", type=FINITE, default=0.0, help="wave heading, degrees (0 = towards +x)")
-    p.add_argument("--ramp", type=NONNEGATIVE, default=0.0, help="start-up ramp of the excitation, s")
-    p.add_argument("--radiation", default="convolution", choices=["convolution", "state_space", "none"])
-    p.add_argument("--no-body-coupling", action="store_true",
-                   help="drop the hydrodynamic interaction between bodies")
-    p.add_argument("--out", default="out/simulation.nc", help="NetCDF output (default out/simulation.nc)")
-    p.add_argument("--no-plot", action="store_true",
-                   help="do not draw the figure (PNG beside --out: q, PTO power, spectra)")
-    p.set_defaults(func=cmd_simulate)
-    p = sub.add_parser("rao", help="frequency-domain RAOs and natural frequencies (NetCDF)")
-    p.add_argument("config")
-    p.add_argument("--omega-min", type=POSITIVE, required=True, help="rad/s, > 0")
-    p.add_argument("--omega-max", type=POSITIVE, required=True, help="rad/s, > omega-min")
-    p.add_argument("--n", type=_count(2), default=100, help="number of frequencies, ≥ 2 (default 100)")
-    p.add_argument("--heading", type=FINITE, default=0.0, help="degrees")
-    p.add_argument("--radiation", default="database", choices=["database", "convolution", "state_space"])
-    p.add_argument("--no-body-coupling", action="store_true")
-    p.add_argument("--out", default="out/rao.nc")
-    p.set_defaults(func=cmd_rao)
-    p = sub.add_parser("hydro", help="generate the config's hydro database with capytaine "
-                       "(the 'bem' extra: pip install -e \".[bem]\")")
-    p.add_argument("config")
-    p.add_argument("--out", help="NetCDF path (default: the config's [hydro] database)")
-    p.add_argument("--force", action="store_true", help="solve again even if up to date")
-    p.add_argument("--threads", type=_count(1), help="threads per BEM solve (default: all cores)")
-    p.set_defaults(func=cmd_hydro)
-    p = sub.add_parser("plot", help="a config's layout (plan and side view), or a result file: "
-                       "time series and spectra (simulate), RAOs (rao), mean power per case "
-                       "(batch); PNG")
-    p.add_argument("config", metavar="CONFIG_OR_RESULT", help="a .toml config or a .nc result")
-    p.add_argument("--out", help="PNG file (default: beside a result, or the config's name in the "
-                   "current directory)")
-    p.add_argument("--dpi", type=_count(10), default=120)
-    p.set_defaults(func=cmd_plot)
-    return ap
-
-
-def main(argv=None):
-    args = build_parser().parse_args(argv)
-    try:
-        args.func(args)
-    except Exception as e:  # config and simulation errors: one clear line, exit code 2
-        from mfm import ConfigError, SimulationError
-
-        if isinstance(e, (ConfigError, SimulationError, ValueError, KeyError, OSError, ImportError)):
-            msg = e.args[0] if isinstance(e, KeyError) and e.args else e
-            print(f"mfm {args.command}: error: {msg}", file=sys.stderr)
-            return 2
-        raise
-    return 0
 
 
 if __name__ == "__main__":

@@ -7,8 +7,10 @@ went non-finite, and returns an :class:`xarray.Dataset`.
 from __future__ import annotations
 
 import collections
+import functools
 import math
 import numbers
+import sys
 import warnings
 from typing import Sequence
 
@@ -192,35 +194,146 @@ def _recordable(model, loads) -> set:
     return names
 
 
-def _rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_every, record):
-    TRACES["rollout"] += 1
+def _saved(model, loads, s, mem, record):
+    """The outputs kept of one saved state."""
+    out = (s.t, s.q, s.qd, s.qdd, s.z, s.iterations)
+    if not record:
+        return out
+    rec = _record(model, loads, s, mem)
+    # a tuple of names keeps only those outputs (the compiler drops the work of the others)
+    return out + ((rec if record is True else {k: rec[k] for k in record}),)
+
+
+def _rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, record):
+    """The initial carry (integrator state, load memories) and its saved outputs."""
     mem0 = _init_memories(model, loads, t0, q0, qd0, dt)
     state = integrator.init(dynamics_function(model, loads, mem0), t0, q0, qd0, z0)
+    return (state, mem0), _saved(model, loads, state, mem0, record)
+
+
+def _rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, record):
+    """``n_blocks`` blocks of ``save_every`` steps from ``carry``: (carry, the saved outputs of
+    each block's last step, stacked)."""
 
     def one_step(carry, _):
         s, mem = carry
         s = integrator.step(dynamics_function(model, loads, mem), s, dt)
         return (s, _update_memories(model, loads, s, mem)), None
 
-    def saved(s, mem):
-        out = (s.t, s.q, s.qd, s.qdd, s.z, s.iterations)
-        if not record:
-            return out
-        rec = _record(model, loads, s, mem)
-        # a tuple of names keeps only those outputs (the compiler drops the work of the others)
-        return out + ((rec if record is True else {k: rec[k] for k in record}),)
-
     def block(carry, _):
         carry, _ = jax.lax.scan(one_step, carry, None, length=save_every)
-        return carry, saved(*carry)
+        return carry, _saved(model, loads, *carry, record)
 
-    _, traj = jax.lax.scan(block, (state, mem0), None, length=n_steps // save_every)
-    first = saved(state, mem0)
+    return jax.lax.scan(block, carry, None, length=n_blocks)
+
+
+def _rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_every, record):
+    TRACES["rollout"] += 1
+    carry, first = _rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, record)
+    _, traj = _rollout_blocks(model, loads, carry, dt, n_steps // save_every, integrator,
+                              save_every, record)
     return jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), first, traj)
 
 
 _rollout_jit = jax.jit(_rollout_impl,
                        static_argnames=("n_steps", "integrator", "save_every", "record"))
+
+
+# The chunked rollout of a progress bar: the same start and blocks, compiled as two functions
+# (the blocks one once for the chunk length), called from the host between bar updates.
+def _chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every, record):
+    TRACES["rollout_chunk"] += 1
+    return _rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, record)
+
+
+_start_jit = jax.jit(_rollout_start, static_argnames=("integrator", "record"))
+_chunk_jit = jax.jit(_chunk_impl, static_argnames=("n_blocks", "integrator", "save_every", "record"))
+
+
+@functools.partial(jax.jit, static_argnames=("model_axis", "integrator", "record"))
+def _start_batch_jit(model, loads, q0, qd0, z0, t0, dt, *, model_axis, integrator, record):
+    return jax.vmap(lambda m, lds, d: _rollout_start(m, lds, q0, qd0, z0, t0, d, integrator, record),
+                    in_axes=(model_axis, 0, 0))(model, loads, dt)
+
+
+@functools.partial(jax.jit, static_argnames=("model_axis", "n_blocks", "integrator", "save_every",
+                                             "record"))
+def _chunk_batch_jit(model, loads, carry, dt, *, model_axis, n_blocks, integrator, save_every,
+                     record):
+    TRACES["rollout_chunk"] += 1
+    return jax.vmap(lambda m, lds, c, d: _rollout_blocks(m, lds, c, d, n_blocks, integrator,
+                                                         save_every, record),
+                    in_axes=(model_axis, 0, 0, 0))(model, loads, carry, dt)
+
+
+def chunk_plan(n_blocks: int, fewest: int = 20, most: int = 100) -> tuple[int, int]:
+    """(chunk length in saved blocks, number of chunks) for a progress bar: between ``fewest``
+    and ``most`` updates, the length that wastes the fewest blocks past the end (the last chunk
+    has the same length, so one compilation serves every chunk; its extra blocks are dropped)."""
+    if n_blocks <= fewest:
+        return 1, n_blocks
+    lengths = range(-(-n_blocks // most), -(-n_blocks // fewest) + 1)
+    c = min(lengths, key=lambda c: (-(-n_blocks // c) * c - n_blocks, c))
+    return c, -(-n_blocks // c)
+
+
+def _progress_options(progress):
+    """The tqdm options of ``progress`` (True, or a dict of tqdm options), or None for no bar."""
+    if progress is None or progress is False:
+        return None
+    if progress is True:
+        return {}
+    if isinstance(progress, dict):
+        return dict(progress)
+    raise ValueError(f"progress: {progress!r}; give False (no bar, the default), True (a bar on "
+                     "stderr) or a dict of tqdm options, e.g. {'delay': 5}")
+
+
+def _progress_bar(options, total, desc):
+    """A tqdm bar on stderr with ``options`` (from :func:`_progress_options`), or None."""
+    if options is None:
+        return None
+    from tqdm.auto import tqdm
+
+    try:
+        return tqdm(**{"total": total, "unit": "step", "desc": desc, "file": sys.stderr, **options})
+    except (TypeError, KeyError) as e:     # tqdm's TqdmKeyError for an unknown option
+        raise ValueError(f"progress: {options!r} is not a set of tqdm options ({e})") from None
+
+
+def _run_chunked(start, chunk, n_blocks, save_every, bar, time_axis):
+    """Run ``start()`` then ``chunk(carry, c)`` (``c`` blocks, from :func:`chunk_plan`) until
+    ``n_blocks`` are done,
+    updating ``bar`` between chunks; stops early once a chunk has a non-finite q or q̇ (the caller
+    finds where). Returns the saved outputs as numpy, the initial state first, as the unchunked
+    rollout does: the same compiled steps in the same order, so the same numbers."""
+    c, n_chunks = chunk_plan(n_blocks)
+    bar.set_postfix_str("compiling")
+    carry, first = start()
+    pieces = [jax.tree_util.tree_map(lambda a: np.expand_dims(np.asarray(a), time_axis), first)]
+    done = 0
+    try:
+        for _ in range(n_chunks):
+            carry, traj = chunk(carry, c)
+            take = min(c, n_blocks - done)
+            cut = (slice(None),) * time_axis + (slice(0, take),)
+            traj = jax.tree_util.tree_map(lambda a: np.asarray(a)[cut], traj)
+            pieces.append(traj)
+            done += take
+            if done == take:
+                # the first chunk compiled: rate, elapsed and ETA count from here, else the
+                # compilation (seconds to a minute) shows as slow steps and a far-off ETA
+                compiled = bar.format_dict["elapsed"]
+                bar.reset(total=bar.total)
+                bar.initial = bar.n = bar.last_print_n = take * save_every
+                bar.set_postfix_str(f"compiled in {compiled:.0f} s")
+            else:
+                bar.update(take * save_every)
+            if not (np.isfinite(traj[1]).all() and np.isfinite(traj[2]).all()):
+                break
+    finally:
+        bar.close()
+    return jax.tree_util.tree_map(lambda *a: np.concatenate(a, axis=time_axis), *pieces)
 
 
 def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=None,
@@ -251,6 +364,20 @@ def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=
                         jnp.asarray(t0, jnp.float64), jnp.asarray(dt, jnp.float64),
                         n_steps=int(n_steps), integrator=integ, save_every=int(save_every),
                         record=record)
+
+
+def _rollout_progress(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0, bar):
+    """:func:`rollout` (``record=True``) in chunks with a progress bar: numpy outputs, the same
+    values; it stops early once the state is non-finite."""
+    parts = [ld.initial_state(model) for ld in loads]
+    z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
+    q0, qd0 = jnp.asarray(q0, jnp.float64), jnp.asarray(qd0, jnp.float64)
+    t0, dt = jnp.asarray(t0, jnp.float64), jnp.asarray(dt, jnp.float64)
+    return _run_chunked(
+        lambda: _start_jit(model, loads, q0, qd0, z0, t0, dt, integrator=integrator, record=True),
+        lambda carry, c: _chunk_jit(model, loads, carry, dt, n_blocks=c, integrator=integrator,
+                                    save_every=save_every, record=True),
+        n_steps // save_every, save_every, bar, time_axis=0)
 
 
 def _check_concrete_positive(value, what):
@@ -392,7 +519,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
              q0=None, qd0=None, loads=None, save_every: int = 1, t0: float = 0.0,
              ramp: float = 0.0, radiation: str = "convolution", memory: float | None = None,
              state_space_options: dict | None = None, check_stability: bool = True,
-             added_mass: str = "lhs") -> xr.Dataset:
+             added_mass: str = "lhs", progress: bool | dict = False) -> xr.Dataset:
     """Simulate a model in the time domain.
 
     Parameters
@@ -417,6 +544,10 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
         iteration counts are in ``iterations``).
     check_stability: warn (:class:`StabilityWarning`) before running when dt exceeds the
         integrator's stability limit at the shortest natural period of the model linearised at q0.
+    progress: False (default), True for a progress bar (tqdm, on stderr), or a dict of tqdm
+        options (e.g. ``{"delay": 5}``: shown only once the run has taken 5 s). The run is then
+        made in 20 to 100 chunks of one compiled function, with the bar updated between them;
+        the results are the same to the last bit.
 
     Returns an :class:`xarray.Dataset` with ``q``, ``qd``, ``qdd`` (time, coordinate),
     ``body_position`` (time, body, axis) CoM in inertial axes, ``body_rotation`` (time, body, angle)
@@ -440,6 +571,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     t0 = _number(t0, "t0")
     ramp = _number(ramp, "ramp", nonnegative=True)
     memory = _number(memory, "memory", positive=True, allow_none=True)
+    progress = _progress_options(progress)
     n_steps = int(round(duration / dt))
     if n_steps < 1:
         raise ValueError(f"duration = {duration} s is shorter than one step dt = {dt} s")
@@ -478,8 +610,13 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                 StabilityWarning, stacklevel=2)
     if sea is not None:
         _warn_accuracy(model, sea, dt, integ)
-    out = rollout(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
-                  save_every=save_every, t0=t0, record=True)
+    bar = _progress_bar(progress, n_steps, model.name)
+    if bar is None:
+        out = rollout(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
+                      save_every=save_every, t0=t0, record=True)
+    else:
+        out = _rollout_progress(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ,
+                                loads=loads, save_every=save_every, t0=t0, bar=bar)
     t, q, qd, qdd, z, iters = (np.asarray(a) for a in out[:6])
     rec = {k: np.asarray(v) for k, v in out[6].items()}
     settings = dict(duration=duration, n_steps=n_steps, save_every=int(save_every), t0=t0,
@@ -517,7 +654,8 @@ def _sea_labels(seas):
 def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
                    radiation: str = "state_space", state_space_options: dict | None = None,
                    memory: float | None = None, save_every: int = 1, t0: float = 0.0,
-                   q0=None, qd0=None, loads=None, outputs=(), vary_loads=None) -> xr.Dataset:
+                   q0=None, qd0=None, loads=None, outputs=(), vary_loads=None,
+                   progress: bool | dict = False) -> xr.Dataset:
     """Many runs of one topology in one compiled, ``jax.vmap``-ed call: a sweep over sea states,
     time steps and model parameters (a power matrix, a T_p sweep at dt = T_p/200, a hinge-height
     study) without retracing.
@@ -539,6 +677,8 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
         ``point_acceleration`` of the ``[[points]]``, or ``body_rotation``, ``joint_force``, ...:
         the names :func:`simulate` records); only what is named is computed and kept, as
         (case, step, ...) arrays.
+    progress: False (default), True or a dict of tqdm options: a bar over the steps (every case
+        advances together), as in :func:`simulate`; the same results.
     Sequences of length > 1 must agree in length B; length-1 arguments are broadcast.
 
     Returns an :class:`xarray.Dataset` with dimensions (case, step, coordinate): ``time``
@@ -571,6 +711,7 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
                          f"save_every={save_every}")
     t0 = _number(t0, "t0")
     memory = _number(memory, "memory", positive=True, allow_none=True)
+    progress = _progress_options(progress)
     pick = lambda seq, i: seq[i if len(seq) > 1 else 0]  # noqa: E731
     structure = {m_.coordinates for m_ in models}
     if len(structure) > 1 or len({id(m_.hydro) for m_ in models}) > 1:
@@ -608,12 +749,24 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
         raise ValueError(f"outputs: {bad} are not outputs of this model and its loads; accepted: "
                          f"{sorted(known)}")
 
-    def one(m_, lds, d):
-        return _rollout_jit(m_, lds, q0, qd0, z0, jnp.asarray(t0, jnp.float64), d, n_steps=int(n_steps),
-                            integrator=integ, save_every=int(save_every), record=outputs or False)
+    model_axis = 0 if len(models) > 1 else None
+    loads_b, dts_b = stack(loads), jnp.asarray(np.broadcast_to(dts, (B,)).copy())
+    t0_ = jnp.asarray(t0, jnp.float64)
+    bar = _progress_bar(progress, int(n_steps), f"{m0.name} × {B}")
+    if bar is None:
+        def one(m_, lds, d):
+            return _rollout_jit(m_, lds, q0, qd0, z0, t0_, d, n_steps=int(n_steps),
+                                integrator=integ, save_every=int(save_every), record=outputs or False)
 
-    out = jax.vmap(one, in_axes=(0 if len(models) > 1 else None, 0, 0))(
-        batched_model, stack(loads), jnp.asarray(np.broadcast_to(dts, (B,)).copy()))
+        out = jax.vmap(one, in_axes=(model_axis, 0, 0))(batched_model, loads_b, dts_b)
+    else:
+        out = _run_chunked(
+            lambda: _start_batch_jit(batched_model, loads_b, q0, qd0, z0, t0_, dts_b,
+                                     model_axis=model_axis, integrator=integ, record=outputs or False),
+            lambda carry, c: _chunk_batch_jit(batched_model, loads_b, carry, dts_b,
+                                              model_axis=model_axis, n_blocks=c, integrator=integ,
+                                              save_every=int(save_every), record=outputs or False),
+            int(n_steps) // int(save_every), int(save_every), bar, time_axis=1)
     t, q, qd = (np.asarray(a) for a in out[:3])
     for i in range(B):
         if not (np.isfinite(q[i]).all() and np.isfinite(qd[i]).all()):

@@ -291,23 +291,31 @@ def test_swapped_hydro_names_are_found_and_shipped_configs_pass():
 
 
 # ------------------------------------------------------------------------------ command line
-def test_cli_module_imports_nothing_heavy_before_parsing():
-    """--help and --version need neither numpy nor jax (mfm/cli.py loaded on its own; the
-    package's __init__ is the other half of a fast `mfm --help`)."""
-    code = ("import importlib.util, sys, io, contextlib\n"
-            "spec = importlib.util.spec_from_file_location('cli_alone', 'mfm/cli.py')\n"
-            "m = importlib.util.module_from_spec(spec); spec.loader.exec_module(m)\n"
+def test_help_and_version_import_neither_mfm_nor_jax():
+    """The console script's entry (pyproject's [project.scripts]) answers --help and --version
+    with the standard library only: mfm/__init__ (jax, ~2 s) is not run."""
+    import tomllib
+
+    entry = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["scripts"]["mfm"]
+    module, func = entry.split(":")
+    code = ("import sys, importlib\n"
+            f"main = getattr(importlib.import_module({module!r}), {func!r})\n"
             "for argv in (['--help'], ['--version'], ['simulate', '--help']):\n"
             "    try:\n"
-            "        m.main(argv)\n"
+            "        main(argv)\n"
             "    except SystemExit as e:\n"
             "        assert e.code == 0, argv\n"
-            "heavy = [k for k in ('numpy', 'jax', 'xarray', 'matplotlib') if k in sys.modules]\n"
+            "heavy = [k for k in ('mfm', 'numpy', 'jax', 'xarray', 'matplotlib') if k in sys.modules]\n"
             "assert not heavy, heavy\n")
     r = _run(code)
     assert r.returncode == 0, r.stderr
     assert "mfm 0." in r.stdout or "mfm unknown" in r.stdout
     assert "--no-plot" in r.stdout
+    # the old entry points are the same function
+    import mfm.cli
+    import mfm_cli
+
+    assert mfm.cli.main is mfm_cli.main
 
 
 @pytest.mark.parametrize("argv, match", [
@@ -390,6 +398,26 @@ damping = 0.1
     assert "cart.stroke [m]  (damper 0.1 N s/m)" in out and "arm.angle [rad]" in out
 
 
+def test_rm3_spar_surge_drift_said_by_info_and_the_run_summary(tmp_path, capsys):
+    """RM3 has no surge restoring (no mooring): `mfm info` and the `mfm simulate` summary name
+    spar.surge, and only it; the result file carries the same list."""
+    from mfm.cli import main
+
+    assert main(["info", str(CONFIGS / "rm3.toml")]) == 0
+    out = capsys.readouterr().out
+    assert "with the water" in out
+    line, = [ln for ln in out.splitlines() if "no restoring in" in ln]
+    assert line.startswith("  no restoring in spar.surge: nothing pulls")
+    nc = tmp_path / "rm3.nc"
+    assert main(["simulate", str(CONFIGS / "rm3.toml"), "--duration", "2", "--dt", "0.1",
+                 "--no-plot", "--out", str(nc)]) == 0
+    out = capsys.readouterr().out
+    line, = [ln for ln in out.splitlines() if "restoring" in ln]
+    assert line.startswith("  no restoring in spar.surge (at q0): nothing pulls back, so its mean")
+    with xr.open_dataset(nc) as ds:
+        assert ds.attrs["no_restoring"] == "spar.surge"
+
+
 def test_plot_result_files(tmp_path, capsys):
     """`mfm simulate` draws its PNG beside the NetCDF; `mfm plot` draws simulation, RAO and
     batch files."""
@@ -451,3 +479,99 @@ def test_m4_study_notebook_stores_its_figures():
         names = re.findall(r'savefig\(FIGS / "([^"]+)"', c.source)
         shown = [o for o in c.outputs if "image/png" in o.get("data", {})]
         assert len(shown) == len(names), names
+
+
+# ------------------------------------------------------------------------------ progress bars
+def _same_numbers(a, b):
+    """Every numeric variable and coordinate of two datasets equal to the last bit."""
+    assert set(a.data_vars) == set(b.data_vars)
+    for v in list(a.data_vars) + list(a.coords):
+        if np.issubdtype(a[v].dtype, np.number):
+            assert np.array_equal(a[v].values, b[v].values, equal_nan=True), v
+
+
+def test_chunk_plan_one_length_few_blocks_wasted():
+    from mfm.simulate import chunk_plan
+
+    assert chunk_plan(7) == (1, 7)
+    for n in (21, 100, 211, 2000, 20000, 99991):
+        c, k = chunk_plan(n)
+        assert 20 <= k <= 100 and (k - 1) * c < n <= k * c, n
+    assert chunk_plan(2000) == (20, 100)                    # a divisor: nothing wasted
+
+
+def test_progress_bar_gives_the_same_numbers_with_one_compilation(capsys):
+    """progress=True runs the scan in chunks of one compiled function (211 steps: chunks of 3,
+    the last one past the end, its extra step dropped) and writes the bar to stderr; the results
+    equal the unchunked run's to the last bit."""
+    import mfm
+    from mfm.simulate import TRACES
+
+    m = mfm.load(CONFIGS / "double_pendulum.toml")
+    kw = dict(duration=2.11, dt=0.01, q0={"upper.angle": 0.5}, integrator="rk4")
+    plain = mfm.simulate(m, **kw)
+    assert capsys.readouterr().err == ""                    # off by default
+    before = TRACES["rollout_chunk"]
+    shown = mfm.simulate(m, progress=True, **kw)
+    assert TRACES["rollout_chunk"] - before == 1            # one compilation for every chunk
+    _same_numbers(plain, shown)
+    err = capsys.readouterr().err
+    assert "double pendulum" in err and "211/211" in err and "step" in err
+    with pytest.raises(ValueError, match=r"progress: 'yes'; give False .*True .*dict of tqdm"):
+        mfm.simulate(m, progress="yes", **kw)
+    with pytest.raises(ValueError, match=r"progress: \{'colour_of_bar': 1\} is not a set of tqdm"):
+        mfm.simulate(m, progress={"colour_of_bar": 1}, **kw)
+
+
+def test_progress_bar_keeps_a_diverging_run_and_a_batch_exact(capsys):
+    """A run that goes non-finite stops at the chunk where it does, with the same error and
+    partial dataset; simulate_batch with a bar gives the unchunked batch's numbers."""
+    import mfm
+
+    m = mfm.load(CONFIGS / "double_pendulum.toml")
+    kw = dict(duration=200.0, dt=0.5, q0={"upper.angle": 1.0})
+    errors = []
+    for progress in (False, True):
+        with pytest.raises(mfm.SimulationError) as e:
+            mfm.simulate(m, progress=progress, **kw)
+        errors.append(e.value)
+    assert str(errors[0]) == str(errors[1])
+    _same_numbers(errors[0].dataset, errors[1].dataset)
+    import re
+
+    done = [int(k) for k in re.findall(r"(\d+)/400", capsys.readouterr().err)]
+    assert done and max(done) < 400                         # it stopped at the first chunk
+    kw = dict(dt=[0.01, 0.02], n_steps=211, q0={"upper.angle": 0.5})
+    _same_numbers(mfm.simulate_batch(m, None, **kw), mfm.simulate_batch(m, None, progress=True, **kw))
+    assert "× 2" in capsys.readouterr().err
+    models = [m, m.replace(damping=m.damping + 0.3)]         # a batch over models too
+    kw = dict(dt=0.01, n_steps=211, q0={"upper.angle": 0.5})
+    _same_numbers(mfm.simulate_batch(models, None, **kw),
+                  mfm.simulate_batch(models, None, progress=True, **kw))
+
+
+def test_cli_progress_choice(tmp_path, capsys):
+    """`mfm simulate --progress`: auto is a bar on a terminal after 2 s, in a log after 5 s
+    (refreshed every 10 s); on shows it at once."""
+    import io
+
+    from mfm.cli import main
+    from mfm_cli import progress_option
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    assert progress_option("auto", Terminal()) == {"delay": 2.0}
+    assert progress_option("auto", io.StringIO()) == {"delay": 5.0, "mininterval": 10.0}
+    assert progress_option("on") is True and progress_option("off") is False
+    with pytest.raises(ValueError, match="--progress 'always'; accepted: auto, on, off"):
+        progress_option("always")
+    argv = ["simulate", str(CONFIGS / "double_pendulum.toml"), "--duration", "0.5", "--dt", "0.01",
+            "--no-plot", "--out", str(tmp_path / "dp.nc")]
+    assert main(argv + ["--progress", "on"]) == 0
+    out, err = capsys.readouterr()
+    assert "50/50" in err
+    assert "  every coordinate has restoring (at q0)" in out
+    assert main(argv) == 0                                   # auto, not a terminal, a short run
+    assert "50/50" not in capsys.readouterr().err
