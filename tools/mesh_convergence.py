@@ -5,7 +5,7 @@ excitation modulus against the finest mesh.
     python tools/mesh_convergence.py configs/stansby_li.toml --dx 1.4 1.0 --omega 0.5 1.0 1.5
 
 Every solve uses the config's own [hydro.bem] settings with ``dx``, ``omega``, one heading
-(``--heading``, degrees) and no ω = ∞ overridden (`mfm.bemgen.generate(overrides=...)`), into a
+(``--heading``, degrees) and ω = ∞ (the reader needs it) overridden (`mfm.bemgen.generate(overrides=...)`), into a
 temporary directory; capytaine is needed. Modes: ``--modes`` (default Surge Heave Pitch).
 """
 import argparse
@@ -33,7 +33,7 @@ def main():
         t0 = time.perf_counter()
         out = generate(args.config, out=tmp / f"dx{dx}.nc", force=True, progress=False, cache=False,
                        overrides={"dx": dx, "omega": list(args.omega), "headings_deg": [args.heading],
-                                  "infinite_frequency": False})
+                                  "infinite_frequency": True})
         print(f"dx {dx} m: {time.perf_counter() - t0:.0f} s")
         dbs.append(open_any_database(out))
     ref = dbs[-1]
@@ -47,7 +47,7 @@ def main():
             dof = f"{b}__{mode}"
             for name, get in (("A", lambda d, w: float(d.added_mass.sel(omega=w, radiating_dof=dof, influenced_dof=dof))),
                               ("B", lambda d, w: float(d.radiation_damping.sel(omega=w, radiating_dof=dof, influenced_dof=dof))),
-                              ("|X|", lambda d, w: float(abs(d.excitation.sel(omega=w, influenced_dof=dof).isel(wave_direction=0))))):
+                              ("abs X", lambda d, w: float(abs(d.excitation.sel(omega=w, influenced_dof=dof).isel(wave_direction=0))))):
                 for w in args.omega:
                     vals = [get(d, d.omega.values[np.argmin(abs(d.omega.values - w))]) for d in dbs]
                     diffs = [f"{100 * (v / vals[-1] - 1):+.2f}%" if vals[-1] else "—" for v in vals[:-1]]
