@@ -195,13 +195,16 @@ def _recordable(model, loads) -> set:
 
 
 def _saved(model, loads, s, mem, record):
-    """The outputs kept of one saved state."""
+    """The outputs kept of one saved state. ``record``: False (the state), True (the state and
+    every per-sample output), or a tuple of output names: a batch's form, the state without the
+    loads' own states z (a radiation fit has thousands per sample: a 36-case sweep of one hour
+    would hold gigabytes of them) and a dict of the named outputs only (the compiler drops the
+    work of the others)."""
+    if isinstance(record, tuple):
+        rec = _record(model, loads, s, mem) if record else {}
+        return (s.t, s.q, s.qd, s.qdd, jnp.zeros(0), s.iterations, {k: rec[k] for k in record})
     out = (s.t, s.q, s.qd, s.qdd, s.z, s.iterations)
-    if not record:
-        return out
-    rec = _record(model, loads, s, mem)
-    # a tuple of names keeps only those outputs (the compiler drops the work of the others)
-    return out + ((rec if record is True else {k: rec[k] for k in record}),)
+    return out + ((_record(model, loads, s, mem),) if record else ())
 
 
 def _rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, record):
@@ -346,7 +349,8 @@ def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=
     the function can be ``jax.vmap``-ed over a batched model or ``jax.grad``-ed (RK4, semi-implicit
     and Newmark; Beeman's while loop is forward-mode only). ``record=True`` appends a dict of
     per-sample outputs (poses, joint reactions, energies, load diagnostics) as a 7th item; a tuple
-    of output names (e.g. ``("point_acceleration",)``) records only those.
+    of output names (e.g. ``("point_acceleration",)``) records only those, and z comes back
+    empty (the batch form: the loads' states are not kept per sample).
     """
     loads = _as_loads(loads)
     integ = _integrators.get(integrator)
@@ -756,16 +760,16 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     if bar is None:
         def one(m_, lds, d):
             return _rollout_jit(m_, lds, q0, qd0, z0, t0_, d, n_steps=int(n_steps),
-                                integrator=integ, save_every=int(save_every), record=outputs or False)
+                                integrator=integ, save_every=int(save_every), record=outputs)
 
         out = jax.vmap(one, in_axes=(model_axis, 0, 0))(batched_model, loads_b, dts_b)
     else:
         out = _run_chunked(
             lambda: _start_batch_jit(batched_model, loads_b, q0, qd0, z0, t0_, dts_b,
-                                     model_axis=model_axis, integrator=integ, record=outputs or False),
+                                     model_axis=model_axis, integrator=integ, record=outputs),
             lambda carry, c: _chunk_batch_jit(batched_model, loads_b, carry, dts_b,
                                               model_axis=model_axis, n_blocks=c, integrator=integ,
-                                              save_every=int(save_every), record=outputs or False),
+                                              save_every=int(save_every), record=outputs),
             int(n_steps) // int(save_every), int(save_every), bar, time_axis=1)
     t, q, qd = (np.asarray(a) for a in out[:3])
     for i in range(B):
