@@ -28,6 +28,7 @@ import numpy as np
 import hydro
 import mfm
 from mfm.simulate import model_loads
+from timing import first_and_warm
 
 warnings.simplefilter("ignore", hydro.database.HydroDatabaseWarning)
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
@@ -36,16 +37,6 @@ TP = 1.2
 N = 20_000
 
 
-def timed(fn, repeats):
-    t0 = time.perf_counter()
-    fn()
-    first = time.perf_counter() - t0
-    ts = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t0)
-    return first, float(np.median(ts))
 
 
 def main():
@@ -86,15 +77,15 @@ def main():
             out["r"][1].block_until_ready()
 
         # the convolution over T_K ≈ 22 s of memory is the slow one: one warm repeat
-        first, warm = timed(run, 1 if rad == "convolution" else args.repeats)
+        first, warm = first_and_warm(run, 1 if rad == "convolution" else args.repeats)
         finite = bool(np.isfinite(np.asarray(out["r"][1])).all())
         it = np.asarray(out["r"][5])[1:]
         extra = f", corrector iterations mean {it.mean():.2f} max {it.max()}" if integ == "beeman" else ""
         rows.append((label, warm))
         print(f"{label:<64s} first {first:6.2f} s, warm {warm:6.3f} s ({warm / N * 1e6:5.1f} µs/step), "
               f"{seed_time / warm:6.0f}× seed 001{'' if finite else ', WENT NON-FINITE'}{extra}")
-    first, warm = timed(lambda: mfm.simulate(m, sea, duration=N * dt, dt=dt, ramp=5 * TP,
-                                             radiation="state_space"), max(1, args.repeats - 1))
+    first, warm = first_and_warm(lambda: mfm.simulate(m, sea, duration=N * dt, dt=dt, ramp=5 * TP,
+                                                      radiation="state_space"), max(1, args.repeats - 1))
     print(f"{'mfm.simulate (dataset recorded every step), state space, RK4':<64s} first {first:6.2f} s, "
           f"warm {warm:6.3f} s, {seed_time / warm:6.0f}× seed 001")
     ours = dict(rows)["state space, RK4"]
@@ -108,8 +99,8 @@ def main():
             mk = mfm.load(CONFIGS / f"m4_{k}.toml")
             mk.hydro.state_space()
             seas = [hydro.Jonswap(hs=0.04, tp=tp, gamma=3.3, seed=1, omega_range=(1.0, 25.0)) for tp in tps]
-            first, warm = timed(lambda: mfm.simulate_batch(mk, seas, dt=tps / 200, n_steps=N, ramp=5 * tps,
-                                                           save_every=2), 1)
+            first, warm = first_and_warm(lambda: mfm.simulate_batch(mk, seas, dt=tps / 200, n_steps=N,
+                                                                    ramp=5 * tps, save_every=2), 1)
             total_first += first
             total_warm += warm
             print(f"Fig. 7 sweep M4 {k}: 11 Tp × 20,000 steps in one call: first {first:.1f} s, warm {warm:.1f} s")

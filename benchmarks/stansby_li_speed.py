@@ -26,21 +26,12 @@ import numpy as np
 import hydro
 import mfm
 from mfm.simulate import model_loads
+from timing import first_and_warm
 
 warnings.simplefilter("ignore", hydro.database.HydroDatabaseWarning)
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
 
-def timed(fn, repeats):
-    t0 = time.perf_counter()
-    fn()
-    first = time.perf_counter() - t0
-    ts = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t0)
-    return first, float(np.median(ts)) if ts else float("nan")
 
 
 def sea(heading_deg=0.0):
@@ -69,20 +60,21 @@ def main():
             out["r"] = mfm.rollout(m, q0, q0, dt=dt, n_steps=n, loads=loads)
             out["r"][1].block_until_ready()
 
-        first, warm = timed(run, args.repeats)
+        first, warm = first_and_warm(run, args.repeats)
         ok = bool(np.isfinite(np.asarray(out["r"][1])).all())
         print(f"one 3600 s sea state, dt {dt:.3g} s ({n} steps), rollout: first {first:.2f} s, warm "
               f"{warm:.3f} s ({warm / n * 1e6:.1f} µs/step){'' if ok else ', NON-FINITE'}")
-        first, warm = timed(lambda: mfm.simulate_batch(m, sea(), dt=dt, n_steps=n, ramp=100.0,
-                                                       outputs=("point_acceleration",)),
-                            max(1, args.repeats - 1))
+        first, warm = first_and_warm(lambda: mfm.simulate_batch(m, sea(), dt=dt, n_steps=n, ramp=100.0,
+                                                                outputs=("point_acceleration",)),
+                                     max(1, args.repeats - 1))
         print(f"  the same through mfm.simulate_batch (dataset, hub acceleration): first {first:.2f} s, "
               f"warm {warm:.3f} s")
     if args.sweep:
         seas = [sea(b) for b in range(0, 360, 10)]
         n = int(round(3700.0 / 0.1))
-        first, warm = timed(lambda: mfm.simulate_batch(m, seas, dt=0.1, n_steps=n, ramp=100.0,
-                                                       save_every=2, outputs=("point_acceleration",)), 1)
+        first, warm = first_and_warm(lambda: mfm.simulate_batch(m, seas, dt=0.1, n_steps=n, ramp=100.0,
+                                                                save_every=2,
+                                                                outputs=("point_acceleration",)), 1)
         print(f"36 headings × {n} steps in one simulate_batch call: first {first:.1f} s, warm {warm:.1f} s")
 
 

@@ -11,3 +11,12 @@ def median_time(fn, repeats):
         fn()
         ts.append(time.perf_counter() - t0)
     return statistics.median(ts)
+
+
+def first_and_warm(fn, repeats):
+    """(wall time of the first call — compilation included —, median of ``repeats`` warm calls;
+    nan when repeats is 0)."""
+    t0 = time.perf_counter()
+    fn()
+    first = time.perf_counter() - t0
+    return first, median_time(fn, repeats) if repeats > 0 else float("nan")
