@@ -178,6 +178,18 @@ RECORD_DIMS = {
 RECORD_COORDS = {"axis": ["x", "y", "z"], "angle": ["roll", "pitch", "yaw"]}
 
 
+def record_specs(model, loads):
+    """What a run can record per sample with these loads: name → (dims after time, attrs), and the
+    coordinate values of those dims (the builtin outputs and each load's :meth:`outputs`)."""
+    specs = dict(RECORD_DIMS)
+    coords = {"body": list(model.body_names), **RECORD_COORDS}
+    for ld in loads:
+        spec = dict(ld.outputs())
+        coords.update(spec.pop("coords", {}))
+        specs.update(spec)
+    return specs, coords
+
+
 def time_series(model, loads, integ, dt, t, q, qd, qdd, iters, rec, settings) -> xr.Dataset:
     """The dataset of one run (:func:`mfm.simulate`)."""
     ds = xr.Dataset(
@@ -227,12 +239,7 @@ def batch(model, models, loads, integ, t, q, qd, dts, settings, save_every, labe
     for name, (_, attrs) in per_case[0].items():
         ds[name] = (("case", "step"), np.stack([per_case[i][name][0] for i in range(B)]), attrs)
     if recorded:
-        specs = dict(RECORD_DIMS)
-        coords = {"body": list(model.body_names), **RECORD_COORDS}
-        for ld in loads[0]:
-            spec = dict(ld.outputs())
-            coords.update(spec.pop("coords", {}))
-            specs.update(spec)
+        specs, coords = record_specs(model, loads[0])
         for name, values in recorded.items():
             dims, attrs = specs[name]
             ds = ds.assign_coords({d: coords[d] for d in dims if d in coords and d not in ds.coords})

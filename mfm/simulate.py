@@ -186,14 +186,6 @@ def _output_names(outputs) -> tuple:
     return tuple(dict.fromkeys(names))
 
 
-def _recordable(model, loads) -> set:
-    """Names :func:`_record` produces for this model and loads (without tracing it)."""
-    names = set(results.RECORD_DIMS)
-    for ld in loads:
-        names |= {k for k in ld.outputs() if k != "coords"}
-    return names
-
-
 def _saved(model, loads, s, mem, record):
     """The outputs kept of one saved state. ``record``: False (the state), True (the state and
     every per-sample output), or a tuple of output names: a batch's form, the state without the
@@ -747,7 +739,7 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
     batched_model = stack([pick(models, i) for i in range(B)]) if len(models) > 1 else m0
 
-    known = _recordable(m0, loads[0])
+    known = set(results.record_specs(m0, loads[0])[0])
     bad = [n for n in outputs if n not in known]
     if bad:
         raise ValueError(f"outputs: {bad} are not outputs of this model and its loads; accepted: "
