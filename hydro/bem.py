@@ -41,6 +41,7 @@ import xarray as xr
 
 from hydro import geometry as geo
 from hydro.database import read_netcdf, write_netcdf
+from hydro.waves import wavenumber
 
 LOG = logging.getLogger(__name__)
 
@@ -278,13 +279,15 @@ def build_body(specs, dx, *, lid=True, symmetry="auto"):
 
 def _solve_problems(body, omegas, directions, *, water_depth, rho, g, progress, n_threads):
     """Radiation (all dofs) and diffraction (all headings, finite ω only) problems, solved one
-    frequency at a time so that the LU factorisation is shared by the problems of one ω."""
+    frequency at a time so that the LU factorisation is shared by the problems of one ω.
+    ``water_depth``: one depth, or one per ω (finite depth where it matters, deep water above)."""
     import capytaine as cpt
     from tqdm.auto import tqdm
 
     dof_names = list(body.dofs)
+    depths = list(water_depth) if np.ndim(water_depth) else [water_depth] * len(omegas)
     groups = []
-    for w in omegas:
+    for w, water_depth in zip(omegas, depths):
         pbs = [cpt.RadiationProblem(body=body, omega=w, radiating_dof=d, water_depth=water_depth,
                                     rho=rho, g=g) for d in dof_names]
         if np.isfinite(w):
@@ -358,7 +361,7 @@ def _augment(ds, specs, hulls, *, rho, g):
 
 def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=1000.0, g=9.81,
           lid=True, symmetry="auto", infinite_frequency=True, cache_dir=None, cache=True,
-          progress=True, n_threads=None):
+          progress=True, n_threads=None, deep_water_kh=None):
     """Radiation and diffraction of a layout of rigid bodies, all solved together.
 
     Parameters
@@ -368,6 +371,11 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
     dx : panel size, m (meridian spacing and water-line arc length per panel).
     wave_directions : headings β, rad (0 = waves travelling towards +x).
     water_depth : m, ``inf`` for deep water.
+    deep_water_kh : with a finite ``water_depth``, solve the frequencies where k h ≥ this value
+        (and ω = ∞) in deep water: tanh(k h) ≥ tanh 5 = 0.99991 at 5, so the depth changes nothing
+        there that the panels resolve, and the finite-depth Green function costs ≈ 3× the deep
+        one. None (default): every frequency at ``water_depth``. The dataset keeps the physical
+        ``water_depth`` and records the split (attrs ``deep_water_kh``, ``deep_water_omega_min``).
     rho, g : kg/m³, m/s².
     lid : water-plane lid against irregular frequencies.
     symmetry : "auto", "xOz", "rotation" or "none" (see the module docstring).
@@ -394,6 +402,8 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
     water_depth = _check_positive("water_depth", water_depth, allow_inf=True)
     rho = _check_positive("rho", rho)
     g = _check_positive("g", g)
+    if deep_water_kh is not None:
+        deep_water_kh = _check_positive("deep_water_kh", deep_water_kh)
     if symmetry not in ("auto", "xOz", "rotation", "none", None, False):
         raise ValueError(f"symmetry = {symmetry!r}: expected 'auto', 'xOz', 'rotation' or 'none'.")
     symmetry = "none" if symmetry in (None, False) else symmetry
@@ -407,6 +417,11 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
                 "wave_directions": [float(b) for b in directions],
                 "water_depth": water_depth, "rho": rho, "g": g, "dx": dx, "lid": bool(lid),
                 "symmetry": symmetry, "infinite_frequency": bool(infinite_frequency)}
+    deep_from = math.inf  # the lowest ω solved in deep water
+    if deep_water_kh is not None and math.isfinite(water_depth):
+        settings["deep_water_kh"] = deep_water_kh
+        kh = wavenumber(omegas, water_depth, g) * water_depth
+        deep_from = float(min((w for w, k in zip(omegas, kh) if k >= deep_water_kh), default=math.inf))
     digest = settings_hash(specs, settings)
     path = None
     if cache:
@@ -422,7 +437,9 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
 
     body, used, hulls = build_body(specs, dx, lid=lid, symmetry=symmetry)
     all_w = list(omegas) + ([np.inf] if infinite_frequency else [])
-    solver, results = _solve_problems(body, all_w, directions, water_depth=water_depth, rho=rho,
+    split = deep_water_kh is not None and math.isfinite(water_depth)
+    depths = [np.inf if split and w >= deep_from else water_depth for w in all_w]
+    solver, results = _solve_problems(body, all_w, directions, water_depth=depths, rho=rho,
                                       g=g, progress=progress, n_threads=n_threads)
     # capytaine warns that a layout body has no unique rotation centre while it fills its
     # `rotation_center` coordinate; we drop that coordinate for `reference_point(body, axis)`.
@@ -430,8 +447,19 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
     level = cpt_log.level
     cpt_log.setLevel(logging.ERROR)
     try:
-        ds = cpt.assemble_dataset(results, hydrostatics=False,
-                                  attrs={k: str(v) for k, v in solver.exportable_settings.items()})
+        attrs = {k: str(v) for k, v in solver.exportable_settings.items()}
+        # capytaine makes water_depth a dimension when it varies: assemble each depth apart and
+        # join them along ω (the physical depth is the attrs' water_depth)
+        parts = []
+        for d in dict.fromkeys(float(r.water_depth) for r in results):
+            part = cpt.assemble_dataset([r for r in results if float(r.water_depth) == d],
+                                        hydrostatics=False, attrs=attrs)
+            parts.append(part.drop_vars("water_depth", errors="ignore"))
+        ds = parts[0] if len(parts) == 1 else xr.concat(parts, dim="omega",
+                                                        data_vars="minimal", coords="minimal",
+                                                        compat="override", combine_attrs="override")
+        if len(parts) > 1:
+            ds = ds.sortby("omega")
     finally:
         cpt_log.setLevel(level)
     ds = _augment(ds, specs, hulls, rho=rho, g=g)
@@ -447,6 +475,8 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
         "wave_directions_rad": json.dumps(settings["wave_directions"]),
         "dx": repr(dx), "lid": str(bool(lid)), "symmetry": symmetry, "symmetry_used": used,
         "infinite_frequency": str(bool(infinite_frequency)),
+        "deep_water_kh": "none" if not split else repr(deep_water_kh),
+        "deep_water_omega_min": "none" if not split else repr(deep_from),
         "nb_hull_panels": str(n_hull), "nb_lid_panels": str(n_lid),
         "capytaine_version": cpt.__version__, "numpy_version": np.__version__,
         "xarray_version": xr.__version__, "schema": SCHEMA_VERSION, "mfm_code_version": code_version(),
@@ -485,7 +515,7 @@ def _check_finite(ds):
 
 def _keel(spec, dx):
     if spec["shape"] in geo.REVOLVED:
-        return float(np.min(geo.meridian(spec, dx)[:, 1]))
+        return float(np.min(geo.meridian(spec, spec.get("dx", dx))[:, 1]))
     hull = geo.body_meshes(spec, dx, "full", lid=False)[0]
     return float(np.min(hull.vertices[:, 2]))
 

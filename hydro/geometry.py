@@ -11,10 +11,18 @@ A body spec is a plain dict (JSON-able, so it can be hashed and stored in a data
   surface when ``|z_c| < radius`` (the part above z = 0 is cut off exactly), else fully submerged.
 - ``{"name", "shape": "hemisphere", "radius", "origin", "reference_point"}``: a floating hemisphere,
   flat face at the still-water line (origin = centre of that face, z = 0).
+- ``{"name", "shape": "revolution", "profile": [[r, z], ...], "origin", "reference_point"}``: any
+  body of revolution about the vertical axis through ``origin`` (z 0), given by its meridian
+  polyline (r ≥ 0 from the axis, z ≤ 0 absolute): from the water line (first point, z = 0, r > 0)
+  down the wetted surface to the keel on the axis (last point, r = 0). Stepped columns and heave
+  plates: ``[[8, 0], [8, -18.67], [16, -18.67], [16, -26.67], [0, -26.67]]`` is an OC4-like
+  column of D 16 m on a base of D 32 m. It keeps the layout's symmetries, unlike a mesh file.
 - ``{"name", "shape": "mesh", "file": "hull.stl", "origin", "reference_point"}``: any mesh file
   capytaine reads (STL via trimesh), translated by ``origin`` and cut at z = 0.
 
 Lengths in m. ``reference_point`` (default: ``origin``) is the rotation centre of the 6 rigid dofs.
+Optional ``dx`` (m): this body's panel size, in place of the layout's (a small float beside a large
+platform needs finer panels than the platform).
 
 Bodies of revolution are revolved from their meridian (r, z) profile, whose points lie on the exact
 surface: the panels are inscribed, so volumes and water-plane integrals converge as O(dθ²) and the
@@ -31,17 +39,18 @@ import os
 
 import numpy as np
 
-SHAPES = ("cylinder", "sphere", "hemisphere", "mesh")
+SHAPES = ("cylinder", "sphere", "hemisphere", "revolution", "mesh")
 BASES = ("flat", "hemisphere", "rounded")
 MODES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
 _KEYS = {
     "cylinder": {"name", "shape", "radius", "draft", "base", "knuckle_radius", "origin",
-                 "reference_point"},
-    "sphere": {"name", "shape", "radius", "origin", "reference_point"},
-    "hemisphere": {"name", "shape", "radius", "origin", "reference_point"},
-    "mesh": {"name", "shape", "file", "origin", "reference_point"},
+                 "reference_point", "dx"},
+    "sphere": {"name", "shape", "radius", "origin", "reference_point", "dx"},
+    "hemisphere": {"name", "shape", "radius", "origin", "reference_point", "dx"},
+    "revolution": {"name", "shape", "profile", "origin", "reference_point", "dx"},
+    "mesh": {"name", "shape", "file", "origin", "reference_point", "dx"},
 }
-REVOLVED = ("cylinder", "sphere", "hemisphere")
+REVOLVED = ("cylinder", "sphere", "hemisphere", "revolution")
 
 
 # ------------------------------------------------------------------------------------------------
@@ -129,18 +138,53 @@ def normalize_spec(spec, index=None):
             raise ValueError(f"{where}: 'origin' z = {out['origin'][2]} puts the sphere (radius "
                              f"{out['radius']}) entirely above the water; give a centre "
                              f"z < radius.")
+    elif shape == "revolution":
+        out["profile"] = _profile(spec.get("profile"), where)
     else:  # mesh
         f = spec.get("file")
         if not isinstance(f, (str, os.PathLike)) or not os.path.isfile(f):
             raise ValueError(f"{where}: 'file' = {f!r} is not an existing mesh file; give the path "
                              f"of an STL (or gdf/nemoh/pnl/hst) file.")
         out["file"] = os.path.abspath(os.fspath(f))
-    if shape in ("cylinder", "hemisphere") and out["origin"][2] != 0.0:
+    if shape in ("cylinder", "hemisphere", "revolution") and out["origin"][2] != 0.0:
         raise ValueError(f"{where}: 'origin' z = {out['origin'][2]} must be 0 for shape {shape!r} "
                          f"(the origin is on the axis at the still-water line; the draft sets the "
                          f"immersion).")
     out["reference_point"] = _point(spec, "reference_point", where, out["origin"])
+    if spec.get("dx") is not None:
+        out["dx"] = _positive(spec, "dx", where)
     return out
+
+
+def _profile(prof, where):
+    """A meridian polyline [[r, z], ...]: water line (z = 0, r > 0) first, keel on the axis
+    (r = 0) last, r ≥ 0, z ≤ 0, no repeated consecutive point. Returned as a list of [r, z]."""
+    example = "[[8, 0], [8, -18.67], [16, -18.67], [16, -26.67], [0, -26.67]]"
+    try:
+        P = np.asarray(prof, dtype=float)
+    except (TypeError, ValueError):
+        P = np.zeros((0,))
+    if P.ndim != 2 or P.shape[1] != 2 or len(P) < 2 or not np.all(np.isfinite(P)):
+        raise ValueError(f"{where}: 'profile' = {prof!r} is not a list of at least two finite "
+                         f"[r, z] points (m); e.g. {example}.")
+    if P[0, 1] != 0.0 or P[0, 0] <= 0.0:
+        raise ValueError(f"{where}: 'profile' starts at {P[0].tolist()}; it must start on the "
+                         f"water line, [r > 0, 0] (a surface-piercing body), e.g. {example}.")
+    if P[-1, 0] != 0.0:
+        raise ValueError(f"{where}: 'profile' ends at {P[-1].tolist()}; it must end on the axis, "
+                         f"[0, z_keel], so that the revolved surface is closed.")
+    bad = np.nonzero((P[:, 0] < 0) | (P[:, 1] > 0))[0]
+    if bad.size:
+        raise ValueError(f"{where}: 'profile' point {int(bad[0])} = {P[bad[0]].tolist()}: r must "
+                         f"be ≥ 0 (distance from the axis) and z ≤ 0 (the wetted surface).")
+    seg = np.linalg.norm(np.diff(P, axis=0), axis=1)
+    if np.any(seg == 0):
+        raise ValueError(f"{where}: 'profile' repeats point {int(np.argmin(seg))} "
+                         f"({P[int(np.argmin(seg))].tolist()}); give each point once.")
+    if np.any(P[1:-1, 0] == 0.0):
+        raise ValueError(f"{where}: 'profile' touches the axis before its last point; a body of "
+                         f"revolution is one closed surface (one keel point on the axis).")
+    return P.tolist()
 
 
 def normalize_specs(bodies):
@@ -206,6 +250,9 @@ def meridian(spec, dx):
         return _chain(*pieces)
     if s["shape"] == "hemisphere":
         return _arc(0.0, 0.0, s["radius"], 0.0, -math.pi / 2, dx)
+    if s["shape"] == "revolution":
+        P = [tuple(p) for p in s["profile"]]
+        return _chain(*(_line(a, b, dx) for a, b in zip(P[:-1], P[1:])))
     if s["shape"] == "sphere":
         R, zc = s["radius"], s["origin"][2]
         if zc <= -R:  # fully submerged: top to bottom
@@ -259,6 +306,7 @@ def body_meshes(spec, dx, part="full", *, lid=True):
     """
     import capytaine as cpt
 
+    dx = spec.get("dx", dx)
     x0, y0, z0 = spec["origin"]
     if spec["shape"] == "mesh":
         if part != "full":

@@ -8,12 +8,13 @@ Format (every key is checked; an unknown key is an error)::
 
     [[bodies]]
     name = "link1"
-    mass = 1.0                                  # kg, > 0
+    mass = 1.0                                  # kg, > 0 (0: a hull welded to its parent,
+                                                #   whose mass the parent carries)
     com = [0.0, 0.0, -0.5]                      # m, inertial axes at q = 0
     inertia = [[0.1, 0, 0], [0, 0.1, 0], [0, 0, 0.01]]   # kg m² about the CoM, or instead:
     # principal_inertia = [Ixx, Iyy, Izz]       #   body axes = inertial axes at q = 0
     # radii_of_gyration = [rx, ry, rz]          #   m, I = m r²
-    # parent = "..."                            # omitted for the one root body
+    # parent = "..."                            # omitted for a root body
     [bodies.joint]
     type = "revolute"        # free | planar | revolute | prismatic | fixed
     axis = [0.0, 1.0, 0.0]   # revolute / prismatic: unit direction, inertial axes at q = 0
@@ -25,7 +26,8 @@ Format (every key is checked; an unknown key is an error)::
 The root may use ``free`` (6 coordinates: surge, sway, heave, roll, pitch, yaw), ``planar`` (surge,
 heave, pitch) or ``free`` with ``dofs = [...]`` (any subset), or a revolute/prismatic/fixed joint to
 the inertial frame. For a root with several coordinates, ``damping``/``stiffness``/``rest`` take
-one value per coordinate.
+one value per coordinate. Several roots (bodies without ``parent``) each hang from the inertial
+frame: bodies that interact only through the water (or through loads such as moorings).
 """
 from __future__ import annotations
 
@@ -234,12 +236,20 @@ def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodyS
         if "mass" not in raw:
             raise ConfigError(f"{where}.mass: missing (kg, > 0)")
         mass = _number(raw["mass"], f"{where}.mass")
-        if mass <= 0:
-            raise ConfigError(f"{where}.mass: {raw['mass']!r} is not positive; give the mass in kg")
+        massless_hull = mass == 0 and isinstance(raw.get("joint"), dict) \
+            and raw["joint"].get("type") == "fixed" and raw.get("parent") is not None
+        if mass < 0 or (mass == 0 and not massless_hull):
+            raise ConfigError(f"{where}.mass: {raw['mass']!r} is not positive; give the mass in kg "
+                              "(0 only for a hull welded to its parent, joint type \"fixed\", whose "
+                              "mass the parent carries)")
         if "com" not in raw:
             raise ConfigError(f"{where}.com: missing; the centre of mass [x, y, z] in m at q = 0")
         com = _vector(raw["com"], 3, f"{where}.com")
-        inertia = _parse_inertia(raw, mass, where)
+        if massless_hull and not any(k in raw for k in ("inertia", "principal_inertia",
+                                                          "radii_of_gyration")):
+            inertia = np.zeros((3, 3))   # a massless hull: its `com` is its hydro reference point
+        else:
+            inertia = _parse_inertia(raw, mass, where)
         parent = raw.get("parent")
         if parent is not None and not isinstance(parent, str):
             raise ConfigError(f"{where}.parent: {parent!r} is not a body name")

@@ -1,7 +1,8 @@
 """Float trees: the validated, host-side description of a multi-body system.
 
-A tree is a list of bodies; each body hangs from its parent (or from the inertial frame, for the
-single root) by a joint. Everything here is plain numpy and Python: it is checked once, when a config
+A tree is a list of bodies; each body hangs from its parent (or from the inertial frame, for a
+root: usually one, several for bodies that are not connected, such as two floats that interact only
+through the water) by a joint. Everything here is plain numpy and Python: it is checked once, when a config
 is loaded, and then compiled into a :class:`mfm.model.Model` of jax arrays.
 
 Conventions (DESIGN §2): inertial frame with origin on the still-water line, z up. Each body frame
@@ -93,8 +94,9 @@ def check_inertia(inertia: np.ndarray, where: str) -> np.ndarray:
 
 def tree_order(bodies: Sequence[BodySpec]) -> list[BodySpec]:
     """Validate the topology and return the bodies in tree order (depth-first from the root,
-    children in the order given). Errors: duplicate names, unknown parent, cycles, no or two roots,
-    free/planar joints below the root."""
+    children in the order given; several roots in the order given, each hanging from the inertial
+    frame: two free bodies coupled only through the water). Errors: duplicate names, unknown
+    parent, cycles, no root, free/planar joints below a root."""
     names = [b.name for b in bodies]
     seen: set[str] = set()
     for i, n in enumerate(names):
@@ -110,10 +112,8 @@ def tree_order(bodies: Sequence[BodySpec]) -> list[BodySpec]:
     roots = [b.name for b in bodies if b.parent is None]
     if not roots:
         raise ConfigError("bodies: no root body (every body has a parent, so the parents form a "
-                          f"cycle); leave `parent` out of exactly one body. Bodies: {names}")
-    if len(roots) > 1:
-        raise ConfigError(f"bodies: {len(roots)} root bodies {roots} (bodies without `parent`); a "
-                          "tree has exactly one root: give the others a parent")
+                          f"cycle); leave `parent` out of the body (or bodies) that hang from the "
+                          f"inertial frame. Bodies: {names}")
     by_name = {b.name: b for b in bodies}
     # cycle detection: walk up from each body
     for i, b in enumerate(bodies):
@@ -136,10 +136,11 @@ def tree_order(bodies: Sequence[BodySpec]) -> list[BodySpec]:
         for c in children.get(b.name, []):
             visit(c)
 
-    visit(by_name[roots[0]])
+    for r in roots:  # several roots: bodies that each hang from the inertial frame
+        visit(by_name[r])
     for i, b in enumerate(bodies):
         if b.parent is not None and b.joint.kind in ("free", "planar"):
             raise ConfigError(f"bodies[{i}] ({b.name!r}).joint.type: {b.joint.kind!r} is only "
-                              "allowed for the root body; below the root use revolute, prismatic "
-                              "or fixed")
+                              "allowed for a root body (no parent); below a root use revolute, "
+                              "prismatic or fixed, or leave out `parent` to make it a root of its own")
     return ordered

@@ -40,7 +40,8 @@ CASES = {
                          d["bodies"].append({**copy.deepcopy(d["bodies"][1]), "name": "d", "parent": "c"})),
               ["parent", "cycle"]),
     "no root": (lambda d: d["bodies"][0].update(parent="b"), ["root"]),
-    "two roots": (lambda d: d["bodies"][1].pop("parent"), ["root", "'a'", "'b'"]),
+    "massless hinged body": (lambda d: d["bodies"][1].update(mass=0.0), ["bodies[1]", "mass", "fixed"]),
+    "massless root": (lambda d: d["bodies"][0].update(mass=0.0), ["bodies[0]", "mass", "parent"]),
     "asymmetric inertia": (lambda d: (d["bodies"][0].pop("principal_inertia"),
                                       d["bodies"][0].update(inertia=[[1, 0.1, 0], [0, 1, 0], [0, 0, 1]])),
                            ["bodies[0]", "inertia", "symmetric"]),
@@ -83,6 +84,44 @@ def test_load_reports_file_and_toml_errors(tmp_path):
     bad.write_text("[[bodies]\nname=")
     with pytest.raises(mfm.ConfigError, match="not valid TOML"):
         mfm.load(bad)
+
+
+def test_two_roots_each_hang_from_the_inertial_frame():
+    """Two bodies without a parent: each moves as it would alone (no coupling through the tree),
+    the second one's coordinates after the first's; a free joint below a root stays an error."""
+    d = modified(lambda d: (d["bodies"][1].pop("parent"),
+                            d["bodies"][1].update(joint={"type": "revolute", "axis": [0, 1, 0],
+                                                         "point": [0.5, 0, 0]})))
+    _, bodies = parse_config(d)
+    both = mfm.compile_tree(bodies)
+    assert both.coordinates[-1] == "b.angle" and both.bodies[1].parent is None
+    alone_a = mfm.compile_tree(parse_config({**d, "bodies": [d["bodies"][0]]})[1])
+    alone_b = mfm.compile_tree(parse_config({**d, "bodies": [d["bodies"][1]]})[1])
+    q = np.array([0.1, -0.2, 0.3, 0.05, -0.1, 0.2, 0.4])
+    qd = np.array([0.3, 0.1, -0.2, 0.4, 0.2, -0.1, 0.5])
+    qdd = np.asarray(mfm.forward_dynamics(both, q, qd))
+    np.testing.assert_allclose(qdd[:6], mfm.forward_dynamics(alone_a, q[:6], qd[:6]), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(qdd[6:], mfm.forward_dynamics(alone_b, q[6:], qd[6:]), rtol=1e-12, atol=1e-12)
+    # the pendulum b about y through (0.5, 0, 0), CoM 0.5 m along +x: gravity’s moment about +y
+    # is r × F = +m g r cos θ, so θ̈ = m g r cos θ / (I + m r²)
+    th = q[6]
+    assert qdd[6] == pytest.approx(9.81 * 0.5 * np.cos(th) / (1.0 + 0.25), rel=1e-12)
+    d["bodies"][1]["parent"] = "a"
+    d["bodies"][1]["joint"] = {"type": "free"}
+    with pytest.raises(mfm.ConfigError, match="only allowed for a root"):
+        parse_config(d)
+
+
+def test_massless_welded_hull_adds_nothing():
+    """A hull welded to its parent with mass 0 (its parent carries the mass): the model's
+    dynamics are those without it."""
+    hull = {"name": "h", "parent": "a", "mass": 0.0, "com": [3, 0, -1], "joint": {"type": "fixed"}}
+    with_hull = mfm.compile_tree(parse_config({**BASE, "bodies": BASE["bodies"] + [hull]})[1])
+    without = mfm.compile_tree(parse_config(BASE)[1])
+    q = np.array([0.1, -0.2, 0.3, 0.05, -0.1, 0.2, 0.4])
+    qd = np.array([0.3, 0.1, -0.2, 0.4, 0.2, -0.1, 0.5])
+    np.testing.assert_allclose(mfm.forward_dynamics(with_hull, q, qd),
+                               mfm.forward_dynamics(without, q, qd), rtol=1e-12)
 
 
 def test_inertia_forms_agree():

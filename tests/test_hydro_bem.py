@@ -455,3 +455,87 @@ def test_meshes_are_closed_with_outward_normals_and_exact_water_line():
     knuckle = (m[:, 0] > 0.05 + 1e-9) & (m[:, 1] < -0.089 - 1e-9)
     assert np.allclose(np.hypot(m[knuckle, 0] - 0.05, m[knuckle, 1] + 0.089), 0.125)
     assert m[-1] == pytest.approx([0.0, -0.214])
+
+
+STEPPED = [[8.0, 0.0], [8.0, -18.67], [16.0, -18.67], [16.0, -26.67], [0.0, -26.67]]
+
+
+def test_revolved_profile_is_the_cylinder_and_a_stepped_column_converges():
+    """shape "revolution": a flat cylinder's profile gives the cylinder's very panels; the stepped
+    OC4-like column's inscribed volume converges to π(8²·18.67 + 16²·8) as O(dθ²) (the panel
+    error of an inscribed polygon, 1 − sin(2π/n)/(2π/n)), and its water-plane area to π·8²."""
+    cyl = geo.normalize_spec({"name": "c", "shape": "cylinder", "radius": 1.0, "draft": 0.7})
+    rev = geo.normalize_spec({"name": "c", "shape": "revolution",
+                              "profile": [[1.0, 0.0], [1.0, -0.7], [0.0, -0.7]]})
+    np.testing.assert_array_equal(geo.meridian(cyl, 0.1), geo.meridian(rev, 0.1))
+    assert geo.n_azimuth(cyl, 0.1) == geo.n_azimuth(rev, 0.1)
+    col = geo.normalize_spec({"name": "col", "shape": "revolution", "profile": STEPPED})
+    exact = math.pi * (64 * 18.67 + 256 * 8)
+    for dx in (2.0, 1.0):
+        hull = geo.body_meshes(col, dx, lid=False)[0]
+        h = geo.hull_hydrostatics(hull, [0.0, 0.0, 0.0])
+        n = geo.n_azimuth(col, dx)
+        polygon = n * math.sin(2 * math.pi / n) / (2 * math.pi)   # inscribed area / circle area
+        assert h["volume"] == pytest.approx(exact * polygon, rel=1e-9)
+        assert h["waterplane_area"] == pytest.approx(math.pi * 64 * polygon, rel=1e-9)
+    # the step faces up: the base's top ring adds buoyancy below the upper column's water line
+    zB = (math.pi * 64 * 18.67 * (-18.67 / 2) + math.pi * 256 * 8 * (-18.67 - 4)) / exact
+    assert h["center_of_buoyancy"][2] == pytest.approx(zB, rel=1e-9)
+
+
+@pytest.mark.parametrize("profile, words", [
+    ([[8.0, -1.0], [0.0, -2.0]], "water line"),
+    ([[8.0, 0.0], [8.0, -2.0]], "axis"),
+    ([[8.0, 0.0], [-1.0, -2.0], [0.0, -3.0]], "r must"),
+    ([[8.0, 0.0], [8.0, 1.0], [0.0, -3.0]], "z ≤ 0"),
+    ([[8.0, 0.0], [8.0, 0.0], [0.0, -3.0]], "repeats"),
+    ([[8.0, 0.0], [0.0, -1.0], [4.0, -2.0], [0.0, -3.0]], "touches the axis"),
+    ("tall", "not a list"),
+])
+def test_revolved_profile_errors_name_the_point(profile, words):
+    with pytest.raises(ValueError, match="'profile'") as info:
+        geo.normalize_spec({"name": "a", "shape": "revolution", "profile": profile})
+    assert words in str(info.value)
+
+
+def test_per_body_panel_size():
+    """A body's own ``dx`` sets its panels, the layout's ``dx`` the others'."""
+    small = {"name": "w", "shape": "hemisphere", "radius": 1.0, "dx": 0.1, "origin": [5.0, 0, 0]}
+    big = {"name": "p", "shape": "cylinder", "radius": 1.0, "draft": 1.0}
+    specs = geo.normalize_specs([big, small])
+    body, used, hulls = bem.build_body(specs, 0.5, lid=False)
+    own = geo.body_meshes(geo.normalize_spec(small), 0.1, lid=False)[0].nb_faces
+    other = geo.body_meshes(geo.normalize_spec(big), 0.5, lid=False)[0].nb_faces
+    assert hulls[1].nb_faces == own and hulls[0].nb_faces == other and own > other
+
+
+def test_deep_water_above_kh_is_the_deep_solve_there_and_finite_below():
+    """``deep_water_kh``: each frequency is solved exactly as the plain deep or finite-depth solve
+    would (same panels, same code path; 1e-4: capytaine's finite-depth values of one ω move by
+    ≈ 1e-5 with the other problems solved beside it, its Green-function and matrix caches), the
+    dataset keeps the physical depth and records where the split lies."""
+    b = [{"name": "h", "shape": "hemisphere", "radius": 1.0}]
+    h = 4.0
+    omega = [1.0, 2.0, 3.5]   # k h = 0.6, 1.8 (finite), 5.0 (deep: k = 3.5²/9.81 = 1.25 /m)
+    kw = dict(dx=0.4, cache=False, progress=False)
+    split = bem.solve(b, omega=omega, water_depth=h, deep_water_kh=4.9, **kw)
+    fin = bem.solve(b, omega=omega[:2], water_depth=h, infinite_frequency=False, **kw)
+    deep = bem.solve(b, omega=omega[2:], **kw)
+    assert split.attrs["water_depth"] == h and split.attrs["deep_water_omega_min"] == "3.5"
+    np.testing.assert_array_equal(split["omega"].values[:3], omega)
+    for v in ("added_mass", "radiation_damping"):
+        s = split[v].values
+        np.testing.assert_allclose(s[:2], fin[v].values, rtol=1e-4, atol=1e-4 * np.abs(s).max())
+        np.testing.assert_allclose(s[2:], deep[v].values, rtol=1e-4, atol=1e-4 * np.abs(s).max())
+    ex = split["excitation_force"].values
+    top = np.abs(ex[:3]).max()   # sway and roll are round-off (1e-13) at heading 0
+    np.testing.assert_allclose(ex[:2], fin["excitation_force"].values, rtol=1e-4, atol=1e-9 * top)
+    np.testing.assert_allclose(ex[2:3], deep["excitation_force"].values[:1], rtol=1e-4,
+                               atol=1e-9 * top)
+    # and the depth matters below the split: the finite-depth heave damping at k h = 0.6 is not
+    # the deep-water one
+    deep_low = bem.solve(b, omega=omega[:1], infinite_frequency=False, **kw)
+    b_fin = float(split["radiation_damping"].values[0, 2, 2])
+    assert abs(b_fin / float(deep_low["radiation_damping"].values[0, 2, 2]) - 1) > 0.05
+    with pytest.raises(ValueError, match="deep_water_kh"):
+        bem.solve(b, omega=omega, water_depth=h, deep_water_kh=-1.0, **kw)
