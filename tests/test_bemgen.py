@@ -151,6 +151,8 @@ def test_overrides_and_out(tmp_path, capsys):
     ("symmetry = \"xoz\"", r"hydro\.bem\.symmetry: 'xoz'"),
     ("lid = 1", r"hydro\.bem\.lid: 1 is not true or false"),
     ("symmetry = \"none\"\n[hydro.bem.x]", r"hydro\.bem: unknown key\(s\) \['x'\]"),
+    ("deep_water_kh = 5.0", r"hydro\.bem\.deep_water_kh: 5 with water_depth \"inf\""),
+    ("deep_water_kh = -5.0", r"hydro\.bem\.deep_water_kh: -5\.0 must be > 0"),
 ])
 def test_bad_bem_settings_name_the_key(tmp_path, extra_bem, match):
     cfg = _write(tmp_path, extra_bem=extra_bem)
@@ -186,6 +188,7 @@ def test_missing_dx_and_water_depth_text(tmp_path):
     ("knuckle_radius = 0.02", r"bodies\[0\] \('a'\)\.geometry\.knuckle_radius:"),
     ("origin = [0.0, 0.0, 0.1]", r"bodies\[0\] \('a'\)\.geometry\.origin:"),
     ("name = \"x\"", r"bodies\[0\] \('a'\)\.geometry\.name: unknown key"),
+    ("dx = -0.1", r"bodies\[0\] \('a'\)\.geometry\.dx:"),
 ])
 def test_bad_geometry_names_the_key(tmp_path, extra_geometry, match):
     cfg = _write(tmp_path, extra_geometry=extra_geometry)
