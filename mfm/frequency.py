@@ -45,31 +45,47 @@ def system_loads(model: Model, loads=None) -> tuple:
     return model_loads(model, None, dt=1.0, duration=1.0, radiation="none") + _as_loads(loads)
 
 
-def _static_functions(model: Model, loads):
-    """Q(q, q̇) (generalised loads other than inertia) and the acceleration-proportional matrix of
-    the loads at rest, M_loads(q)."""
+def _static_parts(model, static, mems, q, qd):
+    """Q(q, q̇) (generalised loads other than inertia) and the acceleration-proportional matrix
+    of the loads at rest (None when no load has one)."""
     from .simulate import applied_loads
 
+    nz = sum(ld.n_states for ld in static)
+    kin = kinematics(model, q, qd)
+    body, tau, mass, _ = applied_loads(model, static, 0.0, q, qd, jnp.zeros(nz), kin, mems)
+    F = gravity_loads(model) + (0.0 if body is None else body)
+    out = jnp.einsum("nai,na->i", kin.B, F) + joint_loads(model, q, qd)
+    return (out if tau is None else out + tau), mass
+
+
+# Compiled once per model structure (model, loads and memories are pytree arguments, not closed
+# over): a second equilibrium or linearisation of the same model reuses them.
+@jax.jit
+def _Q_at_rest(model, static, mems, q):
+    return _static_parts(model, static, mems, q, jnp.zeros_like(q))[0]
+
+
+_dQ_dq = jax.jit(jax.jacfwd(_Q_at_rest, argnums=3))
+
+
+@jax.jit
+def _dQ_dqd(model, static, mems, q):
+    return jax.jacfwd(lambda v: _static_parts(model, static, mems, q, v)[0])(jnp.zeros_like(q))
+
+
+@jax.jit
+def _loads_mass(model, static, mems, q):
+    mass = _static_parts(model, static, mems, q, jnp.zeros_like(q))[1]
+    return jnp.zeros((q.shape[0],) * 2) if mass is None else mass
+
+
+def _static_functions(model: Model, loads):
+    """The loads at rest (:meth:`Load.static_load`) and their memories, ready for the compiled
+    functions above: (static, mems)."""
     static = tuple(s for s in (ld.static_load() for ld in loads) if s is not None)
     zero = jnp.zeros(model.n_coordinates)
     mems = tuple(ld.init_memory(model, 0.0, zero, zero, 1.0) for ld in static)
-    nz = sum(ld.n_states for ld in static)
-
-    def parts(q, qd):
-        kin = kinematics(model, q, qd)
-        body, tau, mass, _ = applied_loads(model, static, 0.0, q, qd, jnp.zeros(nz), kin, mems)
-        F = gravity_loads(model) + (0.0 if body is None else body)
-        out = jnp.einsum("nai,na->i", kin.B, F) + joint_loads(model, q, qd)
-        return (out if tau is None else out + tau), mass
-
-    def Q(q, qd):
-        return parts(q, qd)[0]
-
-    def M_loads(q):
-        mass = parts(q, jnp.zeros_like(q))[1]
-        return jnp.zeros((model.n_coordinates,) * 2) if mass is None else mass
-
-    return Q, M_loads
+    return static, mems
 
 
 def equilibrium(model: Model, q_guess=None, *, loads=None, tol: float = 1e-10, max_iter: int = 50):
@@ -85,10 +101,9 @@ def equilibrium(model: Model, q_guess=None, *, loads=None, tol: float = 1e-10, m
 
 
 def _equilibrium(model, loads, q_guess=None, tol=1e-10, max_iter=50):
-    Q, _ = _static_functions(model, loads)
-    G = lambda q: Q(q, jnp.zeros_like(q))  # noqa: E731
-    Gj = jax.jit(G)
-    Jj = jax.jit(jax.jacfwd(G))
+    static, mems = _static_functions(model, loads)
+    Gj = lambda q: _Q_at_rest(model, static, mems, q)  # noqa: E731
+    Jj = lambda q: _dQ_dq(model, static, mems, q)  # noqa: E731
     q = jnp.zeros(model.n_coordinates) if q_guess is None else jnp.asarray(q_guess, jnp.float64)
     # the size of the loads that must balance: generalised weights, or the largest weight
     scale = max(float(jnp.max(jnp.abs(jnp.einsum("nai,na->i", kinematics(model, q).B,
@@ -148,12 +163,11 @@ def _linear_system(model, lds, q0=None):
     if q0 is None:
         q0, _ = _equilibrium(model, lds)
     q0 = jnp.asarray(q0, jnp.float64)
-    Q, M_loads = _static_functions(model, lds)
-    zero = jnp.zeros_like(q0)
-    K = -np.asarray(jax.jacfwd(lambda q: Q(q, zero))(q0))
-    C = -np.asarray(jax.jacfwd(lambda v: Q(q0, v))(zero))
-    M = np.asarray(mass_matrix(model, q0)) + np.asarray(M_loads(q0))
-    return LinearSystem(np.asarray(q0), M, K, C, kinematics(model, q0, zero), lds)
+    static, mems = _static_functions(model, lds)
+    K = -np.asarray(_dQ_dq(model, static, mems, q0))
+    C = -np.asarray(_dQ_dqd(model, static, mems, q0))
+    M = np.asarray(mass_matrix(model, q0)) + np.asarray(_loads_mass(model, static, mems, q0))
+    return LinearSystem(np.asarray(q0), M, K, C, kinematics(model, q0, jnp.zeros_like(q0)), lds)
 
 
 def linearise(model: Model, q0=None, *, loads=None):
