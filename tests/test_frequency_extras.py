@@ -230,6 +230,33 @@ def test_joint_reactions_of_a_prescribed_motion_by_newton_euler(tmp_path):
         np.testing.assert_allclose(rao[k, :, 4], (-w**2 * sys.M + sys.K) @ x[k], atol=1e-10)
 
 
+def test_joint_reactions_with_a_piston_between_two_bodies_along_the_free_directions(tmp_path):
+    """The seed 000 arrangement dry: a base on a planar joint (springs) and an arm hinged to it,
+    a piston (μ, β, κ) between them, out of the plane (tests/test_device_ptos.py). In a prescribed
+    harmonic motion x̂ the joints' free directions carry the generalised loads the motion needs,
+    τ = (−ω² M − iω C_g + K_g) x̂ with C_g, K_g the damping and stiffness of everything but the
+    joints' own spring–dampers (which the joints carry): the base's surge and heave force and
+    pitch moment about its CoM, the arm's hinge moment. This holds only if the piston's reaction on
+    both bodies (μ ẅ included) is its generalised load gᵀf: 1e-9 of the largest."""
+    from test_device_ptos import CONFIG
+
+    path = tmp_path / "hinged_pto.toml"
+    path.write_text(CONFIG)
+    model = mfm.load(path)
+    omega = np.array([0.9, 3.0])
+    rng = np.random.default_rng(3)
+    x = rng.normal(size=(2, 4)) + 1j * rng.normal(size=(2, 4))
+    _, rao = joint_reactions(model, omega, x, q0=np.zeros(4))
+    sys = linear_system(model, np.zeros(4))
+    Kg = sys.K - np.diag(np.asarray(model.stiffness))
+    Cg = sys.C - np.diag(np.asarray(model.damping))
+    assert np.abs(sys.M - mfm.mass_matrix(model, np.zeros(4))).max() > 0.1     # μ g gᵀ is there
+    for k, w in enumerate(omega):
+        tau = (-w**2 * sys.M - 1j * w * Cg + Kg) @ x[k]
+        got = [rao[k, 0, 0], rao[k, 0, 2], rao[k, 0, 4], rao[k, 1, 4]]
+        np.testing.assert_allclose(got, tau, rtol=0, atol=1e-9 * np.abs(tau).max())
+
+
 class _Memory(Load):
     """A load with a frequency-dependent term and no body loads for it."""
 
