@@ -26,7 +26,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from . import results
-from .dynamics import gravity_loads, joint_loads, mass_matrix
+from .dynamics import Evaluation, gravity_loads, joint_loads, mass_matrix, reaction_loads
 from .kinematics import kinematics
 from .model import Model
 
@@ -200,9 +200,109 @@ def _terms(model, sys, omega, heading, options):
     return Z, F
 
 
+def _reaction_function(model, loads):
+    """The joint reactions of :func:`mfm.simulate` (``_record``: every load's
+    :meth:`~mfm.loads.base.Load.reaction_loads` on the bodies, gravity, then
+    :func:`mfm.dynamics.reaction_loads`) as a function R(q, q̇, q̈) → (n, 6) [force; moment about
+    the joint point], inertial axes, with the loads at rest in still water (their static loads):
+    the joint springs and dampers, and loads acting on the coordinates directly, reach the joints
+    through each body's Newton–Euler residual, as in the time domain."""
+    from .simulate import _state_offsets, applied_loads
+    from .loads.base import Context
+
+    static = tuple(s for s in (ld.static_load() for ld in loads) if s is not None)
+    zero = jnp.zeros(model.n_coordinates)
+    mems = tuple(ld.init_memory(model, 0.0, zero, zero, 1.0) for ld in static)
+    offs = _state_offsets(static)
+    z = jnp.zeros(int(offs[-1]))
+
+    def R(q, qd, qdd):
+        kin = kinematics(model, q, qd)
+        _, _, _, _, outs = applied_loads(model, static, 0.0, q, qd, z, kin, mems, with_outputs=True)
+        F = gravity_loads(model)
+        for k, (ld, out) in enumerate(zip(static, outs)):
+            ctx = Context(model, 0.0, q, qd, z[offs[k]:offs[k + 1]], kin, mems[k], None, qdd)
+            Fk = ld.reaction_loads(ctx, out)
+            if Fk is not None:
+                F = F + Fk
+        Xdot = jnp.einsum("nai,i->na", kin.B, qdd) + kin.bias
+        f, m = reaction_loads(model, Evaluation(qdd=qdd, kin=kin, X=kin.X, Xdot=Xdot, F=F, Q=None))
+        return jnp.concatenate([f, m], axis=1)
+
+    return R
+
+
+@jax.jit
+def _reaction_derivatives(model, loads, q0):
+    """R(q₀, 0, 0) and ∂R/∂q, ∂R/∂q̇, ∂R/∂q̈ there (compiled once per model structure)."""
+    R = _reaction_function(model, loads)
+    zero = jnp.zeros_like(q0)
+    return R(q0, zero, zero), jax.jacfwd(R, argnums=(0, 1, 2))(q0, zero, zero)
+
+
+def _joint_reactions(model, sys, omega, heading, options, x):
+    """(static (n, 6), complex amplitudes (n_ω, n, 6)): see :func:`joint_reactions`."""
+    static, (Jq, Jv, Ja) = jax.tree_util.tree_map(
+        np.asarray, _reaction_derivatives(model, sys.loads, jnp.asarray(sys.q0, jnp.float64)))
+    w = omega[:, None, None, None]
+    D = Jq[None] - 1j * w * Jv[None] - w**2 * Ja[None]           # (n_ω, n, 6, n_q)
+    out = np.einsum("wnai,wi->wna", D, x)
+    n = model.n_bodies
+    zeros6 = jnp.zeros((n, 6))
+
+    def of_wrench(W):
+        """The reactions that balance extra body loads W (n, 6) at q₀, the bodies at rest."""
+        f, m = reaction_loads(model, Evaluation(qdd=None, kin=sys.kin0, X=zeros6, Xdot=zeros6,
+                                                F=jnp.asarray(W), Q=None))
+        return np.concatenate([np.asarray(f), np.asarray(m)], axis=1)
+
+    for ld in sys.loads:
+        W = ld.frequency_body_loads(model, sys.q0, sys.kin0, omega, heading, options, x)
+        if W is None:
+            continue
+        out = out + np.stack([of_wrench(Wk.real) + 1j * of_wrench(Wk.imag) for Wk in W])
+    return static, out
+
+
+def joint_reactions(model: Model, omega, x, *, heading: float = 0.0, q0=None, loads=None,
+                    radiation: str = "database", state_space_options: dict | None = None):
+    """The loads each joint transmits (the time domain's ``joint_force`` and ``joint_moment``: from
+    the parent, or the inertial frame, to the body; inertial axes; moment about the joint point),
+    linearised about q₀ for the coordinate amplitudes x (n_ω, n_q) (x(t) = Re[x̂ e^{−iωt}]).
+
+    With R(q, q̇, q̈) the reactions of the time domain (:func:`mfm.dynamics.reaction_loads` of each
+    body's Newton–Euler residual M_i Ẋ_i + ω × J ω − F_i, summed from the leaves) under the loads
+    at rest (gravity, hydrostatics and buoyancy, A∞, PTO μ/β/κ, joint springs and dampers),
+
+        R̂(ω) = (∂R/∂q − iω ∂R/∂q̇ − ω² ∂R/∂q̈) x̂ + L(Ŵ(ω)),
+
+    all derivatives at (q₀, 0, 0) (jax), Ŵ(ω) the body loads of each load's frequency terms
+    (:meth:`~mfm.loads.base.Load.frequency_body_loads`: the water's excitation X(ω, β) and its
+    radiation memory −[−ω²(A(ω) − A∞) − iωB(ω)] H₀ x̂) and L the (linear) reaction that balances a
+    body load on bodies at rest. Products of two first-order quantities (the rotation of a
+    first-order load, Ḣq̇, gyroscopic terms) are second order and drop out; the static preload
+    R(q₀, 0, 0) is returned separately.
+
+    Along a joint's free directions the result is the joint's own generalised load (its spring and
+    damper: −(k − iωc) x̂ for a hinge); across them, the constraint load.
+
+    Returns (static (n_bodies, 6) N and N m, amplitudes (n_ω, n_bodies, 6) N/m and N m/m per metre of
+    wave amplitude when x is a RAO); the last axis is (fx, fy, fz, mx, my, mz). Raises
+    NotImplementedError naming a load whose frequency terms cannot be put on the bodies.
+    """
+    omega = np.atleast_1d(np.asarray(omega, dtype=float))
+    x = np.asarray(x)
+    if x.shape != (omega.size, model.n_coordinates):
+        raise ValueError(f"x: shape {x.shape}; expected (n_omega, n_coordinates) = "
+                         f"({omega.size}, {model.n_coordinates})")
+    sys = linear_system(model, q0, loads=loads)
+    options = {"radiation": radiation, "state_space_options": state_space_options}
+    return _joint_reactions(model, sys, omega, float(heading), options, x)
+
+
 def frequency_response(model: Model, omega, heading: float = 0.0, *, q0=None,
                        radiation: str = "database", state_space_options: dict | None = None,
-                       loads=None):
+                       loads=None, joint_reactions: bool = True):
     """Complex RAOs (per metre of wave amplitude, x(t) = Re[x̂ e^{−iωt}]) of every coordinate,
     body (CoM displacement and small rotation, inertial axes), hydro dof and PTO, with the absorbed
     power per unit wave amplitude squared, from the model linearised about its equilibrium with
@@ -217,7 +317,10 @@ def frequency_response(model: Model, omega, heading: float = 0.0, *, q0=None,
     Returns an xarray.Dataset: ``rao`` (omega, coordinate), ``body_rao`` (omega, body, dof) with
     dof = x, y, z, rx, ry, rz, ``xi_rao`` (omega, hydro_dof), ``pto_rao`` and ``pto_power``
     (omega, pto) (W/m², mean power ½ c ω² |x̂|²), the loads' own outputs (``hydraulic_pto_power``,
-    ``point_rao``, …), ``equilibrium`` (coordinate).
+    ``point_rao``, ``hydraulic_pto_force_rao``, …), ``equilibrium`` (coordinate); with
+    ``joint_reactions`` (default) ``joint_force_rao`` and ``joint_moment_rao`` (omega, body, axis)
+    per metre of wave amplitude and the static preload ``joint_force_static``,
+    ``joint_moment_static`` (body, axis) (:func:`joint_reactions`).
     """
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: frequency_response needs a "
@@ -236,11 +339,12 @@ def frequency_response(model: Model, omega, heading: float = 0.0, *, q0=None,
     Z = -w**2 * sys.M[None] - 1j * w * sys.C[None] + sys.K[None] + Zl
     x = np.linalg.solve(Z, F[..., None])[..., 0]
     extra = [ld.frequency_outputs(model, sys.kin0, x, omega) for ld in sys.loads]
+    reactions = _joint_reactions(model, sys, omega, heading, options, x) if joint_reactions else None
     settings = {"radiation": radiation}
     if state_space_options:
         settings["state_space_options"] = repr(state_space_options)
     return results.frequency(model, sys.loads, omega, x, sys.q0, sys.kin0, heading, settings,
-                             [e for e in extra if e])
+                             [e for e in extra if e], reactions)
 
 
 def _frequency_range(loads):
@@ -271,12 +375,20 @@ def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: i
         M_ss − M_sf M_ff⁻¹ M_fs, the free part of each mode shape −M_ff⁻¹ M_fs φ_s).
     min_det: local minima of |det Λ(ω)|, Λ = −ω² M_eff(ω) + K_ss, over ``omega_grid``
         (seed 000 §2.10), refined parabolically.
+    min_det_damped: the same with the damping kept (seed 000 eq. 27's remark):
+        |det(−ω² M(ω) − iω (C + B(ω)) + K)|, B(ω) the radiation damping, C the joint, PTO and
+        body-matrix damping, free coordinates condensed out dynamically; refined by a bounded
+        search (:func:`_damped_minima`). These are the peaks of the response to a force of
+        constant amplitude, not the damped natural frequencies ω_n √(1 − ζ²) of free decay: for
+        one dof |det|² = (k − mω²)² + (cω)², and d/d(ω²) = 0 gives
+        ω² = (2km − c²)/(2m²) = ω_n² (1 − 2ζ²), ζ = c / (2√(km)). Seed 000 eq. 32 writes
+        ω_n √(1 − ζ²) there, which is the free-decay frequency, not the minimum.
     damping_ratio: φᵀ C φ / (2 ω φᵀ M(ω) φ) of each mode for the linear damping C (joint dampers,
         hydraulic β, body matrices); radiation_damping_ratio the same with Hᵀ B(ω) H.
 
     Returns an xarray.Dataset: ``eigen``, ``period``, ``damping_ratio``,
     ``radiation_damping_ratio``, ``damped`` (mode), ``modes`` (coordinate, mode), ``min_det``
-    (root); it reads like the former dict (``nat["eigen"]``).
+    (root), ``min_det_damped`` (root_damped); it reads like the former dict (``nat["eigen"]``).
     """
     import scipy.linalg
 
@@ -338,9 +450,110 @@ def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: i
             h = grid[i + 1] - grid[i]
             den = y0 - 2 * y1 + y2
             mins.append(grid[i] + (0.5 * h * (y0 - y2) / den if den > 0 else 0.0))
+    mins_damped = _damped_minima(model, sys, grid, stiff, free, options)
     modes = np.array(modes).T if modes else np.zeros((model.n_coordinates, 0))
     return results.natural(model, sys.loads, np.array(freqs), modes, np.array(zeta),
-                           np.array(zeta_rad), np.array(mins), {"radiation": radiation})
+                           np.array(zeta_rad), np.array(mins), {"radiation": radiation},
+                           min_det_damped=np.array(mins_damped))
+
+
+def _damped_minima(model, sys, grid, stiff, free, options):
+    """Local minima over ``grid`` of |det Λ_d(ω)|, Λ_d = −ω² M(ω) − iω (C + B(ω)) + K, the free
+    coordinates condensed out dynamically (Schur complement Λ_ss − Λ_sf Λ_ff⁻¹ Λ_fs, which is the
+    undamped condensation when C = B = 0), each refined by a bounded Brent search on log|det|
+    between its grid neighbours (|det Λ_d| is smooth at a damped minimum: no cusp)."""
+    import scipy.optimize
+
+    if not stiff:
+        return []
+    ss, sf, fs, ff = (np.ix_(a, b) for a, b in ((stiff, stiff), (stiff, free), (free, stiff),
+                                                 (free, free)))
+
+    def log_det(w):
+        w = np.atleast_1d(np.asarray(w, dtype=float))
+        Mw, Cr = _mass_and_damping_at(model, sys, w, options)
+        W = w[:, None, None]
+        L = -W**2 * Mw - 1j * W * (sys.C[None] + Cr) + sys.K[None]
+        if free:
+            L = L[(slice(None),) + ss] - L[(slice(None),) + sf] @ np.linalg.solve(
+                L[(slice(None),) + ff], L[(slice(None),) + fs])
+        return np.linalg.slogdet(L)[1]
+
+    y = log_det(grid)
+    out = []
+    for i in range(1, len(grid) - 1):
+        if y[i] < y[i - 1] and y[i] <= y[i + 1]:
+            r = scipy.optimize.minimize_scalar(lambda w: float(log_det(w)[0]),
+                                               bounds=(grid[i - 1], grid[i + 1]), method="bounded",
+                                               options={"xatol": 1e-12 * grid[i]})
+            out.append(float(r.x))
+    return out
+
+
+def cubic_natural_frequencies(M, K):
+    """The three natural frequencies (rad/s, ascending) of a 3-dof undamped system with constant
+    mass M and stiffness K (3, 3), from the cubic of seed 000 §2.11 (eqs. 37–44):
+
+        P(λ) = det(K − λM) = â λ³ + b̂ λ² + ĉ λ + d̂,   λ = ω²,
+        â = −det M,  b̂ = tr(adj(M) K),  ĉ = −tr(adj(K) M),  d̂ = det K
+
+    (the expansion det(A + tB) = det A + t tr(adj(A) B) + t² tr(A adj(B)) + t³ det B). Its
+    discriminant Δ₃ = 18âb̂ĉd̂ − 4b̂³d̂ + b̂²ĉ² − 4âĉ³ − 27â²d̂² (eq. 40) is > 0 for three distinct
+    real roots; with Δ₀ = b̂² − 3âĉ, Δ₁ = 2b̂³ − 9âb̂ĉ + 27â²d̂ (eqs. 43, 44) Cardano's E of eq. 42
+    is complex there, |E| = √Δ₀, arg E = φ/3 with cos φ = Δ₁ / (2 Δ₀^{3/2}), and eq. 41 becomes
+    the trigonometric form
+
+        λ_k = −(b̂ + 2 √Δ₀ cos((φ + 2πk)/3)) / (3â),   k = 0, 1, 2,
+
+    (real arithmetic, no cancellation of complex parts). Each root is then polished by Newton
+    steps on P itself. For symmetric M positive definite and symmetric K the roots are the
+    generalised eigenvalues of (K, M): real; positive when K is positive definite.
+
+    Raises ValueError when M or K is not a finite 3×3 matrix, when det M = 0 (no cubic), when
+    Δ₃ < 0 (complex roots: M and K are not a symmetric pair with M positive definite) or when a
+    root ω² ≤ 0 (K not positive definite: a mode without restoring stiffness, or unstable).
+    """
+    M = np.asarray(M, dtype=float)
+    K = np.asarray(K, dtype=float)
+    for name, A in (("M", M), ("K", K)):
+        if A.shape != (3, 3) or not np.isfinite(A).all():
+            raise ValueError(f"{name}: give a finite 3×3 matrix (got shape {A.shape}); the cubic "
+                             "is for three coordinates (reduce the model first)")
+
+    def adj(A):
+        """The adjugate: the transposed cofactors (defined for a singular A too)."""
+        return np.array([[(-1) ** (i + j) * np.linalg.det(np.delete(np.delete(A, j, 0), i, 1))
+                          for j in range(3)] for i in range(3)])
+
+    detM = np.linalg.det(M)
+    if not abs(detM) > 1e-14 * np.abs(M).max() ** 3:
+        raise ValueError(f"M: det M = {detM:.4g}: singular, so det(K − ω²M) is not a cubic in ω² "
+                         "(a coordinate without inertia); give a positive definite mass matrix")
+    a, b, c, d = -detM, np.trace(adj(M) @ K), -np.trace(adj(K) @ M), np.linalg.det(K)
+    disc = 18 * a * b * c * d - 4 * b**3 * d + b**2 * c**2 - 4 * a * c**3 - 27 * a**2 * d**2
+    d0 = b**2 - 3 * a * c
+    d1 = 2 * b**3 - 9 * a * b * c + 27 * a**2 * d
+    # scale of Δ₃ (each of its terms is of the size of (b̂ĉ)²): below it, a rounding of a double root
+    scale = max(abs(18 * a * b * c * d), abs(b**3 * d), (b * c) ** 2, abs(a * c**3), (a * d) ** 2)
+    if disc < -1e-10 * scale:
+        raise ValueError(f"M, K: the cubic det(K − ω²M) has complex roots (discriminant Δ₃ = "
+                         f"{disc:.4g} < 0): M and K are not a symmetric pair with M positive "
+                         "definite")
+    cos_phi = np.clip(d1 / (2 * max(d0, 0.0) ** 1.5), -1.0, 1.0) if d0 > 0 else 1.0
+    phi = math.acos(cos_phi)
+    lam = np.array([-(b + 2 * math.sqrt(max(d0, 0.0)) * math.cos((phi + 2 * math.pi * k) / 3))
+                    / (3 * a) for k in range(3)])
+    for _ in range(3):            # Newton on P: the rounding of the trigonometric form away
+        P = ((a * lam + b) * lam + c) * lam + d
+        dP = (3 * a * lam + 2 * b) * lam + c
+        step = np.where(np.abs(dP) > 0, P / np.where(dP == 0, 1.0, dP), 0.0)
+        lam = lam - step
+    lam = np.sort(lam)
+    if not lam[0] > 0:
+        raise ValueError(f"K: the cubic det(K − ω²M) has the root ω² = {lam[0]:.4g} ≤ 0: K is not "
+                         "positive definite (a mode without restoring stiffness, or an unstable "
+                         "one); remove free coordinates first")
+    return np.sqrt(lam)
 
 
 def critical_damping(model: Model, body: str, mode: str, ratio: float, *, point=None,

@@ -248,8 +248,10 @@ def batch(model, models, loads, integ, t, q, qd, dts, settings, save_every, labe
 
 
 # ------------------------------------------------------------------------------- frequency domain
-def frequency(model, loads, omega, x, q0, kin0, heading, settings, extra) -> xr.Dataset:
-    """The dataset of :func:`mfm.frequency_response` from the coordinate amplitudes x (n_ω, n_q)."""
+def frequency(model, loads, omega, x, q0, kin0, heading, settings, extra,
+              reactions=None) -> xr.Dataset:
+    """The dataset of :func:`mfm.frequency_response` from the coordinate amplitudes x (n_ω, n_q);
+    ``reactions`` (static, amplitudes) of the joints (:func:`add_joint_reactions`)."""
     Bm = np.asarray(kin0.B)
     R = np.asarray(kin0.E[:, :3, :3])
     body = np.concatenate([np.einsum("nai,wi->wna", Bm[:, :3], x),
@@ -284,10 +286,35 @@ def frequency(model, loads, omega, x, q0, kin0, heading, settings, extra) -> xr.
         ds = ds.assign_coords({k: v for k, v in coords.items() if k not in ds.coords})
         for name, (dims, values, attrs) in out.items():
             ds[name] = (("omega",) + tuple(dims), values, attrs)
+    if reactions is not None:
+        ds = add_joint_reactions(ds, *reactions)
     return ds
 
 
-def natural(model, loads, freqs, modes, zeta, zeta_rad, min_det, settings) -> xr.Dataset:
+def add_joint_reactions(ds, static, rao):
+    """Add the joint reactions of a frequency response (:func:`mfm.frequency.joint_reactions`):
+    static (n, 6) and complex amplitudes (n_ω, n, 6), the last axis (fx, fy, fz, mx, my, mz)."""
+    static, rao = np.asarray(static), np.asarray(rao)
+    where = "inertial axes, moment about the joint point"
+    ds = ds.assign_coords({k: v for k, v in RECORD_COORDS.items() if k == "axis" and k not in ds.coords})
+    ds["joint_force_rao"] = (("omega", "body", "axis"), rao[..., :3], {
+        "long_name": "force each joint transmits from its parent (or the inertial frame) per metre "
+                     f"of wave amplitude, first order about the equilibrium, {where}",
+        "units": "N/m"})
+    ds["joint_moment_rao"] = (("omega", "body", "axis"), rao[..., 3:], {
+        "long_name": f"moment each joint transmits per metre of wave amplitude, {where}",
+        "units": "N m/m"})
+    ds["joint_force_static"] = (("body", "axis"), static[:, :3], {
+        "long_name": f"force each joint transmits at the static equilibrium (preload), {where}",
+        "units": "N"})
+    ds["joint_moment_static"] = (("body", "axis"), static[:, 3:], {
+        "long_name": f"moment each joint transmits at the static equilibrium, {where}",
+        "units": "N m"})
+    return ds
+
+
+def natural(model, loads, freqs, modes, zeta, zeta_rad, min_det, settings,
+            min_det_damped=()) -> xr.Dataset:
     """The dataset of :func:`mfm.natural_frequencies`."""
     n = len(freqs)
     with np.errstate(invalid="ignore"):
@@ -309,7 +336,11 @@ def natural(model, loads, freqs, modes, zeta, zeta_rad, min_det, settings) -> xr
          "modes": (("coordinate", "mode"), np.asarray(modes).reshape(model.n_coordinates, n),
                    {"long_name": "mode shapes (coordinates)"}),
          "min_det": (("root",), np.asarray(min_det), {"long_name": "local minima of |det Λ(ω)| "
-                                                      "(seed 000 §2.10)", "units": "rad/s"})},
+                                                      "(seed 000 §2.10)", "units": "rad/s"}),
+         "min_det_damped": (("root_damped",), np.asarray(min_det_damped, dtype=float),
+                            {"long_name": "local minima of |det(−ω² M(ω) − iω (C + B(ω)) + K)|, "
+                             "damping kept: the peaks of the response to a force of constant "
+                             "amplitude, ω_n √(1 − 2ζ²) for one dof", "units": "rad/s"})},
         coords={"mode": np.arange(n), **_coordinate_coords(model)},
         attrs={"title": f"mfm natural frequencies of {model.name}",
                **provenance(model, loads, **settings)})

@@ -131,6 +131,21 @@ class Load(eqx.Module):
         """Frequency-dependent impedance and wave force about q₀ (default: none)."""
         return FrequencyTerms()
 
+    def frequency_body_loads(self, model, q0, kin0, omega, heading: float, options: dict, x):
+        """The body loads (n_ω, n, 6) complex (force inertial, moment about the CoM in body axes,
+        per metre of wave amplitude) of this load's :meth:`frequency_terms` for the coordinate
+        amplitudes x (n_ω, n_q): F(ω) − Z_load(ω) x̂ put on the bodies, so that the joint reactions
+        of a frequency response see them (:func:`mfm.frequency.joint_reactions`). Default: None
+        for a load without frequency terms; a load with frequency terms must say where they act,
+        else this raises (a reaction without them would be wrong)."""
+        if type(self).frequency_terms is Load.frequency_terms:
+            return None
+        raise NotImplementedError(
+            f"load {type(self).__name__}: it adds frequency-dependent terms (frequency_terms) but "
+            "does not give the body loads they make (frequency_body_loads), so the joint reactions "
+            "cannot include them; define frequency_body_loads, or call frequency_response with "
+            "joint_reactions=False")
+
     def frequency_range(self):
         """(ω_lo, ω_hi) rad/s where :meth:`frequency_terms` is defined, or None (everywhere)."""
         return None

@@ -92,8 +92,26 @@ class HydraulicPTO(Load):
         return add_ptos(ds, list(self.names), rec["hydraulic_power"], rec["hydraulic_stroke"],
                         rec["hydraulic_force"])
 
+    def force_rao(self, omega, stroke):
+        """Complex piston force per metre of wave amplitude from the stroke RAO ŵ (n_ω, P):
+
+            f̂ = (κ − ω² μ − iω β) ŵ        (N/m, x(t) = Re[x̂ e^{−iωt}])
+
+        the first-order part of f = μ ẅ + β ẇ + κ w. Its μ term is μ times the stroke
+        acceleration: ẅ = g q̈ + ġ q̇ and ġ q̇ is quadratic in the motion (second order), so
+        ẅ̂ = −ω² ŵ. Mean absorbed power ½ β ω² |ŵ|² = ½ Re[f̂ conj(−iω ŵ)] (only β works)."""
+        omega = np.asarray(omega, dtype=float)
+        stroke = np.asarray(stroke)
+        if stroke.ndim != 2 or stroke.shape != (omega.size, len(self.names)):
+            raise ValueError(f"stroke: shape {stroke.shape}; expected (n_omega, n_pto) = "
+                             f"({omega.size}, {len(self.names)})")
+        w = omega[:, None]
+        return (np.asarray(self.kappa)[None] - w**2 * np.asarray(self.mu)[None]
+                - 1j * w * np.asarray(self.beta)[None]) * stroke
+
     def frequency_outputs(self, model, kin0, x, omega):
-        """Stroke amplitude g x̂ and mean power ½ β ω² |g x̂|² per unit wave amplitude squared."""
+        """Stroke amplitude ŵ = g x̂, force amplitude f̂ = (κ − ω²μ − iωβ) ŵ (:meth:`force_rao`)
+        and mean power ½ β ω² |ŵ|² per unit wave amplitude squared."""
         from ..results import mean_absorbed_power
 
         _, _, g, _, _ = self._kinematics(kin0)
@@ -105,6 +123,10 @@ class HydraulicPTO(Load):
                                         mean_absorbed_power(np.asarray(self.beta), omega[:, None], stroke),
                                         {"long_name": "mean absorbed power β ẇ² per unit wave "
                                          "amplitude squared", "units": "W/m2"}),
+                "hydraulic_pto_force_rao": (("hydraulic_pto",), self.force_rao(omega, stroke),
+                                            {"long_name": "piston force μẅ + βẇ + κw per metre of "
+                                             "wave amplitude, (κ − ω²μ − iωβ) × stroke RAO",
+                                             "units": "N/m"}),
                 "coords": {"hydraulic_pto": list(self.names)}}
 
     # -- config

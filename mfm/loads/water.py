@@ -224,9 +224,9 @@ class Water(Load):
                            self, (jnp.zeros_like(self.exc_values), jnp.zeros_like(self.eta_values),
                                   NoRadiation()))
 
-    def frequency_terms(self, model, q0, kin0, omega, heading, options):
-        """−ω² Hᵀ(A(ω) − A∞)H − iω HᵀB(ω)H (A∞ is in the mass already) and Hᵀ X(ω, β), with A and
-        B those of ``options["radiation"]`` ("database", or a time-domain strategy's)."""
+    def _frequency_coefficients(self, kin0, omega, heading, options, excitation=True):
+        """(A(ω) − A∞, B(ω), X(ω, β) or None, H₀) of ``options["radiation"]``: (n_ω, 6K, 6K),
+        (n_ω, 6K, 6K), (n_ω, 6K), (6K, n_q)."""
         from hydro.excitation import excitation_coefficients
         from hydro.waves import WaveComponents, wavenumber
 
@@ -241,16 +241,44 @@ class Water(Load):
         A, B = rad.coefficients(spec, omega)
         H0 = np.asarray(self.geometry.h_matrix(kin0)[0])
         A_rel = np.asarray(A) - np.asarray(self.A_inf)[None]
-        w = omega[:, None, None]
-        Z = np.einsum("ai,wab,bj->wij", H0, -w**2 * A_rel - 1j * w * np.asarray(B), H0)
+        if not excitation:
+            return A_rel, np.asarray(B), None, H0
         comps = WaveComponents(omega=omega, amplitude=np.ones_like(omega), phase=np.zeros_like(omega),
                                heading=np.full_like(omega, heading),
                                wavenumber=wavenumber(omega, spec.water_depth, spec.g),
                                water_depth=spec.water_depth, g=spec.g)
-        if not options.get("excitation", True):
+        X = np.asarray(excitation_coefficients(spec.database(), comps))
+        return A_rel, np.asarray(B), X, H0
+
+    def frequency_terms(self, model, q0, kin0, omega, heading, options):
+        """−ω² Hᵀ(A(ω) − A∞)H − iω HᵀB(ω)H (A∞ is in the mass already) and Hᵀ X(ω, β), with A and
+        B those of ``options["radiation"]`` ("database", or a time-domain strategy's)."""
+        excitation = options.get("excitation", True)
+        A_rel, B, X, H0 = self._frequency_coefficients(kin0, omega, heading, options, excitation)
+        w = omega[:, None, None]
+        Z = np.einsum("ai,wab,bj->wij", H0, -w**2 * A_rel - 1j * w * B, H0)
+        if X is None:
             return FrequencyTerms(impedance=Z)
-        X = excitation_coefficients(spec.database(), comps)
         return FrequencyTerms(impedance=Z, force=np.einsum("ai,wa->wi", H0, X))
+
+    def frequency_body_loads(self, model, q0, kin0, omega, heading, options, x):
+        """The wave and radiation-memory loads at the reference points,
+
+            F̂_ξ(ω) = X(ω, β) − [−ω² (A(ω) − A∞) − iω B(ω)] H₀ x̂
+
+        (A∞ is in the mass, hydrostatics and buoyancy in the static load), as body wrenches at q₀
+        (the map of :meth:`~mfm.points.BodyPoints.to_body_wrench`, linear: real and imaginary
+        parts each)."""
+        A_rel, B, X, H0 = self._frequency_coefficients(kin0, omega, heading, options,
+                                                       options.get("excitation", True))
+        w = omega[:, None, None]
+        xi = np.einsum("ai,wi->wa", H0, np.asarray(x))
+        F = -np.einsum("wab,wb->wa", -w**2 * A_rel - 1j * w * B, xi)
+        if X is not None:
+            F = F + X
+        to_body = lambda f: np.asarray(self.geometry.to_body_wrench(jnp.asarray(f), kin0,  # noqa: E731
+                                                                      model.n_bodies))
+        return np.stack([to_body(f.real) + 1j * to_body(f.imag) for f in F])
 
     def frequency_range(self):
         om = np.asarray(self.spec.database()["omega"].values)
