@@ -71,7 +71,9 @@ def check_body_assignment(db, bodies, *, rho: float | None = None) -> list[Findi
     db: the hydro database (``displaced_volume`` (body), ``center_of_buoyancy`` (body, axis) in
         inertial axes at q = 0; ``rho`` attr).
     bodies: one ``(config_name, database_body, mass_kg, com_xyz_m)`` per wet body, the CoM in
-        inertial axes at q = 0 (the config's ``com``).
+        inertial axes at q = 0 (the config's ``com``); ``database_body`` may be a tuple of database
+        bodies, the hulls of one rigid body (checked by their total volume and volume-weighted
+        centre of buoyancy).
     rho: water density (kg/m³); default the database's ``rho`` attr, else 1000.
 
     Returns a list of :class:`Finding` (empty when all is well):
@@ -91,7 +93,17 @@ def check_body_assignment(db, bodies, *, rho: float | None = None) -> list[Findi
     names = [str(b) for b in db["body"].values]
     vol = dict(zip(names, np.asarray(db["displaced_volume"].values, dtype=float)))
     cob = dict(zip(names, np.asarray(db["center_of_buoyancy"].values, dtype=float)))
-    rows = [(str(n), str(d), float(m), np.asarray(c, dtype=float)) for n, d, m, c in bodies]
+    rows = []
+    for n, d, m, c in bodies:
+        if isinstance(d, (tuple, list)):
+            # a group of hulls on one rigid body: total volume, volume-weighted centre of buoyancy
+            d = tuple(str(x) for x in d)
+            if not all(x in vol for x in d):
+                continue
+            v = sum(vol[x] for x in d)
+            vol[d] = v
+            cob[d] = sum(vol[x] * cob[x] for x in d) / v
+        rows.append((str(n), d if isinstance(d, tuple) else str(d), float(m), np.asarray(c, dtype=float)))
     out = []
 
     def desc(name, m, c):

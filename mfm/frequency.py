@@ -253,14 +253,17 @@ def _joint_reactions(model, sys, omega, heading, options, x):
     def of_wrench(W):
         """The reactions that balance extra body loads W (n, 6) at q₀, the bodies at rest."""
         f, m = reaction_loads(model, Evaluation(qdd=None, kin=sys.kin0, X=zeros6, Xdot=zeros6,
-                                                F=jnp.asarray(W), Q=None))
-        return np.concatenate([np.asarray(f), np.asarray(m)], axis=1)
+                                                F=W, Q=None))
+        return jnp.concatenate([f, m], axis=1)
 
+    L = None   # the linear map of_wrench as a matrix (n, 6, n, 6): one jacobian, not one call per ω
     for ld in sys.loads:
         W = ld.frequency_body_loads(model, sys.q0, sys.kin0, omega, heading, options, x)
         if W is None:
             continue
-        out = out + np.stack([of_wrench(Wk.real) + 1j * of_wrench(Wk.imag) for Wk in W])
+        if L is None:
+            L = np.asarray(jax.jacfwd(of_wrench)(zeros6))
+        out = out + np.einsum("naKb,wKb->wna", L, W)
     return static, out
 
 

@@ -36,6 +36,7 @@ import warnings
 from pathlib import Path
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -276,9 +277,10 @@ class Water(Load):
         F = -np.einsum("wab,wb->wa", -w**2 * A_rel - 1j * w * B, xi)
         if X is not None:
             F = F + X
-        to_body = lambda f: np.asarray(self.geometry.to_body_wrench(jnp.asarray(f), kin0,  # noqa: E731
-                                                                      model.n_bodies))
-        return np.stack([to_body(f.real) + 1j * to_body(f.imag) for f in F])
+        # the (linear) map to body wrenches as a matrix: one jacobian, not one call per ω
+        T = np.asarray(jax.jacfwd(lambda f: self.geometry.to_body_wrench(f, kin0, model.n_bodies))(
+            jnp.zeros(F.shape[1])))
+        return np.einsum("nbk,wk->wnb", T, F)
 
     def frequency_range(self):
         om = np.asarray(self.spec.database()["omega"].values)
@@ -332,6 +334,21 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
                  grid_m=int(m))
 
 
+def _assignment_rows(by_name, wet):
+    """Rows (config name, database body or bodies, mass, CoM) for the check that each body got its
+    own hull's data. A massless hull welded to a parent (mass 0: its parent carries its mass) is
+    checked together with the nearest ancestor that has a mass: their masses against the sum of
+    their hulls' volumes, the ancestor's CoM against the volume-weighted centre of buoyancy."""
+    rows = {}
+    for name, d, _ in wet:
+        owner = name
+        while by_name[owner].mass == 0 and by_name[owner].parent is not None:
+            owner = by_name[owner].parent
+        rows.setdefault(owner, []).append(d)
+    return [(owner, tuple(ds) if len(ds) > 1 else ds[0], by_name[owner].mass, by_name[owner].com)
+            for owner, ds in rows.items()]
+
+
 def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_coupling: bool | None = None):
     """Build a model's :class:`~hydro.prepare.HydroSpec` from the parsed ``[hydro]`` table."""
     from hydro.checks import check_body_assignment
@@ -362,8 +379,7 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
     # each config body got its own hull's data: volumes and centres of buoyancy against the
     # config's masses and centres of mass (hydro.names in the wrong order is an error)
     by_name = {b.name: b for b in bodies}
-    for f in check_body_assignment(db, [(n, d, by_name[n].mass, by_name[n].com) for n, d, _ in wet],
-                                   rho=options.get("rho")):
+    for f in check_body_assignment(db, _assignment_rows(by_name, wet), rho=options.get("rho")):
         if f.kind == "swap":
             raise ConfigError(f"hydro: {f}")
         warnings.warn(str(f), HydroDatabaseWarning, stacklevel=3)
