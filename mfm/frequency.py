@@ -83,9 +83,28 @@ def _static_functions(model: Model, loads):
     """The loads at rest (:meth:`Load.static_load`) and their memories, ready for the compiled
     functions above: (static, mems)."""
     static = tuple(s for s in (ld.static_load() for ld in loads) if s is not None)
+    return static, _init_memories(model, static)
+
+
+@jax.jit
+def _init_memories(model, static):
     zero = jnp.zeros(model.n_coordinates)
-    mems = tuple(ld.init_memory(model, 0.0, zero, zero, 1.0) for ld in static)
-    return static, mems
+    return tuple(ld.init_memory(model, 0.0, zero, zero, 1.0) for ld in static)
+
+
+@jax.jit
+def _kinematics_at(model, q, qd):
+    """The kinematics at (q, q̇), compiled once per model structure (eager, the walk over the tree
+    is hundreds of small dispatches)."""
+    return kinematics(model, q, qd)
+
+
+_mass_at = jax.jit(mass_matrix)
+
+
+@jax.jit
+def _generalised_weights(model, q):
+    return jnp.einsum("nai,na->i", kinematics(model, q).B, gravity_loads(model))
 
 
 def equilibrium(model: Model, q_guess=None, *, loads=None, tol: float = 1e-10, max_iter: int = 50):
@@ -106,8 +125,7 @@ def _equilibrium(model, loads, q_guess=None, tol=1e-10, max_iter=50):
     Jj = lambda q: _dQ_dq(model, static, mems, q)  # noqa: E731
     q = jnp.zeros(model.n_coordinates) if q_guess is None else jnp.asarray(q_guess, jnp.float64)
     # the size of the loads that must balance: generalised weights, or the largest weight
-    scale = max(float(jnp.max(jnp.abs(jnp.einsum("nai,na->i", kinematics(model, q).B,
-                                                 gravity_loads(model))))),
+    scale = max(float(jnp.max(jnp.abs(_generalised_weights(model, q)))),
                 float(jnp.max(model.mass)) * float(model.gravity))
     it = 0
     q_ok = q
@@ -166,8 +184,8 @@ def _linear_system(model, lds, q0=None):
     static, mems = _static_functions(model, lds)
     K = -np.asarray(_dQ_dq(model, static, mems, q0))
     C = -np.asarray(_dQ_dqd(model, static, mems, q0))
-    M = np.asarray(mass_matrix(model, q0)) + np.asarray(_loads_mass(model, static, mems, q0))
-    return LinearSystem(np.asarray(q0), M, K, C, kinematics(model, q0, jnp.zeros_like(q0)), lds)
+    M = np.asarray(_mass_at(model, q0)) + np.asarray(_loads_mass(model, static, mems, q0))
+    return LinearSystem(np.asarray(q0), M, K, C, _kinematics_at(model, q0, jnp.zeros_like(q0)), lds)
 
 
 def linearise(model: Model, q0=None, *, loads=None):
