@@ -180,3 +180,21 @@ def test_hydro_coupled_scenario_has_two_roots(models):
     alone = mfm.frequency_response(models["fowt"], [1.0], 0.0)
     assert float(alone["body_rao"].sel(body="platform", dof="z").pipe(np.abs).values[0]) != pytest.approx(
         float(z[1, 0]), rel=1e-6)
+
+
+def test_massless_column_hulls_are_checked_with_the_platform():
+    """The outer columns are hulls without mass of their own (the platform carries the 32,000 t):
+    the database check puts their volumes with the platform's (ρ ΣV = 32,022 t against 32,000 t)
+    and raises nothing; a platform mass far from the displacement is still reported."""
+    import warnings
+
+    from hydro.checks import check_body_assignment
+    from hydro.database import HydroDatabaseWarning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", HydroDatabaseWarning)
+        m = mfm.load(CONFIGS / "hallak_fowt.toml")
+    db = m.hydro.db
+    group = ("platform", "column1", "column2", "column3")
+    assert check_body_assignment(db, [("platform", group, 32.0e6, [0.0, 0.0, -13.46])]) == []
+    found = check_body_assignment(db, [("platform", group, 3.2e6, [0.0, 0.0, -13.46])])
+    assert [f.kind for f in found] == ["mismatch"] and "ρV/m = 10" in str(found[0])
