@@ -42,6 +42,22 @@ C_PTO = 4.1e7               # N m s/rad [S]
 RHO, G = 1025.0, 9.81       # [A]
 DEPTH = 60.0                # m [S: anchors 60 m below water]
 PERIODS = (5.0, 6.0, 7.0, 8.0, 8.3, 9.0, 10.0, 11.0, 11.4, 12.0)   # s [S]
+DX_COL, DX_WEC = 2.0, 0.7   # m panel sizes [D]
+
+
+def panel_radius(r, dx):
+    """The radius whose panelled hull (a regular n-gon prism, vertices on the circle, n from
+    hydro.geometry.n_azimuth) has the water-plane area and volume of the circle of radius r:
+    the BEM's buoyancy (mfm takes ρgV from the database) is then the exact hull's."""
+    from hydro import geometry as geo
+
+    def n_of(rr):
+        return geo.n_azimuth(geo.normalize_spec({"name": "h", "shape": "cylinder", "radius": rr,
+                                                 "draft": 1.0, "base": "flat"}), dx)
+    n = n_of(r)
+    re = r * math.sqrt(math.pi / (n / 2 * math.sin(2 * math.pi / n)))
+    assert n_of(re) == n, (r, dx)
+    return round(re, 4), n
 
 # the preload that holds the stated 2 m draft [D]: (m − ρ π R² T) g × arm
 M_DISPLACED = RHO * math.pi * R_WEC ** 2 * DRAFT_WEC
@@ -187,10 +203,14 @@ HEADER = """\
 #   hinge angles take it up, the WECs keep their draft).
 # Viscous damping: none (the seed's C_vis has no values) [A].
 # BEM [D]: the ten periods of the seed (T = 5, 6, 7, 8, 8.3, 9, 10, 11, 11.4, 12 s) + ∞; finite
-#   depth where kh < 5 (ω < 0.90 rad/s, T > 6.95 s), deep water above and at ∞; panels dx 2 m on
-#   the columns, 0.7 m on the WECs; no lid: the first irregular frequencies, ω² = g k coth(k d)
-#   with k = 2.405 / a, are 1.77 rad/s (column) and 2.66 rad/s (WEC), above the highest ω here
-#   (1.257 rad/s); xOz symmetry. One body per hull (15: 3 columns + 12 WECs), solved together.
+#   depth where kh < 5 (ω < 0.90 rad/s, T > 6.95 s), deep water above and at ∞; panels dx {dx_col:g} m on
+#   the columns, {dx_wec:g} m on the WECs. The panelled hulls are regular polygons with their vertices on
+#   the circle; each hull's radius here is the one whose {n_col}-gon (columns, {r_col:g} m) or {n_wec}-gon
+#   (WECs, {r_wec:g} m) has the circle's area, so the database's volumes (from which mfm takes the
+#   buoyancy) are the stated hulls' exactly (a 7.525 m 24-gon would lose 1.1 % of the displacement,
+#   187 t: the platform would settle 0.34 m lower) [D]. No lid: the first irregular frequencies,
+#   ω² = g k coth(k d) with k = 2.405 / a, are 1.77 rad/s (column) and 2.66 rad/s (WEC), above the
+#   highest ω here (1.257 rad/s); xOz symmetry. One body per hull (15: 3 columns + 12 WECs), solved together.
 
 [model]
 name = "Wu-Yuan model {m}"
@@ -207,7 +227,7 @@ omega = {omega}   # rad/s: 2π/T, T = 12, 11.4, 11, 10, 9, 8.3, 8, 7, 6, 5 s [S]
 headings_deg = [0.0]        # [S]
 water_depth = 60.0          # m [S]
 deep_water_kh = 5.0         # finite depth below kh = 5, deep water above [D]
-dx = 2.0                    # m on the columns (the WECs set their own)
+dx = {dx_col}                    # m on the columns (the WECs set their own)
 lid = false                 # first irregular frequencies 1.77 (column), 2.66 rad/s (WEC) > 1.257
 symmetry = "auto"           # xOz (the layout mirrors about y = 0)
 infinite_frequency = true
@@ -235,7 +255,7 @@ parent = "platform"
 type = "fixed"
 [bodies.geometry]
 shape = "cylinder"
-radius = 7.525                       # m, D 15.05 [A]
+radius = {r_col}                      # m: D 15.05 [A] as a {n_col}-gon of the same area [D]
 draft = 30.0                         # m [S]
 base = "flat"                        # [A]
 """
@@ -255,10 +275,10 @@ point = {point}   # hinge: 9.72 m towards the platform, 5.44 m up [S]
 damping = 4.1e7                      # N m s/rad, the PTO [S]
 [bodies.geometry]
 shape = "cylinder"
-radius = 4.0                         # m [S]
+radius = {r_wec}                      # m: R 4 [S] as a {n_wec}-gon of the same area [D]
 draft = 2.0                          # m [S]
 base = "flat"                        # [A]
-dx = 0.7                             # m panels [D]
+dx = {dx_wec}                             # m panels [D]
 """
 
 LINE = """
@@ -286,20 +306,24 @@ def config_text(m: int) -> str:
     ld = SPACINGS[m - 1]
     L = ld * D_WEC
     cw, ww = clearances(L)
+    r_col, n_col = panel_radius(R_COL, DX_COL)
+    r_wec, n_wec = panel_radius(R_WEC, DX_WEC)
     xh = x_hinge_row3()
     parts = [HEADER.format(m=m, ld=ld, L=L, xh=xh, xw=xh - ARM, cw=cw, ww=ww, md=M_DISPLACED,
                            mw=M_WEC, pre=PRELOAD, dm=M_WEC - M_DISPLACED,
-                           omega=vec(omega_list()))]
+                           omega=vec(omega_list()), dx_col=DX_COL, r_col=r_col, n_col=n_col,
+                           r_wec=r_wec, n_wec=n_wec, dx_wec=DX_WEC)]
     notes = {"column1": "apex column on +x", "column2": "column at +120°", "column3": "column at −120°"}
     for name, c in columns():
-        parts.append(COLUMN.format(name=name, notes=notes[name], com=vec([c[0], c[1], -9.68])))
+        parts.append(COLUMN.format(name=name, notes=notes[name], com=vec([c[0], c[1], -9.68]),
+                                   r_col=r_col, n_col=n_col))
     parts.append("\n# ---- the WECs, hinged to the platform ---------------------------------"
                  "---------------------\n")
     for name, row, c, h, a, xdir in wecs(L):
         I = inertia(xdir)
         k = (int(name[3:]) - 1) % 4 + 1
         parts.append(WEC.format(name=name, row=row, k=k, com=vec(c), axis=vec(a, 9),
-                                point=vec(h),
+                                point=vec(h), r_wec=r_wec, n_wec=n_wec, dx_wec=DX_WEC,
                                 inertia="[" + ", ".join(vec(r, 1) for r in I) + "]"))
     parts.append("\n# ---- hinge preloads: hold each WEC at its 2 m draft -------------------"
                  "---------------------\n")
