@@ -42,7 +42,7 @@ C_PTO = 4.1e7               # N m s/rad [S]
 RHO, G = 1025.0, 9.81       # [A]
 DEPTH = 60.0                # m [S: anchors 60 m below water]
 PERIODS = (5.0, 6.0, 7.0, 8.0, 8.3, 9.0, 10.0, 11.0, 11.4, 12.0)   # s [S]
-DX_COL, DX_WEC = 2.0, 0.7   # m panel sizes [D]
+DX_COL, DX_WEC = 2.0, 0.8   # m panel sizes [D]
 
 
 def panel_radius(r, dx):
