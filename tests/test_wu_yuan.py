@@ -9,6 +9,11 @@
 - The six catenary lines at rest: H ≈ 390 kN, T ≈ 613 kN per line; their vertical loads sum to
   ≈ 289 t against the platform's 300 t reserve (displacement − mass).
 - The static equilibrium with the hinge preloads holds every WEC at its stated 2 m draft.
+
+Measured: H 388.9 kN, T 611.8 kN per line, six vertical loads 288.8 t; columns ρV 1.64108e7 kg
+(every model); at the equilibrium every WEC's draft 2.0038 m, hinge angles 0.0135 rad, the
+platform 0.136 m below its 30 m draft (hand: 0.142 m). About 45 s in all (29 s the equilibrium's
+compilation).
 """
 from __future__ import annotations
 
@@ -164,7 +169,9 @@ def test_platform_displacement_from_the_database():
 @pytest.fixture(scope="module")
 def model1():
     _database(1)
-    return mfm.load(CONFIGS / "wu_yuan_m1.toml")
+    # the static equilibrium uses no hydrodynamic interaction (buoyancy and water-plane stiffness
+    # are per hull): without it the same q₀ (checked) compiles in 29 s instead of 40 s
+    return mfm.load(CONFIGS / "wu_yuan_m1.toml", body_coupling=False)
 
 
 def test_equilibrium_holds_every_wec_at_its_draft(model1):

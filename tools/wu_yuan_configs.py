@@ -3,7 +3,7 @@ hinged WECs (seed 004; GEOMETRY.md §4) at the five WEC spacings L = 2D … 3D o
 
 The five files are identical except the spacing-dependent positions (WEC centres, hinge points,
 the model's name and its database); the loader has no way to share tables between configs, so
-this script is their single source. Run from the repository root:
+this script is their single source (values tagged as docs/GEOMETRY.md §4). Run from the repository root:
 
     python tools/wu_yuan_configs.py          # (re)writes the five configs
     python tools/wu_yuan_configs.py --check  # exits 1 if a config differs from what it would write
@@ -158,7 +158,8 @@ def lines():
 HEADER = """\
 # Semi-sub energy harvesting platform with 12 hinged point absorbers, model {m} (L = {ld:g} D = {L:g} m):
 # H. Wu, Z. Yuan, "WEC spacing effects on the performance of a floating energy harvesting
-# platform", Ocean Engineering (2025) (seed 004). Values tagged as in GEOMETRY.md §4:
+# platform", Ocean Engineering (2025) (docs/references.md, seed 004). Values tagged as in
+# docs/GEOMETRY.md §4:
 #   [S] stated in the seed, [D] derived from stated values, [A] assumed (no source found).
 # MADE BY tools/wu_yuan_configs.py (the five models share everything but the spacing-dependent
 #   positions; edit the script and rerun it, not this file).
@@ -191,7 +192,7 @@ HEADER = """\
 #   the WECs run with y ascending in row 3's frame (WEC 9 at y = −1.5 L) [A]. Mirror-symmetric
 #   about y = 0 (row 2 is written as the exact mirror of row 1), so the BEM uses xOz symmetry.
 #   Clearances here: WEC rim to column wall ≥ {cw:.2f} m, WEC rim to WEC rim ≥ {ww:.2f} m [D].
-#   (GEOMETRY.md's "the WECs clear the columns by 12.5 m" is model 1's gap, 12.48 m.)
+#   (docs/GEOMETRY.md's "the WECs clear the columns by 12.5 m" is model 1's gap, 12.48 m.)
 # PTO [S]: rotary damper 4.1e7 N m s/rad on each hinge (joint damping); lock the hinges
 #   (joint locked = true) for the severe sea.
 # Hinge preload [D]: the WEC is heavier than the water it displaces at its stated 2 m draft
