@@ -1,0 +1,204 @@
+"""The semi-sub energy platform with 12 hinged WECs (Wu & Yuan, seed 004): configs/wu_yuan_m1–m5.toml
+(written by tools/wu_yuan_configs.py) against hand checks from the seed's Tables 1–4 and GEOMETRY §4.
+
+- The five configs load, are what the generator writes, and differ only in the spacing.
+- Layout: per model the WECs of each row are spaced by L = 2D … 3D along the row; rows 1 and 2
+  are row 3 rotated by ±120° (centres, hinges, hinge axes, inertias); each hinge is 9.72 m
+  horizontally from its WEC's CoG towards the platform and 5.44 m above water.
+- The database's platform displacement (ρ V of the three columns) ≈ Table 1's 1.64e7 kg.
+- The six catenary lines at rest: H ≈ 390 kN, T ≈ 613 kN per line; their vertical loads sum to
+  ≈ 289 t against the platform's 300 t reserve (displacement − mass).
+- The static equilibrium with the hinge preloads holds every WEC at its stated 2 m draft.
+
+Measured: H 388.9 kN, T 611.8 kN per line, six vertical loads 288.8 t; columns ρV 1.64108e7 kg
+(every model); at the equilibrium every WEC's draft 2.0038 m, hinge angles 0.0135 rad, the
+platform 0.136 m below its 30 m draft (hand: 0.142 m). About 45 s in all (29 s the equilibrium's
+compilation).
+"""
+from __future__ import annotations
+
+import importlib.util
+import math
+
+import jax.numpy as jnp
+import numpy as np
+import pytest
+from conftest import CONFIGS, ROOT
+
+import mfm
+from mfm.loads import CatenaryLines
+
+pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
+
+D, RHO, G = 8.0, 1025.0, 9.81
+SPACING = {1: 2.0 * D, 2: 2.25 * D, 3: 2.5 * D, 4: 2.75 * D, 5: 3.0 * D}
+ARM, Z_HINGE = 9.72, 5.44
+M_PLATFORM, DISPLACEMENT = 1.61e7, 1.64e7          # Table 1 [S]
+M_WEC = 1.1136e5                                   # Table 3 [S]
+ROWS = {1: range(1, 5), 2: range(5, 9), 3: range(9, 13)}
+
+
+def generator():
+    spec = importlib.util.spec_from_file_location("wu_yuan_configs", ROOT / "tools" / "wu_yuan_configs.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def rot(deg):
+    a = math.radians(deg)
+    return np.array([[math.cos(a), -math.sin(a), 0], [math.sin(a), math.cos(a), 0], [0, 0, 1]])
+
+
+@pytest.fixture(scope="module")
+def mechanics():
+    """The five models without their water (the lines' MoorPy table is built once)."""
+    return {m: mfm.load(CONFIGS / f"wu_yuan_m{m}.toml", hydro=False) for m in SPACING}
+
+
+def test_configs_are_the_generators_and_differ_only_in_the_spacing():
+    assert generator().main(["--check"]) == 0
+    texts = [(CONFIGS / f"wu_yuan_m{m}.toml").read_text().splitlines() for m in SPACING]
+    assert len({len(t) for t in texts}) == 1
+    differ = {i for t in texts[1:] for i, (a, b) in enumerate(zip(texts[0], t)) if a != b}
+    for i in differ:   # the spacing-dependent lines only: names, L, positions, clearances
+        line = texts[0][i]
+        assert any(k in line for k in ("model", "L = ", "com = [", "point = [", "database",
+                                       "Clearances", "wu_yuan_m")), line
+
+
+def test_configs_load(mechanics):
+    for m, model in mechanics.items():
+        assert model.n_coordinates == 18          # platform 6 + 12 hinge angles
+        assert model.coordinates[:6] == tuple(f"platform.{d}" for d in
+                                               ("surge", "sway", "heave", "roll", "pitch", "yaw"))
+        assert len(model.body_names) == 16        # platform, 3 columns, 12 WECs
+        assert abs(float(np.asarray(model.mass).sum()) - (M_PLATFORM + 12 * M_WEC)) < 1e-6
+        assert np.allclose(np.asarray(model.damping)[6:], 4.1e7)
+
+
+def test_wec_layout(mechanics):
+    for m, model in mechanics.items():
+        L = SPACING[m]
+        bodies = {b.name: b for b in model.bodies}
+        c = {k: np.asarray(bodies[f"wec{k}"].com) for k in range(1, 13)}
+        h = {k: np.asarray(bodies[f"wec{k}"].joint.point) for k in range(1, 13)}
+        a = {k: np.asarray(bodies[f"wec{k}"].joint.axis) for k in range(1, 13)}
+        J = {k: np.asarray(bodies[f"wec{k}"].inertia) for k in range(1, 13)}
+        for row, ks in ROWS.items():
+            ks = list(ks)
+            steps = [c[k2] - c[k1] for k1, k2 in zip(ks, ks[1:])]
+            for s in steps:                       # spaced by L along the row's hinge axis
+                assert abs(np.linalg.norm(s) - L) < 1e-5
+                assert np.allclose(s / L, a[ks[0]], atol=1e-6)
+            for k in ks:
+                assert abs(c[k][2]) < 1e-12 and abs(h[k][2] - Z_HINGE) < 1e-12
+                d = h[k][:2] - c[k][:2]           # 9.72 m towards the platform
+                assert abs(np.linalg.norm(d) - ARM) < 1e-5
+                assert np.linalg.norm(h[k][:2]) < np.linalg.norm(c[k][:2])
+                assert abs(d @ a[k][:2]) < 1e-5   # the arm is square to the hinge axis
+        # row 3 upwave on −x with its axis along y; rows 1, 2 = row 3 rotated by +120°, −120°
+        assert all(c[k][0] < -40 for k in ROWS[3]) and np.allclose(a[9], [0, 1, 0])
+        for row, deg in ((1, 120.0), (2, -120.0)):
+            R = rot(deg)
+            for k3, k in zip(ROWS[3], ROWS[row]):
+                assert np.allclose(R @ c[k3], c[k], atol=1e-5)
+                assert np.allclose(R @ h[k3], h[k], atol=1e-5)
+                assert np.allclose(R @ a[k3], a[k], atol=1e-8)
+                assert np.allclose(R @ J[k3] @ R.T, J[k], rtol=0, atol=1.0)   # kg m², rounded
+            # axes at ±30° to x (Appendix A)
+            assert abs(abs(math.degrees(math.atan2(a[ROWS[row][0]][1], a[ROWS[row][0]][0]))) % 180
+                       - 30.0) < 1e-6 or abs(abs(math.degrees(math.atan2(
+                           a[ROWS[row][0]][1], a[ROWS[row][0]][0]))) % 180 - 150.0) < 1e-6
+        # Table 3's inertias in row 3's axes (x′ along the arm = x)
+        assert np.allclose(J[9], np.diag([6.8e5, 9.545e5, 1.054e6]))
+        # the layout mirrors about y = 0 exactly (the BEM's xOz symmetry needs it)
+        mirror = [np.array([p[0], -p[1], p[2]]) for p in c.values()]
+        assert all(min(np.abs(q - p).max() for p in c.values()) == 0.0 for q in mirror)
+
+
+def _lines(model):
+    return next(ld for ld in model.loads if isinstance(ld, CatenaryLines))
+
+
+def test_lines_at_rest(mechanics):
+    model = mechanics[1]
+    lines = _lines(model)
+    H, V, inside = (np.asarray(v) for v in lines.tensions(lines.fairleads.positions(
+        mfm.kinematics(model, jnp.zeros(model.n_coordinates)))))
+    T = np.hypot(H, V)
+    print(f"per line H {H[0] / 1e3:.1f} kN, T {T[0] / 1e3:.1f} kN; six vertical loads "
+          f"{V.sum() / G / 1e3:.1f} t")
+    # GEOMETRY §4's hand values, rounded to 3 figures: 1 %
+    assert inside.all() and np.ptp(T) < 1e-6 * T[0]
+    assert abs(H[0] / 390e3 - 1) < 0.01 and abs(T[0] / 613e3 - 1) < 0.01
+    assert abs(V.sum() / G / 289e3 - 1) < 0.01
+    # against displacement − mass = 300 t (Table 1's two figures rounded to 3 digits: ±5 t each):
+    # the lines take 96 % of the reserve
+    assert abs(V.sum() / G / (DISPLACEMENT - M_PLATFORM) - 1) < 0.05
+
+
+# ---- with the hydro database -------------------------------------------------------------------
+
+
+def _database(m):
+    path = ROOT / "hydro" / "data" / f"wu_yuan_m{m}.nc"
+    if not path.exists():
+        pytest.skip(f"{path.name} not generated (mfm hydro configs/wu_yuan_m{m}.toml)")
+    return path
+
+
+def test_platform_displacement_from_the_database():
+    from hydro import bem
+
+    for m in SPACING:
+        ds = bem.load(_database(m))
+        V = ds["displaced_volume"]
+        cols = [b for b in V["body"].values if str(b).startswith("column")]
+        disp = RHO * float(V.sel(body=cols).sum())
+        wec = RHO * float(V.sel(body="wec1"))
+        print(f"model {m}: columns ρV = {disp:.5e} kg, one WEC {wec:.5e} kg")
+        # the panelled columns are 24-gons of the circle's area (the config's radius), so ρ V is
+        # the exact hull's 3 π 7.525² 30 × 1025 = 1.6411e7 kg to round-off (1e-5 here: the radius is
+        # written to 0.1 mm); Table 1's 1.64e7 is that rounded to 3 figures (0.07 %): 0.2 %
+        assert abs(disp / (3 * math.pi * 7.525 ** 2 * 30 * RHO) - 1) < 1e-4
+        assert abs(disp / DISPLACEMENT - 1) < 2e-3
+        assert abs(wec / (math.pi * 16 * 2 * RHO) - 1) < 1e-4
+
+
+@pytest.fixture(scope="module")
+def model1():
+    _database(1)
+    # the static equilibrium uses no hydrodynamic interaction (buoyancy and water-plane stiffness
+    # are per hull): without it the same q₀ (checked) compiles in 29 s instead of 40 s
+    return mfm.load(CONFIGS / "wu_yuan_m1.toml", body_coupling=False)
+
+
+def test_equilibrium_holds_every_wec_at_its_draft(model1):
+    model = model1
+    q0, info = mfm.equilibrium(model)
+    pos, R = (np.asarray(v) for v in mfm.body_poses(model, jnp.asarray(q0)))
+    drafts = []
+    for k in range(1, 13):
+        i = model.body_index(f"wec{k}")
+        keel = pos[i] + R[i] @ np.array([0.0, 0.0, -2.0])     # the keel's centre, 2 m below the CoG
+        drafts.append(-keel[2])
+    drafts = np.array(drafts)
+    heave = q0[model.coordinate_index("platform.heave")]
+    angles = q0[6:]
+    print(f"drafts {np.round(drafts, 4).tolist()}; platform heave {heave:.4f} m, pitch "
+          f"{q0[4]:.2e} rad; hinge angles {np.round(angles, 4).tolist()} rad")
+    # the stated 2 m within 2 cm (the preload balances the WEC's excess weight exactly; what is
+    # left is the second order of the hinge angle and the water-plane moment of the tilted WEC)
+    assert np.abs(drafts - 2.0).max() < 0.02
+    # the platform settles under the WECs' excess weight and the lines' pull beyond its reserve:
+    # (12 × 8316 kg + 289 t − 300 t) / (ρ × 3 π 7.525²) ≈ 0.16 m (the lines' own vertical
+    # stiffness and the columns' hydrostatics as the database has them move it a little)
+    lines = _lines(model)
+    V = np.asarray(lines.tensions(lines.fairleads.positions(mfm.kinematics(model, jnp.zeros(18))))[1])
+    hand = (12 * (M_WEC - math.pi * 16 * 2 * RHO) + V.sum() / G
+            - (3 * math.pi * 7.525 ** 2 * 30 * RHO - M_PLATFORM)) / (RHO * 3 * math.pi * 7.525 ** 2)
+    print(f"platform settles {-heave:.4f} m; hand {hand:.4f} m")
+    assert abs(-heave / hand - 1) < 0.1
+    # the hinges take it up: each WEC stays at the water, its hinge 9.72 m away goes down
+    assert np.all(angles > 0)
