@@ -13,3 +13,15 @@ from pathlib import Path  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIGS = ROOT / "configs"
+
+
+import pytest  # noqa: E402
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _fresh_jax_caches():
+    """Each test module starts without the compiled functions of the modules before it: the
+    frequency domain's compiled linearisations are cached per model structure, and a worker that
+    runs dozens of modules would otherwise keep every model's (and its database's) compilation."""
+    yield
+    jax.clear_caches()
