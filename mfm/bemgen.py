@@ -354,7 +354,9 @@ def database_is_stale(config_path, database=None) -> tuple[bool, str]:
         diffs += _spec_diff(old, [dict(s) for s in specs])
     else:
         return False, f"{database} records no hull geometry (not made by hydro.bem): not checked"
-    if "mfm_bem_settings" in attrs:
+    # a config without [hydro.bem] reads a database another config made (the hydro-coupled
+    # scenario of Hallak reads the fully coupled one's): its hulls are compared, not settings
+    if "mfm_bem_settings" in attrs and hydro.get("bem") is not None:
         settings = bem_settings(hydro.get("bem"), hydro=hydro, gravity=options["gravity"])["record"]
         recorded = json.loads(attrs["mfm_bem_settings"])
         for k in sorted(set(recorded) | set(settings)):

@@ -198,3 +198,12 @@ def test_massless_column_hulls_are_checked_with_the_platform():
     assert check_body_assignment(db, [("platform", group, 32.0e6, [0.0, 0.0, -13.46])]) == []
     found = check_body_assignment(db, [("platform", group, 3.2e6, [0.0, 0.0, -13.46])])
     assert [f.kind for f in found] == ["mismatch"] and "ρV/m = 10" in str(found[0])
+
+
+def test_scenario_reading_another_configs_database_is_checked_by_its_hulls():
+    """hallak_hydro_coupled.toml has no [hydro.bem]: it reads the fully coupled config's database,
+    whose hulls it shares; the staleness check compares the hulls (and finds them equal)."""
+    from mfm.bemgen import database_is_stale
+
+    stale, why = database_is_stale(CONFIGS / "hallak_hydro_coupled.toml")
+    assert not stale and "matches the hulls" in why

@@ -264,11 +264,14 @@ def _wet(config, names=None):
     h = options["hydro"]
     db = open_any_database(config.parent / h["database"], names=names or h.get("names"),
                            rho=h.get("rho"), g=h.get("g"))
+    from mfm.loads.water import _assignment_rows
+
     available = [str(b) for b in db["body"].values]
     tagged = [b for b in bodies if "hydro" in b.extra]
-    wet = ([(b.name, b.extra["hydro"]["body"], b.mass, b.com) for b in tagged] if tagged else
-           [(b.name, b.name, b.mass, b.com) for b in bodies if b.name in available])
-    return db, wet
+    wet = ([(b.name, b.extra["hydro"]["body"], None) for b in tagged] if tagged else
+           [(b.name, b.name, None) for b in bodies if b.name in available])
+    # the rows mfm.load checks (massless hulls with the body that carries their mass)
+    return db, _assignment_rows({b.name: b for b in bodies}, wet)
 
 
 def test_swapped_hydro_names_are_found_and_shipped_configs_pass():
