@@ -228,9 +228,7 @@ def _reaction_function(model, loads):
     from .simulate import _state_offsets, applied_loads
     from .loads.base import Context
 
-    static = tuple(s for s in (ld.static_load() for ld in loads) if s is not None)
-    zero = jnp.zeros(model.n_coordinates)
-    mems = tuple(ld.init_memory(model, 0.0, zero, zero, 1.0) for ld in static)
+    static, mems = _static_functions(model, loads)
     offs = _state_offsets(static)
     z = jnp.zeros(int(offs[-1]))
 
