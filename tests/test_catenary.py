@@ -8,6 +8,7 @@ bodies here (surge, sway, heave), so MoorPy's body, with its rotations fixed, is
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -17,7 +18,7 @@ from scipy.optimize import brentq
 import mfm
 from mfm.config import parse_config
 from mfm.loads import CatenaryLines, JointLoad
-from mfm.loads.catenary import catenary_forces
+from mfm.loads.catenary import catenary_forces, linearise_lines
 from mfm.tree import ConfigError
 
 mp = pytest.importorskip("moorpy")
@@ -365,3 +366,47 @@ def test_tension_rao_in_frequency_response():
         dTx, dTz = (T(d, 0) - T(-d, 0)) / (2 * d), (T(0, d) - T(0, -d)) / (2 * d)
         ref = dTx * x + dTz * z
         assert np.abs(rao.values[:, k] - ref).max() < 1e-4 * np.abs(ref).max(), (k, rao.values[:, k], ref)
+
+
+def test_linearised_lines_are_the_first_order_expansion(lines):
+    # CatenaryLines.linearised about an offset q₀ (3 m surge, 1 m sway, −0.5 m heave): at q₀ the
+    # forces are the nonlinear lines' (round-off) and ∂f/∂r_F is a central difference of them
+    # (δ 1 cm: 1e-6 of the largest entry, the difference's own error); 5 m further in surge the
+    # force is f₀ + ∂f/∂r Δr exactly (1e-9) while the nonlinear lines' tensions differ from it by
+    # more than 10 % of their change (the lines stiffen: H 390 → 638 kN at 5 m)
+    model, ld = lines
+    from mfm.kinematics import kinematics
+    import jax.numpy as jnp
+
+    q0 = np.array([3.0, 1.0, -0.5])
+    lin = ld.linearised(model, q0)
+    assert lin.linear and not ld.linear
+    p0 = np.asarray(ld.fairleads.positions(kinematics(model, jnp.asarray(q0))))
+    assert np.allclose(lin.fairlead_forces(p0), ld.fairlead_forces(p0), rtol=1e-12, atol=1e-6)
+    h = 0.01
+    fd = np.stack([(np.asarray(ld.fairlead_forces(p0 + h * e)) - np.asarray(ld.fairlead_forces(p0 - h * e)))
+                   / (2 * h) for e in np.eye(3)], axis=2)                       # (P, 3, 3)
+    df = np.asarray(lin.lin_df)
+    assert np.abs(df - fd).max() < 1e-6 * np.abs(fd).max()
+    d = np.array([5.0, 0.0, 0.0])
+    f_lin = np.asarray(lin.fairlead_forces(p0 + d))
+    assert np.allclose(f_lin, np.asarray(lin.lin_f0) + df @ d, rtol=1e-9)
+    H, V, inside = (np.asarray(a) for a in lin.tensions(p0 + d))
+    hv = np.asarray(lin.lin_hv0) + np.einsum("kca,a->kc", np.asarray(lin.lin_dhv), d)
+    assert inside.all() and np.allclose(np.c_[H, V], hv, rtol=1e-9)
+    H_nl = np.asarray(ld.tensions(p0 + d)[0])
+    change = np.abs(H - np.asarray(lin.lin_hv0)[:, 0])
+    print(f"5 m further: H linearised {np.round(H / 1e3, 1).tolist()} kN, MoorPy's table "
+          f"{np.round(H_nl / 1e3, 1).tolist()} kN")
+    assert np.max(np.abs(H_nl - H) / change) > 0.1
+    assert "catenary_linearised" in lin.provenance()
+    with pytest.raises(ValueError, match="linearised already"):
+        lin.linearised(model, q0)
+    with pytest.raises(ValueError, match="q0: shape"):
+        ld.linearised(model, np.zeros(6))
+    # linearise_lines: the model's own lines (about its equilibrium when no q0 is given)
+    moored = dataclasses.replace(model, loads=(ld,))
+    out = linearise_lines(moored, q0)
+    assert out.loads[0].linear and np.allclose(out.loads[0].lin_p0, lin.lin_p0)
+    with pytest.raises(ValueError, match="no \\[\\[catenary_lines\\]\\]"):
+        linearise_lines(model)
