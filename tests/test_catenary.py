@@ -596,3 +596,54 @@ def test_six_dof_stiffness_against_moorpy_finite_difference(wy_platform, pose):
     # the antisymmetric part is ½[M]× to MoorPy's round-off (analytic both ways)
     skew = np.array([[0, -M[2], M[1]], [M[2], 0, -M[0]], [-M[1], M[0], 0]])
     assert np.abs(asym - skew / 2).max() < 1e-9 * np.abs(K_A[3:, 3:]).max()
+
+
+def test_moordyn_slow_limit_is_the_quasi_static_line(lines):
+    # MoorDyn's lumped-mass line (the seed's eq. 28; the optional `moordyn` package), written by
+    # tools/moordyn_check.py's input writer, with its fairlead moved slowly (8 m away from the
+    # anchor and 4 m up and back over 200 s, speeds ≤ 0.13 m/s, from rest): its fairlead tension
+    # is the engine's quasi-static table along the same path within 3 % of the local tension
+    # (measured 1.3 %: 40 segments of 20 m, 3.4 % with 20, 1.0 % with 80, the rest the drag at
+    # these speeds, 2.6 % over 100 s). So the large dynamic tensions tools/moordyn_check.py finds
+    # in the severe sea are the lines' dynamics, not a different line. ~15 s.
+    moordyn = pytest.importorskip("moordyn")
+    import importlib.util
+    import tempfile
+
+    from conftest import ROOT
+
+    spec = importlib.util.spec_from_file_location("moordyn_check", ROOT / "tools" / "moordyn_check.py")
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+    import jax
+
+    from mfm.loads.catenary import interpolate
+
+    _, ld = lines
+    table = jax.jit(lambda x, z: interpolate(ld.coef[0], ld.n[0], ld.lo[0], ld.step[0], x, z)[0])
+    ln = wy_lines()[0]
+    fl, an = np.asarray(ln["fairlead"]), np.asarray(ln["anchor"])
+    work = tempfile.mkdtemp(prefix="moordyn_")
+    path = f"{work}/line.txt"
+    with open(path, "w") as f:
+        f.write(tool.moordyn_input([an], [fl], L, EA, W, RHO, G, 60.0, 40, 1.0, 0.005))
+    md = moordyn.Create(path)
+    assert moordyn.Init(md, fl.tolist(), [0.0] * 3) == 0
+    away = np.r_[(fl - an)[:2] / np.hypot(*(fl - an)[:2]), 0.0]
+    period, dt = 200.0, 0.05
+    w = 2 * math.pi / period
+    worst, T_max = 0.0, 0.0
+    for i in range(int(round(period / dt))):
+        t = (i + 1) * dt
+        p = fl + 4.0 * (1 - math.cos(w * t)) * away + [0.0, 0.0, 2.0 * (1 - math.cos(2 * w * t))]
+        v = 4.0 * w * math.sin(w * t) * away + [0.0, 0.0, 4.0 * w * math.sin(2 * w * t)]
+        f = np.asarray(moordyn.Step(md, p.tolist(), v.tolist(), t, dt))
+        if i % 10 == 0:
+            d = p - an
+            T = float(np.hypot(*np.asarray(table(math.hypot(d[0], d[1]), d[2]))))
+            worst, T_max = max(worst, abs(np.linalg.norm(f) / T - 1)), max(T_max, T)
+    moordyn.Close(md)
+    print(f"MoorDyn's slow fairlead tension against the quasi-static line: {worst:.2e} of the "
+          f"local tension (up to {T_max / 1e3:.0f} kN)")
+    assert T_max > 1.5 * math.hypot(*catenary_forces(X0, Z0, L, EA, W))     # it did pull
+    assert worst < 0.03
