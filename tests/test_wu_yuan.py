@@ -72,6 +72,33 @@ def test_configs_are_the_generators_and_differ_only_in_the_spacing():
                                        "Clearances", "wu_yuan_m")), line
 
 
+def test_locked_variant_is_model_m_with_rigid_hinges(tmp_path):
+    """The severe-sea variant (tools/wu_yuan_configs.py config_text(m, locked=True)): the same
+    bodies, hulls, lines and database as model m, every hinge locked (no coordinate, no PTO
+    damper, no preload): 6 coordinates. Parsed only (the water and the lines are model m's)."""
+    from mfm.config import load_config
+
+    gen = generator()
+    for m in (1, 5):
+        text = gen.config_text(m, locked=True)
+        plain = gen.config_text(m)
+        assert text.count("\nlocked = true") == 12 and "\n[[joint_loads]]" not in text
+        assert plain.count("\ndamping = 4.1e7") == 12 and "\nlocked = true" not in plain
+        path = tmp_path / f"m{m}_locked.toml"
+        path.write_text(text)
+        options, bodies = load_config(path)
+        wecs = [b for b in bodies if b.name.startswith("wec")]
+        assert len(wecs) == 12 and all(b.joint.kind == "fixed" and b.joint.locked for b in wecs)
+        assert options["hydro"]["database"] == f"../hydro/data/wu_yuan_m{m}.nc"
+        # everything but the joints, the preloads and the name is model m's, character for character
+        a, b = plain.index("\n# ---- hinge preloads"), plain.index("\n# ---- catenary moorings")
+        expected = gen.LOCKED_NOTE + (plain[:a] + plain[b:]).replace(
+            "damping = 4.1e7                      # N m s/rad, the PTO [S]",
+            "locked = true                        # severe sea: the hinge locked [S]").replace(
+            f'name = "Wu-Yuan model {m}"', f'name = "Wu-Yuan model {m}, hinges locked"')
+        assert text == expected
+
+
 def test_configs_load(mechanics):
     for m, model in mechanics.items():
         assert model.n_coordinates == 18          # platform 6 + 12 hinge angles

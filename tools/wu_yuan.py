@@ -66,6 +66,28 @@ def lone_headings(heading_deg: float = 0.0) -> dict[str, float]:
     return out
 
 
+def platform_model(m: int, locked: bool = False):
+    """Model ``m`` (1–5) of the platform: configs/wu_yuan_m<m>.toml, or with ``locked`` its
+    severe-sea variant (every hinge locked: no PTO, no preload; 6 coordinates), written by
+    tools/wu_yuan_configs.py into a temporary file that reads the same database."""
+    import tempfile
+
+    import mfm
+
+    if m not in (1, 2, 3, 4, 5):
+        raise ValueError(f"m: {m!r}; the seed's models are 1, 2, 3, 4, 5")
+    if not locked:
+        return mfm.load(ROOT / "configs" / f"wu_yuan_m{m}.toml")
+    text = _generator().config_text(m, locked=True)
+    rel = f'"../hydro/data/wu_yuan_m{m}.nc"'
+    if rel not in text:
+        raise RuntimeError(f"tools/wu_yuan_configs.py no longer names the database as {rel}")
+    text = text.replace(rel, '"' + (ROOT / "hydro" / "data" / f"wu_yuan_m{m}.nc").as_posix() + '"')
+    path = Path(tempfile.mkdtemp(prefix="wu_yuan_locked_")) / f"wu_yuan_m{m}_locked.toml"
+    path.write_text(text)
+    return mfm.load(path)
+
+
 @functools.lru_cache(maxsize=1)
 def wec_alone_model():
     """The lone WEC (configs/wu_yuan_wec.toml with its database), loaded once per process."""

@@ -356,6 +356,12 @@ line_type = {line_type}
 LINE_TYPE_FIRST = ('{name = "chain", length = 800.0, mass_per_length = 303.0, EA = 1.243e9, '
                    'notes = "800 m, 0.303 t/m in water, EA 1.243e6 kN, D 0.12 m [S]"}')
 
+LOCKED_NOTE = ("# SEVERE-SEA VARIANT (seed §4.3): every hinge locked, so no PTO damper and no preload;\n"
+               "#   each WEC rigid on the platform at its design position (the text below on the\n"
+               "#   preloads and the settling describes the operating model).\n")
+WEC_DAMPER = "damping = 4.1e7                      # N m s/rad, the PTO [S]\n"
+WEC_LOCKED = "locked = true                        # severe sea: the hinge locked [S]\n"
+assert WEC_DAMPER in WEC
 PRELOAD_ENTRY = """
 [[joint_loads]]
 name = "preload_{name}"
@@ -364,9 +370,12 @@ value = {value}   # N m [D]: holds the 2 m draft (positive lifts the WEC)
 """
 
 
-def config_text(m: int, td: bool = False) -> str:
+def config_text(m: int, td: bool = False, locked: bool = False) -> str:
     """The config of model m; ``td``: its time-domain twin (same bodies and loads, the band
-    database ``wu_yuan_m<m>_td.nc``)."""
+    database ``wu_yuan_m<m>_td.nc``); ``locked``: the severe-sea variant (seed §4.3: every hinge
+    locked, so no PTO damper and no preload: each WEC rigid on the platform at its design
+    position, the platform carrying its excess weight). Not written to configs/ (the same hulls
+    and database as model m): tools/wu_yuan.py ``platform_model(m, locked=True)`` loads it."""
     ld = SPACINGS[m - 1]
     L = ld * D_WEC
     cw, ww = clearances(L)
@@ -380,6 +389,9 @@ def config_text(m: int, td: bool = False) -> str:
                   n_w=TD_BAND[2], w_2=TD_BAND[0] + TD_STEP, dw=TD_STEP, tk=math.pi / TD_STEP)
     parts = [(HEADER + (BEM_NOTE_TD + TABLES_TD if td else BEM_NOTE_FD + TABLES_FD)
               + PLATFORM).format(**values)]
+    if locked:
+        parts[0] = LOCKED_NOTE + parts[0].replace(f'name = "Wu-Yuan model {m}"',
+                                                  f'name = "Wu-Yuan model {m}, hinges locked"', 1)
     notes = {"column1": "apex column on +x", "column2": "column at +120°", "column3": "column at −120°"}
     for name, c in columns():
         parts.append(COLUMN.format(name=name, notes=notes[name], com=vec([c[0], c[1], -9.68]),
@@ -389,13 +401,17 @@ def config_text(m: int, td: bool = False) -> str:
     for name, row, c, h, a, xdir in wecs(L):
         I = inertia(xdir)
         k = (int(name[3:]) - 1) % 4 + 1
-        parts.append(WEC.format(name=name, row=row, k=k, com=vec(c), axis=vec(a, 9),
-                                point=vec(h), r_wec=r_wec, n_wec=n_wec, dx_wec=DX_WEC,
-                                inertia="[" + ", ".join(vec(r, 1) for r in I) + "]"))
-    parts.append("\n# ---- hinge preloads: hold each WEC at its 2 m draft -------------------"
-                 "---------------------\n")
-    for name, *_ in wecs(L):
-        parts.append(PRELOAD_ENTRY.format(name=name, value=f"{PRELOAD:.1f}"))
+        text = WEC.format(name=name, row=row, k=k, com=vec(c), axis=vec(a, 9),
+                          point=vec(h), r_wec=r_wec, n_wec=n_wec, dx_wec=DX_WEC,
+                          inertia="[" + ", ".join(vec(r, 1) for r in I) + "]")
+        if locked:
+            text = text.replace(WEC_DAMPER, WEC_LOCKED)
+        parts.append(text)
+    if not locked:
+        parts.append("\n# ---- hinge preloads: hold each WEC at its 2 m draft -------------------"
+                     "---------------------\n")
+        for name, *_ in wecs(L):
+            parts.append(PRELOAD_ENTRY.format(name=name, value=f"{PRELOAD:.1f}"))
     parts.append("\n# ---- catenary moorings (Table 2) --------------------------------------"
                  "---------------------\n")
     for i, (name, bearing, fl, an) in enumerate(lines()):
