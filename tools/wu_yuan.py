@@ -66,10 +66,12 @@ def lone_headings(heading_deg: float = 0.0) -> dict[str, float]:
     return out
 
 
+@functools.lru_cache(maxsize=None)
 def platform_model(m: int, locked: bool = False):
     """Model ``m`` (1–5) of the platform: configs/wu_yuan_m<m>.toml, or with ``locked`` its
     severe-sea variant (every hinge locked: no PTO, no preload; 6 coordinates), written by
-    tools/wu_yuan_configs.py into a temporary file that reads the same database."""
+    tools/wu_yuan_configs.py into a temporary file that reads the same database. Loaded once per
+    process (a model keeps its compiled linearisation: a second study of it is cheap)."""
     import tempfile
 
     import mfm

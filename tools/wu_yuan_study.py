@@ -39,7 +39,9 @@ RHO, G, WIDTH, N_WEC = 1025.0, 9.81, 8.0, 12     # eq. 34: ρ, g, WEC diameter, 
 
 def seed_periods() -> np.ndarray:
     """The seed's ten periods (s, ascending): those of the databases (2π/ω, rounded to 0.1 s)."""
-    w = np.asarray(xr.open_dataset(ROOT / "hydro" / "data" / "wu_yuan_m1.nc").omega.values)
+    from hydro.database import read_netcdf     # never a bare xr.open_dataset (hydro/database.py)
+
+    w = np.asarray(read_netcdf(ROOT / "hydro" / "data" / "wu_yuan_m1.nc").omega.values)
     return np.sort(np.round(2 * np.pi / w[np.isfinite(w) & (w > 0)], 1))
 
 
@@ -51,9 +53,13 @@ def _platform_rao(fr) -> xr.DataArray:
         "dof", errors="ignore").assign_coords(motion=["surge", "heave", "pitch"]).transpose("omega", "motion")
 
 
-def fd_study(models=(1, 2, 3, 4, 5), periods=None, H: float = H_AVERAGE, *, verbose: bool = False) -> xr.Dataset:
+def fd_study(models=(1, 2, 3, 4, 5), periods=None, H: float = H_AVERAGE, *,
+             platform_damping: float | None = None, verbose: bool = False) -> xr.Dataset:
     """The five spacings in regular waves of height ``H`` (m), heading 0, at ``periods`` (s;
-    default the seed's ten). Returns a Dataset (model, period, wec, row, motion, line):
+    default the seed's ten). ``platform_damping``: a viscous damping of the platform's heave, roll
+    and pitch as a fraction of critical (mfm.loads.body_matrix.LinearBodyMatrix ``damping_ratio``;
+    the seed's C_vis, whose values it does not give; default none). Returns a Dataset (model,
+    period, wec, row, motion, line):
 
     power (W) per WEC, P_s (W) the lone WEC's (assumed definition), q_s, row_power (W) and q_r
     per row, array_power (W), q_a, CWR; platform_rao (surge, heave m/m; pitch deg/m);
@@ -74,7 +80,14 @@ def fd_study(models=(1, 2, 3, 4, 5), periods=None, H: float = H_AVERAGE, *, verb
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", HydroDatabaseWarning)
             model = wu_yuan.platform_model(k)
-            fr = mfm.frequency_response(model, w, 0.0, joint_reactions=False)
+            loads = []
+            if platform_damping:
+                from mfm.loads.body_matrix import LinearBodyMatrix
+
+                z = float(platform_damping)
+                loads = [LinearBodyMatrix.create(model, "platform", name="platform_viscous",
+                                                 damping_ratio={"heave": z, "roll": z, "pitch": z})]
+            fr = mfm.frequency_response(model, w, 0.0, loads=loads, joint_reactions=False)
         wec = [p.split(".")[0] for p in fr.pto.values]
         P = xr.DataArray(fr.pto_power.values * a2, dims=("period", "wec"), coords={"period": T, "wec": wec})
         heave = fr.body_rao.sel(dof="z", body=["platform", "wec1"]).values
@@ -106,41 +119,50 @@ def fd_study(models=(1, 2, 3, 4, 5), periods=None, H: float = H_AVERAGE, *, verb
     ds.period.attrs["units"] = "s"
     ds.attrs.update(title="Wu & Yuan: five WEC spacings in regular waves (frequency domain)",
                     wave_height_m=H, heading_deg=0.0, made_by="tools/wu_yuan_study.py fd_study",
+                    platform_damping_ratio=float(platform_damping or 0.0),
                     P_s_definition=Ps.attrs["definition"], mfm_version=fr.attrs.get("mfm_version", ""),
                     configs=", ".join(f"configs/wu_yuan_m{k}.toml" for k in models))
     return ds
 
 
-def severe_study(models=(1, 2, 3, 4, 5), H: float = SEVERE[0], T: float = SEVERE[1], *,
+def severe_study(models=(1, 2, 3, 4, 5), H: float = SEVERE[0], T: float = SEVERE[1], periods=None, *,
                  verbose: bool = False) -> xr.Dataset:
     """The severe sea of the seed (H 8.1 m, T 11.4 s), every hinge locked (tools/wu_yuan.py
-    ``platform_model(m, locked=True)``): the platform's RAOs and each line's tension RAO per
-    model (Fig. 14), and the motions' and tensions' amplitudes at H (linear: RAO × H/2)."""
+    ``platform_model(m, locked=True)``): the platform's RAOs and each line's tension RAO per model
+    at ``periods`` (s; default the seed's ten, which include T) — Fig. 14 reads them at T; the
+    curves show where the locked platform's resonances sit — and the motions' and tensions'
+    amplitudes at (H, T) (linear: RAO × H/2)."""
     import mfm
     import wu_yuan
     from hydro.database import HydroDatabaseWarning
 
+    Ts = seed_periods() if periods is None else np.sort(np.atleast_1d(np.asarray(periods, float)))
+    if not np.any(np.isclose(Ts, T)):
+        Ts = np.sort(np.append(Ts, T))
     out = []
     for k in models:
         t0 = time.perf_counter()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", HydroDatabaseWarning)
             model = wu_yuan.platform_model(k, locked=True)
-            fr = mfm.frequency_response(model, [2 * np.pi / T], 0.0, joint_reactions=False)
+            fr = mfm.frequency_response(model, 2 * np.pi / Ts, 0.0, joint_reactions=False)
         out.append(xr.Dataset({
-            "platform_rao": (("motion",), _platform_rao(fr).values[0]),
-            "tension_rao": (("line",), np.abs(fr.fairlead_tension_rao.values[0])),
+            "platform_rao": (("period", "motion"), _platform_rao(fr).values),
+            "tension_rao": (("period", "line"), np.abs(fr.fairlead_tension_rao.values)),
             "heave_offset": fr.equilibrium.sel(coordinate="platform.heave").values},
-            coords={"motion": ["surge", "heave", "pitch"], "line": fr.mooring_line.values}).expand_dims(model=[k]))
+            coords={"period": Ts, "motion": ["surge", "heave", "pitch"],
+                    "line": fr.mooring_line.values}).expand_dims(model=[k]))
         if verbose:
             print(f"  locked model {k}: {time.perf_counter() - t0:.0f} s", flush=True)
     ds = xr.concat(out, dim="model")
-    ds["platform_amplitude"] = ds.platform_rao * H / 2
-    ds["tension_amplitude"] = ds.tension_rao * H / 2
+    at = ds.sel(period=Ts[np.argmin(np.abs(Ts - T))])
+    ds["platform_amplitude"] = at.platform_rao * H / 2
+    ds["tension_amplitude"] = at.tension_rao * H / 2
     for name, u in {"platform_rao": "m/m (surge, heave), deg/m (pitch)", "tension_rao": "N/m",
                     "heave_offset": "m", "platform_amplitude": "m (surge, heave), deg (pitch)",
                     "tension_amplitude": "N"}.items():
         ds[name].attrs["units"] = u
+    ds.period.attrs["units"] = "s"
     ds.attrs.update(title="Wu & Yuan: severe sea, hinges locked (frequency domain)", wave_height_m=H,
                     wave_period_s=T, heading_deg=0.0, made_by="tools/wu_yuan_study.py severe_study")
     return ds
@@ -176,9 +198,10 @@ def main(argv=None) -> int:
     print(f"                   row 1 {(ds.P_s.sel(wec='wec1').values / 1e3).round(1)}")
     sv = severe_study(args.models, verbose=True)
     print(f"severe sea H {SEVERE[0]} m, T {SEVERE[1]} s, hinges locked: RAOs per model {args.models}")
+    at = sv.sel(period=SEVERE[1])
     for mo in ("surge", "heave", "pitch"):
-        print(f"  |{mo}|  {sv.platform_rao.sel(motion=mo).values.round(3)}")
-    print(f"  max |T| kN/m {(sv.tension_rao.max('line').values / 1e3).round(1)}")
+        print(f"  |{mo}|  {at.platform_rao.sel(motion=mo).values.round(3)}")
+    print(f"  max |T| kN/m {(at.tension_rao.max('line').values / 1e3).round(1)}")
     if args.out:
         args.out.parent.mkdir(parents=True, exist_ok=True)
         write_netcdf(split_complex(ds), args.out)
