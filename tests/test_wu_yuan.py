@@ -12,13 +12,18 @@
 - The WEC alone (configs/wu_yuan_wec.toml, P_s of eqs. 31–33): its hinge RAO and power from
   mfm.frequency_response against the 1-dof equation assembled by hand from its database; a turned
   arm in heading 0 is the row-3 arm in the turned-back wave (tools/wu_yuan.py's P_s per WEC).
+- The band database of the time domain (wu_yuan_m1_td.nc) against wu_yuan_m1.nc at the seed's
+  periods. The time domain against the frequency domain of model 1 is measured in
+  benchmarks/wu_yuan_td_fd.py (minutes: the 90-dof radiation fit and the compilations; numbers in
+  benchmarks/RESULTS.md); the linearised lines it uses are tested in tests/test_catenary.py.
 
 Measured: H 388.9 kN, T 611.8 kN per line, six vertical loads 288.8 t; columns ρV 1.64108e7 kg
 (every model); at the equilibrium every WEC's draft 2.0038 m, hinge angles 0.0135 rad, the
 platform 0.136 m below its 30 m draft (hand: 0.142 m). About 45 s in all (29 s the equilibrium's
 compilation). The lone WEC: |θ̂| 0.034–0.092 rad/m at heading 0 (T 5–12 s), the hand equation to
 6e-16; P_s (H 3.8 m) of WEC 1 / WEC 9 = 251 / 223 kW at 6 s, 261 / 257 kW at 8.3 s, 184 / 184 kW at
-11.4 s, the turned arm to 7e-9. About 45 s more (the lone WEC's loading and linearisations).
+11.4 s, the turned arm to 7e-9: 13 s more (the lone WEC's loading and linearisations; 50 s on the
+shared machine under load). The band database (item below): 0.1 s.
 """
 from __future__ import annotations
 
