@@ -36,7 +36,9 @@ from hydro.waves import WaveComponents, _check_components, _harmonic_sum, ramp
 
 __all__ = ["excitation_coefficients", "excitation_time_series", "excitation_dataarray"]
 
-_REL_TOL = 1e-9  # relative slack on grid edges (rounding of stored coordinates)
+# relative slack on the ω grid's ends: a frequency this close beyond an end is that end (configs list
+# their BEM frequencies with six decimals, so 2π/5 s is stored as 0.523599, 4e-7 from 2π/5 itself)
+GRID_RTOL = 1e-6
 _HEADING_TOL = 1e-9  # rad
 
 
@@ -152,7 +154,7 @@ def excitation_coefficients(db: xr.Dataset, components: WaveComponents, *, dofs=
 
     w = c.omega
     lo, hi = omega[0], omega[-1]
-    outside = (w < lo * (1.0 - _REL_TOL)) | (w > hi * (1.0 + _REL_TOL))
+    outside = (w < lo * (1.0 - GRID_RTOL)) | (w > hi * (1.0 + GRID_RTOL))
     if np.any(outside):
         energy = c.amplitude**2
         total = float(energy.sum())

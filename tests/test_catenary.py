@@ -3,11 +3,18 @@ its single-line solver, its stiffness and its equilibrium, and a closed form of 
 
 The geometry is the Wu & Yuan semi-sub's (GEOMETRY.md §4): six lines in 3 groups at 120°, ±2.5°
 within a group; fairleads 15 m above the water at radius 54.5 m; anchors 60 m deep at radius
-830 m; 800 m long; 0.303 t/m in water; EA 1.243e6 kN. Only translations are free in the model
-bodies here (surge, sway, heave), so MoorPy's body, with its rotations fixed, is the same system.
+830 m; 800 m long; 0.303 t/m in water; EA 1.243e6 kN. Most model bodies here have only their
+translations free (surge, sway, heave), so MoorPy's body, with its rotations fixed, is the same
+system; the 6 × 6 stiffness test frees all six (MoorPy's Euler angles are mfm's free joint's).
+Measured there (K the lines' part of mfm.frequency.linear_system's K, against a central difference
+of MoorPy's forces and moments in the same coordinates): at the platform's equilibrium 3.7e-6,
+1.9e-6, 2.4e-6, 1.1e-6 of the largest entry of the translation–translation, translation–rotation,
+rotation–translation and rotation–rotation blocks; at a severe-sea excursion 4.1e-6, 2.3e-6,
+2.7e-6, 1.5e-6; MoorPy's analytic getStiffnessA agrees likewise.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -17,7 +24,7 @@ from scipy.optimize import brentq
 import mfm
 from mfm.config import parse_config
 from mfm.loads import CatenaryLines, JointLoad
-from mfm.loads.catenary import catenary_forces
+from mfm.loads.catenary import catenary_forces, linearise_lines
 from mfm.tree import ConfigError
 
 mp = pytest.importorskip("moorpy")
@@ -365,3 +372,278 @@ def test_tension_rao_in_frequency_response():
         dTx, dTz = (T(d, 0) - T(-d, 0)) / (2 * d), (T(0, d) - T(0, -d)) / (2 * d)
         ref = dTx * x + dTz * z
         assert np.abs(rao.values[:, k] - ref).max() < 1e-4 * np.abs(ref).max(), (k, rao.values[:, k], ref)
+
+
+def test_linearised_lines_are_the_first_order_expansion(lines):
+    # CatenaryLines.linearised about an offset q₀ (3 m surge, 1 m sway, −0.5 m heave): at q₀ the
+    # forces are the nonlinear lines' (round-off) and ∂f/∂r_F is a central difference of them
+    # (δ 1 cm: 1e-6 of the largest entry, the difference's own error); 5 m further in surge the
+    # force is f₀ + ∂f/∂r Δr exactly (1e-9) while the nonlinear lines' tensions differ from it by
+    # more than 10 % of their change (the lines stiffen: H 390 → 638 kN at 5 m)
+    model, ld = lines
+    from mfm.kinematics import kinematics
+    import jax.numpy as jnp
+
+    q0 = np.array([3.0, 1.0, -0.5])
+    lin = ld.linearised(model, q0)
+    assert lin.linear and not ld.linear
+    p0 = np.asarray(ld.fairleads.positions(kinematics(model, jnp.asarray(q0))))
+    assert np.allclose(lin.fairlead_forces(p0), ld.fairlead_forces(p0), rtol=1e-12, atol=1e-6)
+    h = 0.01
+    fd = np.stack([(np.asarray(ld.fairlead_forces(p0 + h * e)) - np.asarray(ld.fairlead_forces(p0 - h * e)))
+                   / (2 * h) for e in np.eye(3)], axis=2)                       # (P, 3, 3)
+    df = np.asarray(lin.lin_df)
+    assert np.abs(df - fd).max() < 1e-6 * np.abs(fd).max()
+    d = np.array([5.0, 0.0, 0.0])
+    f_lin = np.asarray(lin.fairlead_forces(p0 + d))
+    assert np.allclose(f_lin, np.asarray(lin.lin_f0) + df @ d, rtol=1e-9)
+    H, V, inside = (np.asarray(a) for a in lin.tensions(p0 + d))
+    hv = np.asarray(lin.lin_hv0) + np.einsum("kca,a->kc", np.asarray(lin.lin_dhv), d)
+    assert inside.all() and np.allclose(np.c_[H, V], hv, rtol=1e-9)
+    H_nl = np.asarray(ld.tensions(p0 + d)[0])
+    change = np.abs(H - np.asarray(lin.lin_hv0)[:, 0])
+    print(f"5 m further: H linearised {np.round(H / 1e3, 1).tolist()} kN, MoorPy's table "
+          f"{np.round(H_nl / 1e3, 1).tolist()} kN")
+    assert np.max(np.abs(H_nl - H) / change) > 0.1
+    assert "catenary_linearised" in lin.provenance()
+    with pytest.raises(ValueError, match="linearised already"):
+        lin.linearised(model, q0)
+    with pytest.raises(ValueError, match="q0: shape"):
+        ld.linearised(model, np.zeros(6))
+    # linearise_lines: the model's own lines (about its equilibrium when no q0 is given)
+    moored = dataclasses.replace(model, loads=(ld,))
+    out = linearise_lines(moored, q0)
+    assert out.loads[0].linear and np.allclose(out.loads[0].lin_p0, lin.lin_p0)
+    with pytest.raises(ValueError, match="no \\[\\[catenary_lines\\]\\]"):
+        linearise_lines(model)
+
+
+def test_linearised_lines_in_the_time_domain_are_the_linear_system():
+    # the hull (free in surge, sway, heave: its fairleads move with q exactly) on linearised lines
+    # and a heave spring, released from a 4 m surge / 2 m sway / 0.5 m heave offset about its
+    # equilibrium: the time domain (RK4, dt 0.2 s) equals the linear solution
+    # q(t) = q₀ + V cos(Ω t) V⁻¹ Δq of the frequency domain's own M and K
+    # (mfm.frequency.linear_system, M⁻¹K = V Ω² V⁻¹) within 1e-5 of the offset: RK4's phase error,
+    # (ω dt)⁵/120 per step on the 10.8 s heave, is 3.5e-5 rad after 200 steps on a heave 1/8 of the
+    # largest offset (measured 4.0e-6)
+    awp = 533.7
+    model = hull_model(k_heave=RHO * G * awp, rest=1.64e7 / RHO / awp)
+    ld = CatenaryLines.create(model, wy_lines())
+    q0, _ = mfm.equilibrium(model, loads=ld)
+    lin = ld.linearised(model, q0)
+    sys = mfm.frequency.linear_system(model, q0, loads=lin)
+    lam, V = np.linalg.eig(np.linalg.solve(sys.M, sys.K))
+    dq = np.array([4.0, 2.0, 0.5])
+    dt, n = 0.2, 200
+    t = dt * np.arange(n + 1)
+    modal = np.cos(np.outer(t, np.sqrt(lam.real))) * np.linalg.solve(V, dq)     # (n + 1, 3)
+    ref = q0 + np.real(modal @ V.T)
+    _, q, *_ = mfm.rollout(model, q0 + dq, np.zeros(3), dt=dt, n_steps=n, loads=lin)
+    err = np.abs(np.asarray(q) - ref).max() / np.abs(dq).max()
+    print(f"periods {np.round(2 * np.pi / np.sqrt(lam.real), 2).tolist()} s; linearised lines against "
+          f"the linear solution {err:.1e} of the offset")
+    assert err < 1e-5
+
+
+# ---- the full 6 × 6 stiffness of the Wu & Yuan lines, rotations included ---------------------
+
+# The platform's pose at the static equilibrium of configs/wu_yuan_m1.toml (free hinges with their
+# preloads; surge, sway, heave m, roll, pitch, yaw rad), as `python tools/moordyn_check.py
+# --equilibrium` prints it (heave −0.136027 m, the rest below 1e-7; the equilibrium costs ~40 s,
+# too much to repeat here). The comparison holds at any pose; the second one (a severe-sea
+# excursion) has large moments of the lines about the CoG.
+WY_EQUILIBRIUM = (0.0, 0.0, -0.136027, 0.0, 0.0, 0.0)
+WY_EXCURSION = (6.0, 1.0, -0.5, 0.03, 0.05, 0.02)
+
+
+@pytest.fixture(scope="module")
+def wy_platform():
+    """The platform of configs/wu_yuan_m1.toml (its CoG, free in 6 dofs) with the six lines of
+    :func:`wy_lines`, checked to be the config's own [[catenary_lines]] (parsed: line types, mass
+    per length × g) within the config's 1e-6 m rounding (so the table is the module's, cached)."""
+    import tomllib
+
+    from conftest import CONFIGS
+
+    cfg = tomllib.loads((CONFIGS / "wu_yuan_m1.toml").read_text())
+    plat = next(b for b in cfg["bodies"] if b["name"] == "platform")
+    model = mfm.compile_tree(parse_config({"bodies": [{
+        "name": "platform", "mass": plat["mass"], "com": plat["com"],
+        "radii_of_gyration": plat["radii_of_gyration"], "joint": {"type": "free"}}]})[1],
+        gravity=cfg["model"]["gravity"])
+    parsed = CatenaryLines.parse_table(cfg["catenary_lines"], ["platform"])
+    ours = CatenaryLines.parse_table([dict(ln, body="platform") for ln in wy_lines()], ["platform"])
+    for a, b in zip(parsed, ours, strict=True):
+        assert np.abs(a["fairlead"] - b["fairlead"]).max() < 1e-5
+        assert np.abs(a["anchor"] - b["anchor"]).max() < 1e-5
+        assert (a["length"], a["EA"], a["mass_per_length"] * cfg["model"]["gravity"]) == \
+            (b["length"], b["EA"], b["weight"])
+    return model, CatenaryLines.from_parsed(ours, model), np.asarray(plat["com"], float)
+
+
+def _euler(q):
+    """R = R_z(yaw) R_y(pitch) R_x(roll) (mfm's free joint, mfm/compile.py; MoorPy's
+    rotationMatrix(roll, pitch, yaw) is the same) and E, whose columns map the angle rates
+    (roll, pitch, yaw) to the angular velocity in inertial axes: ω = R_z R_y x̂ φ̇ + R_z ŷ θ̇ + ẑ ψ̇."""
+    from moorpy.helpers import rotationMatrix
+
+    phi, th, psi = q[3:6]
+    Rz = np.array([[math.cos(psi), -math.sin(psi), 0], [math.sin(psi), math.cos(psi), 0], [0, 0, 1]])
+    Ry = np.array([[math.cos(th), 0, math.sin(th)], [0, 1, 0], [-math.sin(th), 0, math.cos(th)]])
+    return rotationMatrix(phi, th, psi), np.column_stack([Rz @ Ry[:, 0], Rz[:, 1], [0, 0, 1]])
+
+
+def moorpy_platform(ld, com):
+    """MoorPy's System of the six lines, with a free body whose reference point is the CoG."""
+    ms = mp.System(depth=60.0, rho=RHO, g=G)
+    body = ms.addBody(0, np.r_[com, 0, 0, 0])
+    for k in range(len(ld.names)):
+        ln = dict(ld.lines[k])
+        ms.lineTypes[f"t{k}"] = dict(name=f"t{k}", d_vol=0.0, w=ln["weight"], m=ln["weight"] / G,
+                                     EA=ln["EA"], material="chain", d_nom=0.12)
+        ms.addPoint(1, np.asarray(ld.anchors[k]))
+        ms.addPoint(1, np.asarray(ld.fairleads.d_ref[k]), body=1)
+        ms.addLine(ln["length"], f"t{k}", pointA=len(ms.pointList) - 1, pointB=len(ms.pointList))
+    ms.initialize()
+    return ms, body
+
+
+def moorpy_generalised_forces(ms, body, com, q):
+    """The lines' generalised forces on mfm's coordinates q (surge, sway, heave, roll, pitch,
+    yaw) from MoorPy: its body at the pose q (reference point the CoG), the lines solved to
+    1e-10 m, its net force F and moment M about the CoG (inertial axes) projected by virtual
+    power: Q = (F, Eᵀ M) (E of :func:`_euler`)."""
+    q = np.asarray(q, float)
+    body.setPosition(np.r_[com + q[:3], q[3:]])
+    for ln in ms.lineList:
+        ln.staticSolve(tol=1e-10)
+    f6 = body.getForces(lines_only=True)
+    return np.r_[f6[:3], _euler(q)[1].T @ f6[3:]], f6
+
+
+def _blocks_error(K, K_ref):
+    """The largest difference in each 3 × 3 block (translation/rotation rows × columns) relative
+    to the largest entry of that block of K_ref."""
+    out = {}
+    for r, rs in (("T", slice(0, 3)), ("R", slice(3, 6))):
+        for c, cs in (("T", slice(0, 3)), ("R", slice(3, 6))):
+            out[r + c] = np.abs(K[rs, cs] - K_ref[rs, cs]).max() / np.abs(K_ref[rs, cs]).max()
+    return out
+
+
+@pytest.mark.parametrize("pose", [WY_EQUILIBRIUM, WY_EXCURSION], ids=["equilibrium", "excursion"])
+def test_six_dof_stiffness_against_moorpy_finite_difference(wy_platform, pose):
+    # The lines' part of the frequency domain's K (mfm.frequency.linear_system: K = −∂Q/∂q, jax's
+    # derivative of the interpolated tables through the fairlead kinematics) on the platform's six
+    # coordinates, against a central difference of MoorPy's own forces and moments on a body with
+    # the same six lines (δ 1 cm, 2e-4 rad: 1 cm at the fairleads; truncation (δ/5 m)² ~ 1e-6).
+    # Tolerance 1e-4 of the largest entry of each 3 × 3 block (the issue's): the table's error is
+    # 1.8e-5 of the tension near rest, 3.2e-4 at its slack corner (test above).
+    model, ld, com = wy_platform
+    q0 = np.asarray(pose)
+    ms, body = moorpy_platform(ld, com)
+    # the same fairleads: MoorPy's rotation convention and mfm's free joint agree
+    from mfm.kinematics import kinematics
+    import jax.numpy as jnp
+
+    moorpy_generalised_forces(ms, body, com, q0)
+    p_mfm = np.asarray(ld.fairleads.positions(kinematics(model, jnp.asarray(q0))))
+    p_mp = np.array([ms.pointList[2 * k + 1].r for k in range(6)])
+    assert np.abs(p_mfm - p_mp).max() < 1e-9
+
+    K = (mfm.frequency.linear_system(model, q0, loads=ld).K - mfm.frequency.linear_system(model, q0).K)
+    K_fd = np.zeros((6, 6))
+    for j, d in enumerate([0.01] * 3 + [2e-4] * 3):
+        e = np.zeros(6)
+        e[j] = d
+        K_fd[:, j] = -(moorpy_generalised_forces(ms, body, com, q0 + e)[0]
+                       - moorpy_generalised_forces(ms, body, com, q0 - e)[0]) / (2 * d)
+    err = _blocks_error(K, K_fd)
+    np.set_printoptions(precision=5, linewidth=150)
+    print(f"pose {pose}: mfm K (N/m, N/rad, N m/m, N m/rad)\n{K}\nMoorPy FD\n{K_fd}\n"
+          f"per block |ΔK| / max|K_block|: {', '.join(f'{b} {v:.1e}' for b, v in err.items())}")
+    assert max(err.values()) < 1e-4, err
+
+    # In generalised coordinates K is the Hessian of the lines' potential energy (elastic lines on
+    # a frictionless seabed): symmetric; MoorPy's difference of the same forces is too, to its
+    # truncation (both: 1e-4 of the block, as above)
+    assert max(_blocks_error(K.T, K).values()) < 1e-4
+    assert max(_blocks_error(K_fd.T, K_fd).values()) < 1e-4
+
+    # Second opinion, MoorPy's analytic getStiffnessA: the Jacobian of its wrench w = (F, M) in
+    # small rotations δφ about inertial axes. Its rotational block holds [F_k]× [r_k]× per fairlead,
+    # non-symmetric by ½[M]× (M the lines' moment about the CoG); in the Euler angles that part is
+    # what ∂Eᵀ/∂q · M cancels: K = Jᵀ K_A J − Σ_j (∂Jᵀ/∂q_j) w e_jᵀ, J = diag(I, E).
+    moorpy_generalised_forces(ms, body, com, q0)
+    K_A = body.getStiffnessA(lines_only=True, all_DOFs=True)
+    w = body.getForces(lines_only=True)
+    J = np.eye(6)
+    J[3:, 3:] = _euler(q0)[1]
+    G = np.zeros((6, 6))
+    for j in range(3, 6):
+        e = np.zeros(6)
+        e[j] = 1e-6
+        dE = (_euler(q0 + e)[1] - _euler(q0 - e)[1]) / 2e-6
+        G[3:, j] = dE.T @ w[3:]
+    K_from_A = J.T @ K_A @ J - G
+    err_A = _blocks_error(K, K_from_A)
+    asym = (K_A[3:, 3:] - K_A[3:, 3:].T) / 2
+    M = w[3:]
+    print(f"MoorPy getStiffnessA: per block {', '.join(f'{b} {v:.1e}' for b, v in err_A.items())}; "
+          f"its rotational block's antisymmetric part {np.abs(asym).max():.4g} N m/rad, "
+          f"the lines' moment about the CoG {M} N m")
+    assert max(err_A.values()) < 1e-4, err_A
+    # the antisymmetric part is ½[M]× to MoorPy's round-off (analytic both ways)
+    skew = np.array([[0, -M[2], M[1]], [M[2], 0, -M[0]], [-M[1], M[0], 0]])
+    assert np.abs(asym - skew / 2).max() < 1e-9 * np.abs(K_A[3:, 3:]).max()
+
+
+def test_moordyn_slow_limit_is_the_quasi_static_line(lines):
+    # MoorDyn's lumped-mass line (the seed's eq. 28; the optional `moordyn` package), written by
+    # tools/moordyn_check.py's input writer, with its fairlead moved slowly (8 m away from the
+    # anchor and 4 m up and back over 200 s, speeds ≤ 0.13 m/s, from rest): its fairlead tension
+    # is the engine's quasi-static table along the same path within 3 % of the local tension
+    # (measured 1.3 %: 40 segments of 20 m, 3.4 % with 20, 1.0 % with 80, the rest the drag at
+    # these speeds, 2.6 % over 100 s). So the large dynamic tensions tools/moordyn_check.py finds
+    # in the severe sea are the lines' dynamics, not a different line. ~15 s.
+    moordyn = pytest.importorskip("moordyn")
+    import importlib.util
+    import tempfile
+
+    from conftest import ROOT
+
+    spec = importlib.util.spec_from_file_location("moordyn_check", ROOT / "tools" / "moordyn_check.py")
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+    import jax
+
+    from mfm.loads.catenary import interpolate
+
+    _, ld = lines
+    table = jax.jit(lambda x, z: interpolate(ld.coef[0], ld.n[0], ld.lo[0], ld.step[0], x, z)[0])
+    ln = wy_lines()[0]
+    fl, an = np.asarray(ln["fairlead"]), np.asarray(ln["anchor"])
+    work = tempfile.mkdtemp(prefix="moordyn_")
+    path = f"{work}/line.txt"
+    with open(path, "w") as f:
+        f.write(tool.moordyn_input([an], [fl], L, EA, W, RHO, G, 60.0, 40, 1.0, 0.005))
+    md = moordyn.Create(path)
+    assert moordyn.Init(md, fl.tolist(), [0.0] * 3) == 0
+    away = np.r_[(fl - an)[:2] / np.hypot(*(fl - an)[:2]), 0.0]
+    period, dt = 200.0, 0.05
+    w = 2 * math.pi / period
+    worst, T_max = 0.0, 0.0
+    for i in range(int(round(period / dt))):
+        t = (i + 1) * dt
+        p = fl + 4.0 * (1 - math.cos(w * t)) * away + [0.0, 0.0, 2.0 * (1 - math.cos(2 * w * t))]
+        v = 4.0 * w * math.sin(w * t) * away + [0.0, 0.0, 4.0 * w * math.sin(2 * w * t)]
+        f = np.asarray(moordyn.Step(md, p.tolist(), v.tolist(), t, dt))
+        if i % 10 == 0:
+            d = p - an
+            T = float(np.hypot(*np.asarray(table(math.hypot(d[0], d[1]), d[2]))))
+            worst, T_max = max(worst, abs(np.linalg.norm(f) / T - 1)), max(T_max, T)
+    moordyn.Close(md)
+    print(f"MoorDyn's slow fairlead tension against the quasi-static line: {worst:.2e} of the "
+          f"local tension (up to {T_max / 1e3:.0f} kN)")
+    assert T_max > 1.5 * math.hypot(*catenary_forces(X0, Z0, L, EA, W))     # it did pull
+    assert worst < 0.03

@@ -152,6 +152,18 @@ def test_frequency_outside_grid():
         excitation_coefficients(db, comps, drop_energy_fraction=1e-7)
 
 
+def test_frequency_at_a_rounded_grid_end():
+    """A config lists its BEM frequencies with six decimals (2π/5 s as 0.523599): 2π/5 itself lies
+    4e-7 beyond that end and is read as the end (GRID_RTOL = 1e-6); 2e-6 beyond is refused."""
+    db = make_db(np.array([0.2, 1.0, 2 * math.pi / 5.0]).round(6), BETA)
+    hi = float(db.omega[-1])
+    X = excitation_coefficients(db, Regular(1.0, 5.0).components())
+    np.testing.assert_allclose(X[0], excitation_coefficients(db, Regular(1.0, 2 * math.pi / hi).components())[0],
+                               rtol=1e-12)
+    with pytest.raises(ValueError, match="outside the database's omega grid"):
+        excitation_coefficients(db, Regular(1.0, 2 * math.pi / (hi * (1 + 2e-6))).components())
+
+
 def test_heading_outside_range():
     db = make_db(OMEGA, np.deg2rad([0.0, 20.0, 40.0]))
     with pytest.raises(ValueError, match=r"heading 1\.5708 rad \(90°\).*\[0, 0\.698132\] rad"):

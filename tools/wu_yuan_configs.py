@@ -1,11 +1,13 @@
 """Write configs/wu_yuan_m1.toml … wu_yuan_m5.toml: the Wu & Yuan semi-sub energy platform with 12
-hinged WECs (seed 004; GEOMETRY.md §4) at the five WEC spacings L = 2D … 3D of the seed's Table 4.
+hinged WECs (seed 004; GEOMETRY.md §4) at the five WEC spacings L = 2D … 3D of the seed's Table 4;
+configs/wu_yuan_m1_td.toml, model 1 with a band database for the time domain (K(t)); and
+configs/wu_yuan_wec.toml, one WEC alone hinged at a fixed point (P_s of the interaction factors).
 
 The five files are identical except the spacing-dependent positions (WEC centres, hinge points,
 the model's name and its database); the loader has no way to share tables between configs, so
 this script is their single source (values tagged as docs/GEOMETRY.md §4). Run from the repository root:
 
-    python tools/wu_yuan_configs.py          # (re)writes the five configs
+    python tools/wu_yuan_configs.py          # (re)writes the configs
     python tools/wu_yuan_configs.py --check  # exits 1 if a config differs from what it would write
 
 Layout (heading 0 = waves travelling to +x):
@@ -43,6 +45,10 @@ RHO, G = 1025.0, 9.81       # [A]
 DEPTH = 60.0                # m [S: anchors 60 m below water]
 PERIODS = (5.0, 6.0, 7.0, 8.0, 8.3, 9.0, 10.0, 11.0, 11.4, 12.0)   # s [S]
 DX_COL, DX_WEC = 2.0, 0.8   # m panel sizes [D]
+TD_BAND = (0.25, 3.0, 56)   # rad/s: the time domain's band database (omega_min, omega_max, n) [D]
+TD_STEP = (TD_BAND[1] - TD_BAND[0]) / (TD_BAND[2] - 1)
+TD_MODELS = (1,)            # the models with a time-domain twin (wu_yuan_m<m>_td.toml)
+WEC_HEADINGS = (-120.0, 0.0, 120.0)   # deg: the lone WEC's database (rows 2, 3, 1; see wec_config_text)
 
 
 def panel_radius(r, dx):
@@ -203,6 +209,9 @@ HEADER = """\
 #   300 t reserve: it settles ≈ 0.16 m below its 30 m draft (the seed's masses do not close; the
 #   hinge angles take it up, the WECs keep their draft).
 # Viscous damping: none (the seed's C_vis has no values) [A].
+"""
+
+BEM_NOTE_FD = """\
 # BEM [D]: the ten periods of the seed (T = 5, 6, 7, 8, 8.3, 9, 10, 11, 11.4, 12 s) + ∞; finite
 #   depth where kh < 5 (ω < 0.90 rad/s, T > 6.95 s), deep water above and at ∞; panels dx {dx_col:g} m on
 #   the columns, {dx_wec:g} m on the WECs. The panelled hulls are regular polygons with their vertices on
@@ -213,6 +222,9 @@ HEADER = """\
 #   ω² = g k coth(k d) with k = 2.405 / a, are 1.77 rad/s (column) and 2.66 rad/s (WEC), above the
 #   highest ω here (1.257 rad/s); xOz symmetry. One body per hull (15: 3 columns + 12 WECs), solved together.
 
+"""
+
+TABLES_FD = """\
 [model]
 name = "Wu-Yuan model {m}"
 gravity = 9.81              # m/s² [A]
@@ -233,6 +245,55 @@ lid = false                 # first irregular frequencies 1.77 (column), 2.66 ra
 symmetry = "auto"           # xOz (the layout mirrors about y = 0)
 infinite_frequency = true
 
+"""
+
+BEM_NOTE_TD = """\
+# THIS FILE is model {m} for the TIME DOMAIN: the same bodies, joints and loads as
+#   configs/wu_yuan_m{m}.toml (which the frequency-domain study reads), with a database over a band
+#   of frequencies for the radiation memory K(t) (mfm.simulate) instead of the seed's ten periods.
+# BEM [D]: ω = {w_lo:g}, {w_2:g}, …, {w_hi:g} rad/s ({n_w}, step {dw:g} rad/s: K(t) sampled to
+#   π/Δω = {tk:.0f} s) + ∞; finite depth where kh < 5 (ω < 0.90 rad/s), deep water above and at ∞;
+#   panels as in wu_yuan_m{m}.toml: dx {dx_col:g} m on the columns ({n_col}-gons of radius {r_col:g} m,
+#   the circle's area), {dx_wec:g} m on the WECs ({n_wec}-gons, {r_wec:g} m), so the band
+#   database holds the frequency-domain database's hulls. Water-plane lids on every hull: the first
+#   irregular frequencies, ω² = g k coth(k d) with k = 2.405 / a, are 1.77 rad/s (column) and
+#   2.66 rad/s (WEC), inside the band. xOz symmetry. Panels per wavelength (deep water,
+#   λ = 2π g / ω²): 5 panels of 2 m hold up to ω = 2.48 rad/s on the columns, 5 of 0.8 m up to
+#   3.92 rad/s on the WECs; above 2.48 rad/s the columns' coefficients are coarser: one column
+#   alone at 3.0 rad/s, dx 2 m against 1 m: surge damping +24 % (it is 10 % of its 1 rad/s
+#   value there), pitch damping +12 %, surge excitation −4 % (2.0 rad/s: +7 %, +0.2 %, −4 %). Those
+#   frequencies only shape K(t) near t = 0; the waves of the seed are below 1.26 rad/s. 1.4 m
+#   panels on the columns (+8 % surge damping at 3 rad/s) would double the cost (≈ 1 h) [D].
+#   (hydro/data/README.md)
+
+"""
+
+TABLES_TD = """\
+[model]
+name = "Wu-Yuan model {m} (time domain)"
+gravity = 9.81              # m/s² [A]
+description = "Semi-sub energy platform with 12 hinged WECs, WEC spacing L = {ld:g} D (Wu & Yuan, model {m}), band database for the time domain"
+
+[hydro]
+database = "../hydro/data/wu_yuan_m{m}_td.nc"   # made by `mfm hydro configs/wu_yuan_m{m}_td.toml --threads 1`
+body_coupling = true        # all interactions between the 15 hulls
+rho = 1025.0                # kg/m³ [A]
+
+[hydro.bem]
+omega_min = {w_lo}            # rad/s  }} the band of K(t) [D]
+omega_max = {w_hi}             # rad/s  }}
+n_omega = {n_w}                # step {dw:g} rad/s
+headings_deg = [0.0]        # [S]
+water_depth = 60.0          # m [S]
+deep_water_kh = 5.0         # finite depth below kh = 5, deep water above [D]
+dx = {dx_col}                    # m on the columns (the WECs set their own)
+lid = true                  # first irregular frequencies 1.77 (column), 2.66 rad/s (WEC) in the band
+symmetry = "auto"           # xOz (the layout mirrors about y = 0)
+infinite_frequency = true
+
+"""
+
+PLATFORM = """\
 # ---- the platform: a dry root with all the mass, and its three columns ------------------------
 
 [[bodies]]
@@ -303,17 +364,22 @@ value = {value}   # N m [D]: holds the 2 m draft (positive lifts the WEC)
 """
 
 
-def config_text(m: int) -> str:
+def config_text(m: int, td: bool = False) -> str:
+    """The config of model m; ``td``: its time-domain twin (same bodies and loads, the band
+    database ``wu_yuan_m<m>_td.nc``)."""
     ld = SPACINGS[m - 1]
     L = ld * D_WEC
     cw, ww = clearances(L)
     r_col, n_col = panel_radius(R_COL, DX_COL)
     r_wec, n_wec = panel_radius(R_WEC, DX_WEC)
     xh = x_hinge_row3()
-    parts = [HEADER.format(m=m, ld=ld, L=L, xh=xh, xw=xh - ARM, cw=cw, ww=ww, md=M_DISPLACED,
-                           mw=M_WEC, pre=PRELOAD, dm=M_WEC - M_DISPLACED,
-                           omega=vec(omega_list()), dx_col=DX_COL, r_col=r_col, n_col=n_col,
-                           r_wec=r_wec, n_wec=n_wec, dx_wec=DX_WEC)]
+    values = dict(m=m, ld=ld, L=L, xh=xh, xw=xh - ARM, cw=cw, ww=ww, md=M_DISPLACED,
+                  mw=M_WEC, pre=PRELOAD, dm=M_WEC - M_DISPLACED,
+                  omega=vec(omega_list()), dx_col=DX_COL, r_col=r_col, n_col=n_col,
+                  r_wec=r_wec, n_wec=n_wec, dx_wec=DX_WEC, w_lo=TD_BAND[0], w_hi=TD_BAND[1],
+                  n_w=TD_BAND[2], w_2=TD_BAND[0] + TD_STEP, dw=TD_STEP, tk=math.pi / TD_STEP)
+    parts = [(HEADER + (BEM_NOTE_TD + TABLES_TD if td else BEM_NOTE_FD + TABLES_FD)
+              + PLATFORM).format(**values)]
     notes = {"column1": "apex column on +x", "column2": "column at +120°", "column3": "column at −120°"}
     for name, c in columns():
         parts.append(COLUMN.format(name=name, notes=notes[name], com=vec([c[0], c[1], -9.68]),
@@ -338,12 +404,110 @@ def config_text(m: int) -> str:
     return "".join(parts)
 
 
+WEC_ALONE = """\
+# One WEC of the Wu & Yuan platform operating ALONE: P_s of the interaction factors q_s, q_r, q_a
+# (seed 004 eqs. 31–33: "P_s^i is the captured power of the i-th WEC when it operates alone").
+# H. Wu, Z. Yuan, Ocean Engineering (2025) (docs/references.md, seed 004); values tagged as in
+# docs/GEOMETRY.md §4 ([S] stated, [D] derived, [A] assumed).
+# MADE BY tools/wu_yuan_configs.py (the WEC's data are those of configs/wu_yuan_m1..m5.toml; edit
+#   the script and rerun it, not this file).
+#
+# ASSUMED DEFINITION OF P_s [A]: the seed does not say how it computed a WEC "operating alone".
+#   Here it is the same WEC on the same arm, hinged at a FIXED point (the inertial frame) instead
+#   of the platform: hinge 9.72 m horizontally from its CoG towards where the platform was and
+#   5.44 m above water [S], the same hinge axis, mass 1.1136e5 kg and inertias (Table 3, in the
+#   WEC's own axes, x′ along the arm) [S], the same hull (flat cylinder R 4 m, draft 2 m, as the
+#   platform configs' {n_wec}-gon of radius {r_wec:g} m: the circle's area) [S/A], the same PTO
+#   (rotary damper 4.1e7 N m s/rad) [S] and the same hinge preload holding the 2 m draft
+#   ({pre:.4e} N m, positive lifts the WEC) [D], in the same regular wave (heading 0: waves
+#   travelling to +x) [S]. No other body, no platform motion, no line.
+# This file is the row-3 WEC (arm along x: the WEC on the −x side of its hinge, hinge axis
+#   along y){alpha_note}. The hull is axisymmetric, so a WEC whose arm is turned by α about z
+#   absorbs in heading 0 what this one absorbs in heading −α: row 1 (α = +120°) → heading −120°,
+#   row 2 (α = −120°) → +120°, row 3 → 0 (tools/wu_yuan.py: wec_alone_power). The database holds
+#   those three headings.
+# BEM [D]: the WEC alone, its CoG at the origin (one body of revolution on the z axis: capytaine's
+#   rotation symmetry), reference point the CoG; the ten periods of the seed (T = 5, 6, 7, 8, 8.3,
+#   9, 10, 11, 11.4, 12 s) + ∞; depth 60 m, finite where kh < 5, deep water above and at ∞;
+#   ρ 1025, g 9.81; panels dx {dx_wec:g} m as in the platform configs; no lid (first irregular
+#   frequency 2.66 rad/s > 1.257), as in wu_yuan_m1..m5.nc.
+
+[model]
+name = "Wu-Yuan WEC alone"
+gravity = 9.81              # m/s² [A]
+description = "One WEC of the Wu & Yuan platform hinged at a fixed point: P_s of eqs. 31–33 [A]"
+
+[hydro]
+database = "{database}"   # made by `mfm hydro configs/wu_yuan_wec.toml --threads 1`
+rho = 1025.0                # kg/m³ [A]
+
+[hydro.bem]
+omega = {omega}   # rad/s: 2π/T, T = 12, 11.4, 11, 10, 9, 8.3, 8, 7, 6, 5 s [S]
+headings_deg = {headings}   # rows 2, 3, 1 (see above)
+water_depth = 60.0          # m [S]
+deep_water_kh = 5.0         # finite depth below kh = 5, deep water above [D]
+dx = {dx_wec}                    # m [D]
+lid = false                 # first irregular frequency 2.66 rad/s > 1.257
+symmetry = "auto"           # rotation (one body of revolution on the z axis)
+infinite_frequency = true
+
+[[bodies]]
+name = "wec"
+notes = "one WEC alone, hinged at a fixed point{alpha_note}"
+mass = 1.1136e5                      # kg [S]
+com = [0.0, 0.0, 0.0]                # m: CoG at the water line [S], at the origin
+inertia = {inertia}   # kg m² [S/D]
+[bodies.joint]
+type = "revolute"                    # to the inertial frame [A]
+axis = {axis}
+point = {point}   # hinge: 9.72 m from the CoG, 5.44 m up [S]
+damping = 4.1e7                      # N m s/rad, the PTO [S]
+[bodies.geometry]
+shape = "cylinder"
+radius = {r_wec}                      # m: R 4 [S] as a {n_wec}-gon of the same area [D]
+draft = 2.0                          # m [S]
+base = "flat"                        # [A]
+
+[[joint_loads]]
+name = "preload_wec"
+coordinate = "wec.angle"
+value = {preload}   # N m [D]: holds the 2 m draft (positive lifts the WEC)
+"""
+
+
+def wec_config_text(alpha_deg: float = 0.0, database: str = "../hydro/data/wu_yuan_wec.nc") -> str:
+    """The lone WEC's config (configs/wu_yuan_wec.toml: ``alpha_deg`` = 0, row 3's arm along x).
+
+    alpha_deg: the arm turned by α about z (the hinge point, hinge axis and inertia of row 3
+    rotated; the hull stays at the origin, so the same database serves): the check that a turned
+    arm in heading 0 is the row-3 arm in heading −α (tests/test_wu_yuan.py).
+    database: the [hydro] database path as written in the file."""
+    R = rot(alpha_deg)
+    hinge = R @ np.array([ARM, 0.0, Z_HINGE])
+    axis = R @ np.array([0.0, 1.0, 0.0])
+    I = inertia(R @ np.array([-1.0, 0.0, 0.0]))
+    r_wec, n_wec = panel_radius(R_WEC, DX_WEC)
+    note = "" if alpha_deg == 0 else f", the arm turned by {alpha_deg:g}° about z"
+    return WEC_ALONE.format(
+        n_wec=n_wec, r_wec=r_wec, pre=PRELOAD, dx_wec=DX_WEC, omega=vec(omega_list()),
+        headings="[" + ", ".join(f(h) for h in WEC_HEADINGS) + "]", database=database,
+        inertia="[" + ", ".join(vec(r, 1) for r in I) + "]", axis=vec(axis, 9), point=vec(hinge),
+        preload=f"{PRELOAD:.1f}", alpha_note=note)
+
+
+def outputs() -> dict:
+    """{path: text} of every config this script writes."""
+    out = {ROOT / "configs" / f"wu_yuan_m{m}.toml": config_text(m) for m in range(1, 6)}
+    out.update({ROOT / "configs" / f"wu_yuan_m{m}_td.toml": config_text(m, td=True)
+                for m in TD_MODELS})
+    out[ROOT / "configs" / "wu_yuan_wec.toml"] = wec_config_text()
+    return out
+
+
 def main(argv):
     check = "--check" in argv
     bad = 0
-    for m in range(1, 6):
-        path = ROOT / "configs" / f"wu_yuan_m{m}.toml"
-        text = config_text(m)
+    for path, text in outputs().items():
         if check:
             if not path.exists() or path.read_text() != text:
                 print(f"{path} differs from tools/wu_yuan_configs.py's output")

@@ -39,11 +39,25 @@ fairlead out stops as non-finite and :meth:`CatenaryLines.describe_nonfinite` na
 span and the table's bounds (widen ``table_extent``); the equilibrium and the linearisation fail
 likewise. :meth:`CatenaryLines.table_margin` tells how close a configuration is to an edge.
 
+Linearised lines. :meth:`CatenaryLines.linearised` (or :func:`linearise_lines` for every line of
+a model) gives the same lines with the fairlead force and the tensions replaced by their first-order
+expansion in the fairlead positions about a configuration q₀ (the static equilibrium by default):
+
+    f(r_F) = f(r_F,0) + ∂f/∂r_F (r_F − r_F,0),   (H, V)(r_F) = (H, V)₀ + ∂(H, V)/∂r_F (r_F − r_F,0),
+
+the derivatives those of the table at r_F,0 (so the equilibrium, the stiffness and the tension RAO
+of the frequency domain are the nonlinear lines' own), the fairleads still moving with their bodies
+exactly. The time domain with linearised lines is the model the frequency domain solves, as far as
+the lines go: the check of one against the other, and the measure of what the lines' nonlinearity
+does in a given sea. Linearised lines have no table, so they never leave it.
+
 Outputs: ``fairlead_tension``, ``fairlead_horizontal_tension`` and ``fairlead_vertical_tension``
 (N, per ``mooring_line``) in the time domain; ``fairlead_tension_rao`` (N/m, complex) in the
 frequency domain, the tension's own linearisation ∂T/∂r_F · r̂_F.
 """
 from __future__ import annotations
+
+import dataclasses
 
 import equinox as eqx
 import jax
@@ -152,6 +166,14 @@ class CatenaryLines(Load):
     step: jnp.ndarray
     names: tuple[str, ...] = eqx.field(static=True)
     lines: tuple = eqx.field(static=True)     # per line: dict items (length, EA, weight, …, hi)
+    # linearised lines (:meth:`linearised`): the fairleads r_F,0 (P, 3) about which, the force
+    # f₀ (P, 3) and its derivative ∂f/∂r_F (P, 3, 3), the tensions (H, V)₀ (P, 2) and theirs (P, 2, 3)
+    linear: bool = eqx.field(static=True, default=False)
+    lin_p0: jnp.ndarray | None = None
+    lin_f0: jnp.ndarray | None = None
+    lin_df: jnp.ndarray | None = None
+    lin_hv0: jnp.ndarray | None = None
+    lin_dhv: jnp.ndarray | None = None
 
     # -- the physics
     def spans(self, p):
@@ -164,15 +186,44 @@ class CatenaryLines(Load):
     def tensions(self, p):
         """(H, V, inside) per line at fairlead positions p (P, 3): horizontal and vertical
         fairlead tensions (N; NaN outside the table) and whether each is in its table."""
+        if self.linear:
+            HV = self.lin_hv0 + jnp.einsum("kca,ka->kc", self.lin_dhv, p - self.lin_p0)
+            return HV[:, 0], HV[:, 1], jnp.ones(HV.shape[0], dtype=bool)
         x, z, _ = self.spans(p)
         HV, inside = jax.vmap(interpolate)(self.coef, self.n, self.lo, self.step, x, z)
         return HV[:, 0], HV[:, 1], inside
 
     def fairlead_forces(self, p):
         """Forces on the fairleads (P, 3), inertial axes, N."""
+        if self.linear:
+            return self.lin_f0 + jnp.einsum("kab,kb->ka", self.lin_df, p - self.lin_p0)
         H, V, _ = self.tensions(p)
         _, _, e = self.spans(p)
         return jnp.concatenate([-H[:, None] * e, -V[:, None]], axis=1)
+
+    def linearised(self, model, q0) -> "CatenaryLines":
+        """These lines linearised in their fairlead positions about the configuration ``q0``
+        (n_q,) of ``model`` (module docstring): f = f₀ + ∂f/∂r_F (r_F − r_F,0), and likewise H and
+        V, each line's derivatives taken from its table at r_F,0 (jax). The fairleads move with
+        their bodies as before; :func:`mfm.equilibrium` and :func:`mfm.frequency_response` give the
+        same results with either (the same force and derivative at q₀)."""
+        from ..kinematics import kinematics
+
+        if self.linear:
+            raise ValueError("linearised: these catenary lines are linearised already")
+        q0 = jnp.asarray(q0, jnp.float64)
+        if q0.shape != (model.n_coordinates,):
+            raise ValueError(f"q0: shape {tuple(q0.shape)}; expected ({model.n_coordinates},), "
+                             "the model's coordinates")
+        p0 = self.fairleads.positions(kinematics(model, q0))
+        f0, df, hv0, dhv = _expansion(self, p0)
+        _, _, inside = self.tensions(p0)
+        if not bool(jnp.all(inside)) or not bool(jnp.all(jnp.isfinite(df))):
+            bad = [n for n, ok in zip(self.names, np.asarray(inside)) if not ok]
+            raise ValueError(f"q0: the fairleads of catenary lines {bad} lie outside their tables "
+                             "there; linearise about a configuration inside them")
+        return dataclasses.replace(self, linear=True, lin_p0=p0, lin_f0=f0, lin_df=df,
+                                   lin_hv0=hv0, lin_dhv=dhv)
 
     def evaluate(self, ctx):
         f = self.fairlead_forces(self.fairleads.positions(ctx.kin))
@@ -224,7 +275,13 @@ class CatenaryLines(Load):
             nx, nz = (int(a) for a in np.asarray(self.n[k]))
             parts.append(f"{name}: x {ln['x_lo']:.6g}..{ln['x_hi']:.6g} m ({nx}), "
                          f"z {ln['z_lo']:.6g}..{ln['z_hi']:.6g} m ({nz})")
-        return {"catenary_moorpy_version": moorpy_version(),
+        lin = {}
+        if self.linear:
+            lin = {"catenary_linearised": "fairlead forces and tensions linearised in the fairlead "
+                                          "positions about " + "; ".join(
+                f"{n}: r_F ({', '.join(f'{v:.6g}' for v in np.asarray(p))}) m"
+                for n, p in zip(self.names, self.lin_p0))}
+        return {**lin, "catenary_moorpy_version": moorpy_version(),
                 "catenary_tables": "; ".join(parts),
                 "catenary_interpolation": "tensor-product not-a-knot cubic spline of MoorPy's "
                                           "(H, V) over (span, height); NaN outside the table"}
@@ -247,7 +304,7 @@ class CatenaryLines(Load):
         from ..kinematics import kinematics
 
         q = np.asarray(q, dtype=float)
-        if not np.isfinite(q).all():
+        if self.linear or not np.isfinite(q).all():      # linearised lines have no table to leave
             return None
         margin = self.table_margin(model, q)
         x, z, _ = (np.asarray(a) for a in self.spans(self.fairleads.positions(
@@ -392,3 +449,35 @@ class CatenaryLines(Load):
                    anchors=jnp.asarray(np.stack([t["anchor"] for t in parsed])),
                    coef=jnp.asarray(padded), n=jnp.asarray(n), lo=jnp.asarray(np.array(lo)), step=jnp.asarray(np.array(step)),
                    names=tuple(t["name"] for t in parsed), lines=tuple(lines))
+
+
+def linearise_lines(model, q0=None):
+    """``model`` with each of its :class:`CatenaryLines` loads replaced by
+    :meth:`CatenaryLines.linearised` about ``q0`` (default: the static equilibrium of the model,
+    :func:`mfm.equilibrium`). Raises ValueError when the model has no catenary lines."""
+    from ..frequency import equilibrium
+
+    if not any(isinstance(ld, CatenaryLines) for ld in model.loads):
+        raise ValueError(f"model: {model.name!r} has no [[catenary_lines]] to linearise")
+    if q0 is None:
+        q0 = equilibrium(model)[0]
+    loads = tuple(ld.linearised(model, q0) if isinstance(ld, CatenaryLines) and not ld.linear else ld
+                  for ld in model.loads)
+    return dataclasses.replace(model, loads=loads)
+
+
+@eqx.filter_jit
+def _expansion(lines: CatenaryLines, p0):
+    """f₀ (P, 3), ∂f/∂r_F (P, 3, 3), (H, V)₀ (P, 2) and ∂(H, V)/∂r_F (P, 2, 3) of each line at its
+    fairlead p0 (P, 3) (compiled: the eager jacobian of the tables took ~20 s)."""
+    k = jnp.arange(p0.shape[0])
+
+    def hv(p):
+        H, V, _ = lines.tensions(p)
+        return jnp.stack([H, V], axis=1)
+
+    out = []
+    for fn in (lines.fairlead_forces, hv):
+        J = jax.jacfwd(fn)(p0)                                  # (P, c, P, 3)
+        out += [fn(p0), J[k, :, k, :]]                         # line k's own: (P, c, 3)
+    return tuple(out)

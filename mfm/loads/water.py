@@ -228,18 +228,20 @@ class Water(Load):
     def _frequency_coefficients(self, kin0, omega, heading, options, excitation=True):
         """(A(ω) − A∞, B(ω), X(ω, β) or None, H₀) of ``options["radiation"]``: (n_ω, 6K, 6K),
         (n_ω, 6K, 6K), (n_ω, 6K), (6K, n_q)."""
-        from hydro.excitation import excitation_coefficients
+        from hydro.excitation import GRID_RTOL, excitation_coefficients
         from hydro.waves import WaveComponents, wavenumber
 
         spec = self.spec
         rad = strategy(spec, options.get("radiation", "database"), frequency_domain=True,
                        state_space_options=options.get("state_space_options"))
         om_db = np.asarray(spec.database()["omega"].values)
-        if omega.min() < om_db[0] * (1 - 1e-9) or omega.max() > om_db[-1] * (1 + 1e-9):
-            raise ValueError(f"omega: [{omega.min():.4g}, {omega.max():.4g}] rad/s lies outside the "
-                             f"database's [{om_db[0]:.4g}, {om_db[-1]:.4g}] rad/s; choose frequencies "
+        om_db = om_db[np.isfinite(om_db)]
+        # a frequency within GRID_RTOL beyond an end of the grid is that end (six-decimal grids)
+        if omega.min() < om_db[0] * (1 - GRID_RTOL) or omega.max() > om_db[-1] * (1 + GRID_RTOL):
+            raise ValueError(f"omega: [{omega.min():.7g}, {omega.max():.7g}] rad/s lies outside the "
+                             f"database's [{om_db[0]:.7g}, {om_db[-1]:.7g}] rad/s; choose frequencies "
                              "inside it or regenerate the database")
-        A, B = rad.coefficients(spec, omega)
+        A, B = rad.coefficients(spec, np.clip(omega, om_db[0], om_db[-1]))
         H0 = np.asarray(self.geometry.h_matrix(kin0)[0])
         A_rel = np.asarray(A) - np.asarray(self.A_inf)[None]
         if not excitation:
