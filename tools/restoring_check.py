@@ -5,6 +5,19 @@ restoring diagonal K_kk / max|K| (the margin of :func:`mfm.simulate.free_coordin
 Prints a table; exits 1 if any line differs. Minutes per large config (loading, compiling).
 
     python tools/restoring_check.py [configs/rm3.toml ...]      (default: every configs/**/*.toml)
+
+Measured 2026-11-23 (`OMP_NUM_THREADS=1 nice -n 10 python tools/restoring_check.py`, stopped after
+9 min on the shared 2-core machine; the first six configs, same line from both everywhere):
+
+    config                              mfm info / run summary   min K_kk/max|K|
+    configs/double_pendulum.toml        none                     2.50e-01
+    configs/hallak_fowt.toml            none                     2.03e-03
+    configs/hallak_fwwp.toml            none                     1.76e-03
+    configs/hallak_hydro_coupled.toml   none                     1.50e-06
+    configs/hallak_wec.toml             none                     9.72e-03
+    configs/m4_111.toml                 float1.surge             2.24e-01
+
+RM3 (spar.surge) and the slider on a pendulum are in tests/test_new_user.py.
 """
 from __future__ import annotations
 
