@@ -60,22 +60,6 @@ def _pairs(items, what):
     return out
 
 
-def no_restoring(model, tol=1e-9):
-    """Coordinates with no static restoring: displaced alone, nothing pushes them back, i.e. the
-    diagonal entry K_kk of the static stiffness at q = 0 (gravity, buoyancy, water plane,
-    moorings, joint springs) is ≤ `tol` × the largest |K|. RM3's surge has K = 0 in its whole
-    column; it drifts freely (wave drift forces act, nothing pulls back). A negative K_kk is
-    listed too (unstable alone). Returns (names, K)."""
-    import numpy as np
-
-    import mfm
-
-    K = mfm.frequency.linearise(model, q0=np.zeros(model.n_coordinates))[2]
-    scale = max(float(np.abs(K).max()), 1e-300)
-    free = [c for k, c in enumerate(model.coordinates) if float(K[k, k]) <= tol * scale]
-    return free, K
-
-
 def cmd_info(args):
     import numpy as np
 
@@ -118,16 +102,12 @@ def cmd_info(args):
     print(f"\ntotal mass {float(model.mass.sum()):g} kg")
     if args.no_restoring:
         return
-    print("\nrestoring (static stiffness at q = 0" + (", with the water" if wet else
-          ", mechanics only: no [hydro] table" if "hydro" not in options else
-          ", mechanics only (--no-hydro)") + "):", flush=True)
-    free, _ = no_restoring(model)
-    if free:
-        print(f"  no restoring in {', '.join(free)}: nothing pulls these coordinates back, so they "
-              "drift after the start-up transient (wave drift, any mean load); add a mooring "
-              "([[moorings]]) or a joint spring if they must stay bounded")
-    else:
-        print("  every coordinate has restoring")
+    from mfm.simulate import no_restoring
+
+    print("\nrestoring at q0 = 0, where `mfm simulate` starts without --initial (" +
+          ("with the water" if wet else "mechanics only: no [hydro] table" if "hydro" not in options
+           else "mechanics only (--no-hydro)") + "):", flush=True)
+    print("  " + _restoring_text(", ".join(no_restoring(model))))
 
 
 def _sea(args):
@@ -211,15 +191,19 @@ def cmd_simulate(args):
 
 
 def _restoring_text(no_restoring: str) -> str:
-    """The run summary's line on free drift, from the dataset's ``no_restoring`` attribute (the
-    coordinates :func:`mfm.simulate` found nothing pulls back, at q0)."""
+    """The line on free drift of ``mfm info`` and of the ``mfm simulate`` summary, from the
+    coordinates :func:`mfm.simulate.no_restoring` names (comma-separated, as in a result's
+    ``no_restoring`` attribute)."""
     if no_restoring == "not checked":
         return "restoring not checked (check_stability=False)"
     if not no_restoring:
         return "every coordinate has restoring (at q0)"
-    return (f"no restoring in {no_restoring} (at q0): nothing pulls back, so its mean and last "
-            "values are a drift after the start-up transient (wave drift, any mean load), not an "
-            "offset; add a mooring ([[moorings]]) or a joint spring if it must stay bounded")
+    one = "," not in no_restoring
+    it, they = ("it", "it drifts") if one else ("them", "they drift")
+    return (f"no restoring in {no_restoring} (at q0): nothing pulls {it} back, so {they} after the "
+            f"start-up transient (wave drift, any mean load) and a run's mean and last values of "
+            f"{it} are that drift, not an offset; add a mooring ([[moorings]]) or a joint spring "
+            f"if {it} must stay bounded")
 
 
 def _peak_text(omega, a, unit):

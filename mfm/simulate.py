@@ -431,20 +431,69 @@ def _number(value, what, *, positive=False, nonnegative=False, allow_none=False)
 
 @jax.jit
 def _stiffness_jacobian(model, loads, q):
-    """∂q̈/∂q at (q, q̇ = 0, z = 0, t = 0): compiled once per model and loads structure."""
+    """(∂q̈/∂q, −∂Q/∂q) at (q, q̇ = 0, z = 0, t = 0), Q = Bᵀ F + τ the generalised loads
+    (M* q̈ = Q at rest): compiled once per model and loads structure."""
     TRACES["stiffness"] += 1
     qd0 = jnp.zeros(model.n_coordinates)
     mems = _init_memories(model, loads, 0.0, q, qd0, 1.0)
-    f = dynamics_function(model, loads, mems)
     z0 = jnp.zeros(sum(ld.n_states for ld in loads))
-    return jax.jacfwd(lambda x: f(0.0, x, qd0, z0)[0])(q)
+
+    def qdd_and_Q(x):
+        kin = kinematics(model, x, qd0)
+        body, tau, mass, _ = applied_loads(model, loads, 0.0, x, qd0, z0, kin, mems)
+        ev = evaluate(model, x, qd0, tau=tau, body_loads=body, extra_mass=mass, kin=kin)
+        return ev.qdd, jnp.einsum("nai,na->i", kin.B, ev.F) + ev.Q
+
+    J, dQ = jax.jacfwd(qdd_and_Q)(q)
+    return J, -dQ
+
+
+def _at_rest(loads) -> tuple[Load, ...]:
+    """The loads as the linearisation at rest sees them: each load's still-water part
+    (:meth:`Load.static_load`: the water without its waves and radiation memory), a load without
+    one (a user's function of t, q, q̇; a probe) as it is. The sea and the ramp of a run do not
+    change what restores a coordinate."""
+    return tuple(ld if (s := ld.static_load()) is None else s for ld in _as_loads(loads))
+
+
+def linearised_at_rest(model: Model, q, loads=()) -> tuple[np.ndarray, np.ndarray]:
+    """(J, K), each (n_q, n_q), at configuration q, q̇ = 0, t = 0 with the loads at rest
+    (:func:`_at_rest`): J = ∂q̈/∂q (q̈ ≈ J δq for a small displacement δq; its eigenvalues give
+    the stability check's periods) and the static stiffness K = −∂Q/∂q of the generalised loads
+    Q (gravity, buoyancy, water plane, moorings, joint springs; K = −M* J at an equilibrium)."""
+    J, K = _stiffness_jacobian(model, _at_rest(loads), jnp.asarray(q, jnp.float64))
+    return np.asarray(J), np.asarray(K)
+
+
+def free_coordinates(model: Model, K) -> list[str]:
+    """The coordinates nothing pulls back: K_kk ≤ 1e-9 of the largest |K| for the static
+    stiffness K (:func:`linearised_at_rest`), i.e. displaced alone, q_k feels no load back towards
+    where it was. An unmoored body's surge (RM3's spar, the M4's bow float: a column of exact
+    zeros) drifts after the start-up transient under wave drift and any mean load; K_kk < 0 (a
+    slider on a hanging arm) is unstable alone. Where K is positive semi-definite, K_kk = 0 means
+    the whole column is zero. 1e-9: far below any restoring entry of the shipped configs (the
+    smallest is ≥ 1e-5 of their largest) and far above the round-off of a zero one."""
+    K = np.asarray(K)
+    scale = max(float(np.abs(K).max()), 1e-300)
+    return [c for k, c in enumerate(model.coordinates) if float(K[k, k]) <= 1e-9 * scale]
+
+
+def no_restoring(model: Model, q0=None, *, loads=None) -> list[str]:
+    """The coordinates of ``model`` nothing pulls back at q0 (default 0, the start of
+    :func:`simulate` and ``mfm simulate`` without ``--initial``), under its own loads in still
+    water and ``loads`` (:func:`free_coordinates`): what ``mfm info`` reports, and what
+    :func:`simulate` records in its ``no_restoring`` attribute for a run from the same q0 with
+    the same extra loads, whatever its sea."""
+    lds = model_loads(model, None, dt=1.0, duration=1.0, radiation="none") + _as_loads(loads)
+    _, K = linearised_at_rest(model, _initial_vector(model, q0, "q0"), lds)
+    return free_coordinates(model, K)
 
 
 def shortest_natural_period(model: Model, q, loads=()) -> float:
     """Estimate of the shortest natural period (s) at configuration q (q̇ = 0): 2π/√λ_max with λ
-    the eigenvalues of −∂q̈/∂q (jax Jacobian of the full dynamics: its mass matrix, added mass
-    included, and every restoring load). Returns inf when nothing is restoring."""
-    return _period_from_jacobian(_stiffness_jacobian(model, _as_loads(loads), jnp.asarray(q, jnp.float64)))
+    the eigenvalues of −∂q̈/∂q (:func:`linearised_at_rest`: the mass matrix, added mass included,
+    and every restoring load). Returns inf when nothing is restoring."""
+    return _period_from_jacobian(linearised_at_rest(model, q, loads)[0])
 
 
 def _period_from_jacobian(Jq) -> float:
@@ -587,14 +636,12 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                         added_mass=added_mass, integrator=integ) + _as_loads(loads)
     q0 = _initial_vector(model, q0, "q0")
     qd0 = _initial_vector(model, qd0, "qd0")
-    no_restoring = []
+    free = []
     if check_stability:
-        # one Jacobian of the dynamics at q0 gives the shortest period and the coordinates that
-        # nothing pulls back (a column of zeros: they drift, e.g. an unmoored body's surge)
-        Jq = np.asarray(_stiffness_jacobian(model, loads, jnp.asarray(q0, jnp.float64)))
-        scale = max(float(np.abs(Jq).max()), 1e-300)
-        no_restoring = [c for k, c in enumerate(model.coordinates)
-                        if np.abs(Jq[:, k]).max() <= 1e-12 * scale]
+        # one linearisation at q0 gives the shortest period and the coordinates that nothing
+        # pulls back (those of no_restoring(model, q0, loads=<the extra loads>), `mfm info`'s)
+        Jq, K = linearised_at_rest(model, q0, loads)
+        free = free_coordinates(model, K)
     if check_stability and math.isfinite(integ.stability_limit):
         T_min = _period_from_jacobian(Jq)
         if math.isfinite(T_min) and 2 * math.pi * dt / T_min > integ.stability_limit:
@@ -618,7 +665,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     settings = dict(duration=duration, n_steps=n_steps, save_every=int(save_every), t0=t0,
                     complete="true", ramp_s=ramp, memory_s=memory,
                     sea="still water" if sea is None else repr(sea),
-                    no_restoring=", ".join(no_restoring) if check_stability else "not checked")
+                    no_restoring=", ".join(free) if check_stability else "not checked")
     finite = np.isfinite(q).all(axis=1) & np.isfinite(qd).all(axis=1)
     if not finite.all():
         k = int(np.argmax(~finite))

@@ -368,9 +368,11 @@ def test_rao_summary_never_calls_the_grid_edge_a_peak():
     assert _peak_text(om, a, "m/m").startswith("peak |RAO| ")
 
 
-def test_info_names_the_coordinates_without_restoring(tmp_path, capsys):
+def test_info_and_the_run_summary_name_the_same_free_coordinates(tmp_path, capsys):
     """A pendulum (gravity restores its angle) carrying a horizontal slider (nothing restores
-    it): `mfm info` names the slider only."""
+    it: K_ss = 0, and tilting the arm makes it slide, so K is indefinite): `mfm info` and the
+    `mfm simulate` summary print the same line, naming the slider only. (They disagreed: info
+    read K's diagonal at q = 0, the run a zero column of ∂q̈/∂q, which the arm's coupling fills.)"""
     from mfm.cli import main
 
     cfg = tmp_path / "slider.toml"
@@ -397,26 +399,33 @@ damping = 0.1
 """)
     assert main(["info", str(cfg)]) == 0
     out = capsys.readouterr().out
-    assert "no restoring in cart.stroke:" in out and "arm.angle" not in out.split("no restoring")[1]
     assert "cart.stroke [m]  (damper 0.1 N s/m)" in out and "arm.angle [rad]" in out
+    info, = [ln for ln in out.splitlines() if "restoring in" in ln]
+    assert info.startswith("  no restoring in cart.stroke (at q0): nothing pulls it back, so it drifts")
+    nc = tmp_path / "slider.nc"
+    assert main(["simulate", str(cfg), "--duration", "0.02", "--dt", "0.01", "--no-plot",
+                 "--out", str(nc)]) == 0
+    summary, = [ln for ln in capsys.readouterr().out.splitlines() if "restoring" in ln]
+    assert summary == info
 
 
 def test_rm3_spar_surge_drift_said_by_info_and_the_run_summary(tmp_path, capsys):
     """RM3 has no surge restoring (no mooring): `mfm info` and the `mfm simulate` summary name
-    spar.surge, and only it; the result file carries the same list."""
+    spar.surge, and only it, in the same line (in waves too); the result file carries the list."""
     from mfm.cli import main
 
     assert main(["info", str(CONFIGS / "rm3.toml")]) == 0
     out = capsys.readouterr().out
-    assert "with the water" in out
-    line, = [ln for ln in out.splitlines() if "no restoring in" in ln]
-    assert line.startswith("  no restoring in spar.surge: nothing pulls")
+    assert "restoring at q0 = 0, where `mfm simulate` starts without --initial (with the water)" in out
+    info, = [ln for ln in out.splitlines() if "restoring in" in ln]
+    assert info.startswith("  no restoring in spar.surge (at q0): nothing pulls it back")
     nc = tmp_path / "rm3.nc"
+    # in waves, without a ramp: the excitation at t = 0 does not count as restoring
     assert main(["simulate", str(CONFIGS / "rm3.toml"), "--duration", "2", "--dt", "0.1",
+                 "--wave", "regular", "--height", "1", "--period", "8", "--ramp", "0",
                  "--no-plot", "--out", str(nc)]) == 0
-    out = capsys.readouterr().out
-    line, = [ln for ln in out.splitlines() if "restoring" in ln]
-    assert line.startswith("  no restoring in spar.surge (at q0): nothing pulls back, so its mean")
+    summary, = [ln for ln in capsys.readouterr().out.splitlines() if "restoring" in ln]
+    assert summary == info
     with xr.open_dataset(nc) as ds:
         assert ds.attrs["no_restoring"] == "spar.surge"
 
