@@ -42,10 +42,19 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
 
 
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
+# the suite runs with --dist loadfile: one file's tests stay on one worker, so the notebooks are
+# split over two files (these run from tests/test_notebooks_second.py) to use both workers;
+# every other notebook, a new one included, runs here
+SECOND = ("hallak_fwwp", "wu_yuan")
+FIRST = [p for p in NOTEBOOKS if p.stem not in SECOND]
 
 
-@pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
+@pytest.mark.parametrize("path", FIRST, ids=[p.stem for p in FIRST])
 def test_notebook_runs_in_smoke_mode(path, monkeypatch):
+    run_in_smoke_mode(path, monkeypatch)
+
+
+def run_in_smoke_mode(path, monkeypatch):
     monkeypatch.setenv("MFM_SMOKE", "1")
     monkeypatch.setenv("MPLBACKEND", "Agg")
     # the kernel starts in notebooks/: put this checkout first, not whatever `pip install -e`
