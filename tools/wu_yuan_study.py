@@ -20,6 +20,7 @@ as identity-hashed static data).
 from __future__ import annotations
 
 import argparse
+import functools
 import sys
 import time
 import warnings
@@ -39,6 +40,12 @@ RHO, G, WIDTH, N_WEC = 1025.0, 9.81, 8.0, 12     # eq. 34: ρ, g, WEC diameter, 
 
 def seed_periods() -> np.ndarray:
     """The seed's ten periods (s, ascending): those of the databases (2π/ω, rounded to 0.1 s)."""
+    return _seed_periods().copy()
+
+
+@functools.lru_cache(maxsize=1)
+def _seed_periods() -> np.ndarray:
+    # read once per process: every study call asks for them, and the file is read whole
     from hydro.database import read_netcdf     # never a bare xr.open_dataset (hydro/database.py)
 
     w = np.asarray(read_netcdf(ROOT / "hydro" / "data" / "wu_yuan_m1.nc").omega.values)
