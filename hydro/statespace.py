@@ -39,7 +39,7 @@ import xarray as xr
 from scipy.linalg import solve_triangular
 from scipy.optimize import nnls
 
-from .radiation import filon_weights, impulse_response, memory_length
+from .radiation import filon_weights, impulse_response, impulse_response_transform, memory_length
 
 
 # ------------------------------------------------------------------------------- SISO fitting
@@ -649,9 +649,12 @@ def fit_state_space(db: xr.Dataset, *, order="auto", method: str = "vf",
         db_t["radiation_damping"] = (dims, Bfix)
     # causal target from K(t)
     t = np.arange(0.0, irf_tmax + irf_dt / 2, irf_dt)
-    K = impulse_response(db_t, t, tail=tail).values
     om_fit = np.concatenate([om, om[-1] * np.geomspace(1.0, 3.0, 21)[1:]])
-    ZK = sym(np.tensordot(filon_weights(t, -om_fit), K, axes=(1, 0)))      # ∫K e^{−iωt} dt
+    if method == "era":
+        K = impulse_response(db_t, t, tail=tail).values
+        ZK = sym(np.tensordot(filon_weights(t, -om_fit), K, axes=(1, 0)))  # ∫K e^{−iωt} dt
+    else:
+        ZK = sym(impulse_response_transform(db_t, t, om_fit, tail=tail))  # the same, K not formed
     A_K = Ainf[None] + ZK[:len(om)].imag / om[:, None, None]
     dA = np.mean(sym(A)[band] - sym(A_K)[band], axis=0) if fit_added_mass_inf else np.zeros((nd, nd))
     Ainf_fit = sym(Ainf) + dA
