@@ -146,12 +146,11 @@ def _sigma_zeros(poles, d, c):
     return _flip(new)
 
 
-def _vf(s, f, w, order, w_lo, w_hi, n_iter=10, poles=None):
+def _vf(s, f, w, order, w_lo, w_hi, n_iter=10):
     """Vector fitting of f(s) ≈ Σ r/(s−p); returns poles (Im ≥ 0 representatives), coefficients.
     f (n_s,): one function; f (n_s, n_f): n_f functions with one common pole set (coefficients
-    (n_coef, n_f)), by relaxed fast VF (:func:`_sigma_relaxed`). ``poles``: starting poles
-    (default: ``order`` damped poles spread over (w_lo, w_hi))."""
-    poles = _initial_poles(order, w_lo, w_hi) if poles is None else list(poles)
+    (n_coef, n_f)), by relaxed fast VF (:func:`_sigma_relaxed`)."""
+    poles = _initial_poles(order, w_lo, w_hi)
     extra = np.zeros((len(s), 0))
     ne = 0
     for _ in range(n_iter):
