@@ -748,8 +748,9 @@ def fit_state_space(db: xr.Dataset, *, order="auto", method: str = "vf",
     Zf = fitted_impedance(ss, om)
     blk = np.ix_(np.flatnonzero(band), np.flatnonzero(dof_ok), np.flatnonzero(dof_ok))
     overall = float(np.linalg.norm((Zf - Z)[blk]) / np.linalg.norm(Z[blk]))
-    errs = {(labels[i], labels[j]): float(np.linalg.norm((Zf - Z)[band, i, j])
-                                          / np.linalg.norm(Z[band, i, j])) for (i, j) in entries}
+    e_num = np.linalg.norm((Zf - Z)[band], axis=0)
+    e_den = np.linalg.norm(Z[band], axis=0)
+    errs = {(labels[i], labels[j]): float(e_num[i, j] / e_den[i, j]) for (i, j) in entries}
     dA_rel = np.abs(dA) / np.sqrt(np.abs(np.outer(np.diag(Ainf_fit), np.diag(Ainf_fit))) + 1e-300)
     k_dA = np.unravel_index(np.argmax(dA_rel), dA_rel.shape)
     max_re = float(np.max(np.linalg.eigvals(Am).real)) if Am.size else -np.inf
