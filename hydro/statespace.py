@@ -89,8 +89,9 @@ def _sigma_relaxed(Phi, F, w):
     Fast VF (Gustavsen's QR elimination, one orthonormal basis U of the shared residue columns
     Φ for all functions): each function's rows [−f_k X] (X = [1 | Φ]) are projected onto the
     complement of Φ, which eliminates its residues r_k; the projected rows of all functions are
-    reduced to one (n + 1)² triangle by QR and solved with the relaxation row. Cost O(n_f n_s n²)
-    in BLAS products.
+    reduced to one (n + 1)² triangle (Cholesky of their Gram matrix, Householder QR when that is
+    ill-conditioned: diagonal ratio < 1e-6) and solved with the relaxation row. Cost
+    O(n_f n_s n²) in BLAS products.
     """
     n_s, n = Phi.shape
     Pw = Phi * w[:, None]
@@ -107,7 +108,16 @@ def _sigma_relaxed(Phi, F, w):
     Gs = G.reshape(-1, n + 1)
     cs = np.linalg.norm(Gs, axis=0)
     cs[cs == 0] = 1.0
-    Rg = np.linalg.qr(Gs / cs, mode="r")                                 # (n + 1, n + 1)
+    Gs = Gs / cs
+    try:
+        # the triangle from the Gram matrix (one BLAS product: half the time of Householder QR of
+        # the n_f·2n_s rows); exact in exact arithmetic, so used only while well conditioned
+        Rg = np.linalg.cholesky(Gs.T @ Gs).T
+        dg = np.abs(np.diag(Rg))
+        if not dg.min() > 1e-6 * dg.max():
+            raise np.linalg.LinAlgError
+    except np.linalg.LinAlgError:
+        Rg = np.linalg.qr(Gs, mode="r")                                  # (n + 1, n + 1)
     # relaxation row, weighted like an average data row (Gustavsen 2006 eq. 8)
     row = np.concatenate([[np.sum(w)], (Phi * w[:, None]).real.sum(axis=0)]) / cs
     scale = np.linalg.norm(Rg) / np.sqrt(Gs.shape[0])
