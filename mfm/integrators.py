@@ -7,7 +7,8 @@ integrator is an immutable, hashable object with
     init(f, t0, q0, qd0, z0) -> State
     step(f, state, dt)       -> State
 
-so it can be a static argument of a jit-compiled simulation. ``stage_offsets`` declares when within a
+so it can be a static argument of a jit-compiled simulation. ``evaluations``: the evaluations of
+f per step (what a load's cost per step is multiplied by). ``stage_offsets`` declares when within a
 step ``f`` is evaluated (fractions of dt from the step's start): loads with memory or tabulated
 inputs (the radiation convolution, the excitation) prepare exactly those stages instead of
 assuming them. ``State.qdd`` holds the acceleration at
@@ -67,6 +68,7 @@ class RK4:
     """Classical 4th-order Runge–Kutta on (q, q̇, z). Global error O(dt⁴)."""
     name: str = "rk4"
     order: int = 4
+    evaluations: int = 4
     stability_limit: float = 2.0 * math.sqrt(2.0)
     stage_offsets: tuple = (0.0, 0.5, 1.0)
 
@@ -99,6 +101,7 @@ class SemiImplicitEuler:
     """
     name: str = "semi_implicit"
     order: int = 1
+    evaluations: int = 1
     stability_limit: float = 2.0
     stage_offsets: tuple = (0.0, 1.0)
 
@@ -131,6 +134,7 @@ class Verlet:
     """
     name: str = "verlet"
     order: int = 2
+    evaluations: int = 1
     stability_limit: float = 2.0
     stage_offsets: tuple = (0.0, 1.0)
 
@@ -169,6 +173,7 @@ class Beeman:
     max_iter: int = 50
     name: str = "beeman"
     order: int = 2
+    evaluations: int = 3          # typical: the predictor and two corrector iterations
     stability_limit: float = 2.0
     stage_offsets: tuple = (0.0, 1.0)
 
@@ -216,6 +221,7 @@ class Newmark:
     iterations: int = 4
     name: str = "newmark"
     order: int = 2
+    evaluations: int = 6          # the Jacobian (forward mode), four iterations, the final one
     stability_limit: float = math.inf
     stage_offsets: tuple = (0.0, 1.0)
 

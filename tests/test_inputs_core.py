@@ -95,6 +95,7 @@ def test_results_carry_their_provenance(rm3):
     assert ds.attrs["config"].endswith("rm3.toml")
     assert "Regular" in ds.attrs["sea"] and ds.attrs["ramp_s"] == 1.0
     assert ds.attrs["radiation"] == "state_space" and ds.attrs["state_space_states"] > 0
+    assert ds.attrs["radiation_choice"] == "given"
     assert len(ds.attrs["database_sha256"]) == 64
     for key in ("mfm_version", "jax_version", "git_commit", "integrator", "dt", "created"):
         assert key in ds.attrs
