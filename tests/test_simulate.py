@@ -79,3 +79,27 @@ def test_auto_radiation_takes_the_cheaper_and_says_why():
     assert choose_radiation(m4, dt=0.006, n_steps=n_rk4 + 1, integrator="verlet")[0] == "convolution"
     assert choose_radiation(MODEL, dt=0.01, n_steps=10**9) == ("none", "no water")
 
+
+
+def test_outputs_computed_after_the_loop_equal_those_inside_it(monkeypatch):
+    # a recorded run with a small memory evaluates its outputs after the time loop, vmapped over
+    # the saved samples; forcing them back into the loop must give the same numbers (to round-off:
+    # the vectorised products may sum in another order)
+    import importlib
+
+    import jax
+
+    S = importlib.import_module("mfm.simulate")   # the module (mfm.simulate is also the function)
+    m = mfm.load(CONFIGS / "double_pendulum.toml")
+    kw = dict(duration=1.37, dt=0.01, q0={"upper.angle": 0.8}, save_every=1)
+    after = mfm.simulate(m, **kw)
+    monkeypatch.setattr(S, "DEFERRED_RECORD_MEMORY", -1)
+    jax.clear_caches()                     # the setting is read when the rollout is traced
+    before = S.TRACES["rollout"]
+    inside = mfm.simulate(m, **kw)
+    assert S.TRACES["rollout"] == before + 1
+    assert after.sizes["time"] == 138
+    for v in after.data_vars:
+        if np.issubdtype(after[v].dtype, np.number):
+            np.testing.assert_allclose(after[v].values, inside[v].values, rtol=1e-12, atol=1e-12,
+                                       err_msg=v)
