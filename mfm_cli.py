@@ -88,7 +88,7 @@ def build_parser():
     p.add_argument("config")
     p.add_argument("--duration", type=POSITIVE, default=10.0, help="s (default 10)")
     p.add_argument("--dt", type=POSITIVE, default=0.01, help="time step, s (default 0.01)")
-    p.add_argument("--integrator", default="rk4", choices=["rk4", "beeman", "semi_implicit", "newmark"])
+    p.add_argument("--integrator", default="rk4", choices=["rk4", "beeman", "semi_implicit", "newmark", "verlet"])
     p.add_argument("--initial", action="append", metavar="NAME=VALUE",
                    help="initial coordinate (m or rad), repeatable, e.g. --initial upper.angle=0.3")
     p.add_argument("--initial-velocity", action="append", metavar="NAME=VALUE",
@@ -105,7 +105,7 @@ def build_parser():
     p.add_argument("--components", type=_count(1), help="number of wave components")
     p.add_argument("--heading", type=FINITE, default=0.0, help="wave heading, degrees (0 = towards +x)")
     p.add_argument("--ramp", type=NONNEGATIVE, default=0.0, help="start-up ramp of the excitation, s")
-    p.add_argument("--radiation", default="convolution", choices=["convolution", "state_space", "none"])
+    p.add_argument("--radiation", default="auto", choices=["auto", "convolution", "state_space", "state_space_exact", "none"])
     p.add_argument("--no-body-coupling", action="store_true",
                    help="drop the hydrodynamic interaction between bodies")
     p.add_argument("--out", default="out/simulation.nc", help="NetCDF output (default out/simulation.nc)")

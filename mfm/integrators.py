@@ -7,7 +7,8 @@ integrator is an immutable, hashable object with
     init(f, t0, q0, qd0, z0) -> State
     step(f, state, dt)       -> State
 
-so it can be a static argument of a jit-compiled simulation. ``stage_offsets`` declares when within a
+so it can be a static argument of a jit-compiled simulation. ``evaluations``: the evaluations of
+f per step (what a load's cost per step is multiplied by). ``stage_offsets`` declares when within a
 step ``f`` is evaluated (fractions of dt from the step's start): loads with memory or tabulated
 inputs (the radiation convolution, the excitation) prepare exactly those stages instead of
 assuming them. ``State.qdd`` holds the acceleration at
@@ -15,8 +16,8 @@ assuming them. ``State.qdd`` holds the acceleration at
 step (implicit and predictor–corrector schemes; 0 otherwise).
 
 Stability on an undamped oscillator of natural frequency ω (``stability_limit`` = max ω dt):
-RK4 2√2, Beeman (seed 001 eq. 52 with its corrector) 2, semi-implicit Euler 2, Newmark average
-acceleration ∞ (unconditionally stable).
+RK4 2√2, Beeman (seed 001 eq. 52 with its corrector) 2, semi-implicit Euler 2, Verlet (Beeman's
+step without the corrector) 2, Newmark average acceleration ∞ (unconditionally stable).
 """
 from __future__ import annotations
 
@@ -46,12 +47,12 @@ def phase_error(integrator, omega_dt: float) -> float:
     """Relative error of the period an integrator gives an undamped oscillator of ω at step dt
     (leading term of its modified frequency; Hairer, Lubich & Wanner, Geometric Numerical
     Integration, 2006, §IX): RK4 (ω dt)⁴/120, trapezoidal schemes (Newmark average acceleration,
-    Beeman with its corrector) (ω dt)²/12, semi-implicit Euler (ω dt)²/24."""
+    Beeman with its corrector) (ω dt)²/12, semi-implicit Euler and Verlet (ω dt)²/24."""
     x = float(omega_dt)
     order = getattr(integrator, "order", 2)
     if order >= 4:
         return x**4 / 120.0
-    if getattr(integrator, "name", "") == "semi_implicit":
+    if getattr(integrator, "name", "") in ("semi_implicit", "verlet"):
         return x**2 / 24.0
     return x**2 / 12.0
 
@@ -67,6 +68,7 @@ class RK4:
     """Classical 4th-order Runge–Kutta on (q, q̇, z). Global error O(dt⁴)."""
     name: str = "rk4"
     order: int = 4
+    evaluations: int = 4
     stability_limit: float = 2.0 * math.sqrt(2.0)
     stage_offsets: tuple = (0.0, 0.5, 1.0)
 
@@ -99,6 +101,7 @@ class SemiImplicitEuler:
     """
     name: str = "semi_implicit"
     order: int = 1
+    evaluations: int = 1
     stability_limit: float = 2.0
     stage_offsets: tuple = (0.0, 1.0)
 
@@ -111,6 +114,39 @@ class SemiImplicitEuler:
         z = s.z + dt * s.zd
         t = s.t + dt
         a, zd = f(t, q, qd, z)
+        return State(t=t, q=q, qd=qd, qdd=a, z=z, zd=zd, iterations=jnp.asarray(0))
+
+
+@dataclasses.dataclass(frozen=True)
+class Verlet:
+    """Velocity Verlet with a predicted velocity: one evaluation of f per step, second order.
+
+        qₙ₊₁ = qₙ + dt q̇ₙ + dt²/2 q̈ₙ,   q̇* = q̇ₙ + dt q̈ₙ,   z* = zₙ + dt żₙ      (predictor)
+        q̈ₙ₊₁, ż* = f(tₙ₊₁, qₙ₊₁, q̇*, z*)
+        q̇ₙ₊₁ = q̇ₙ + dt/2 (q̈ₙ + q̈ₙ₊₁),   zₙ₊₁ = zₙ + dt/2 (żₙ + ż*)
+
+    Beeman's step (seed 001 eq. 52) with no corrector iteration. q̈ₙ₊₁ is taken at the predicted
+    velocity q̇*, which is O(dt²) off q̇ₙ₊₁: with velocity-dependent loads (damping, drag, PTOs) that
+    enters q̇ at O(dt³) per step, so the scheme stays second order. On an undamped oscillator it is
+    Störmer–Verlet: period error (ω dt)²/24, half the trapezoid's. Stable for ω dt < 2 (undamped). z advances by Heun's rule (explicit trapezoid),
+    weakly unstable for undamped oscillatory states: use it with radiation='state_space_exact',
+    whose states are advanced exactly outside the integrator. Reverse-mode differentiable.
+    """
+    name: str = "verlet"
+    order: int = 2
+    evaluations: int = 1
+    stability_limit: float = 2.0
+    stage_offsets: tuple = (0.0, 1.0)
+
+    def init(self, f, t0, q0, qd0, z0):
+        return _init(f, t0, q0, qd0, z0)
+
+    def step(self, f, s: State, dt):
+        t = s.t + dt
+        q = s.q + dt * (s.qd + 0.5 * dt * s.qdd)
+        a, zd = f(t, q, s.qd + dt * s.qdd, s.z + dt * s.zd)
+        qd = s.qd + 0.5 * dt * (s.qdd + a)
+        z = s.z + 0.5 * dt * (s.zd + zd)
         return State(t=t, q=q, qd=qd, qdd=a, z=z, zd=zd, iterations=jnp.asarray(0))
 
 
@@ -137,6 +173,7 @@ class Beeman:
     max_iter: int = 50
     name: str = "beeman"
     order: int = 2
+    evaluations: int = 3          # typical: the predictor and two corrector iterations
     stability_limit: float = 2.0
     stage_offsets: tuple = (0.0, 1.0)
 
@@ -184,6 +221,7 @@ class Newmark:
     iterations: int = 4
     name: str = "newmark"
     order: int = 2
+    evaluations: int = 6          # the Jacobian (forward mode), four iterations, the final one
     stability_limit: float = math.inf
     stage_offsets: tuple = (0.0, 1.0)
 
@@ -220,11 +258,12 @@ class Newmark:
 
 
 INTEGRATORS = {"rk4": RK4, "beeman": Beeman, "semi_implicit": SemiImplicitEuler,
-               "newmark": Newmark}
+               "newmark": Newmark, "verlet": Verlet}
 
 
-def get(integrator) -> RK4 | Beeman | SemiImplicitEuler | Newmark:
-    """An integrator instance from a name (``rk4``, ``beeman``, ``semi_implicit``, ``newmark``) or
+def get(integrator) -> RK4 | Beeman | SemiImplicitEuler | Newmark | Verlet:
+    """An integrator instance from a name (``rk4``, ``beeman``, ``semi_implicit``, ``newmark``,
+    ``verlet``) or
     an instance (returned as is)."""
     if isinstance(integrator, str):
         try:

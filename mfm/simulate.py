@@ -66,6 +66,38 @@ def model_loads(model: Model, sea=None, *, dt, duration, t0=0.0, ramp=0.0,
     return tuple(out) + tuple(model.loads)
 
 
+# convolution work per run above which radiation="auto" takes the state space: ≈ 10 s of
+# multiply–adds at the ~2e9/s one core does on these small matrix–vector products, about what a
+# state-space fit costs (M4 134 …), so the choice is the cheaper of the two
+AUTO_CONVOLUTION_LIMIT = 2e10
+
+
+def choose_radiation(model: Model, *, dt, n_steps, integrator="rk4", memory=None):
+    """The radiation strategy ``radiation="auto"`` takes, and why: ``(name, reason)``.
+
+    The convolution costs n_steps × (evaluations per step) × n_lags × n² multiply–adds (n the
+    moved hydro dofs, n_lags = T_K/dt with T_K the memory from the decay of K, or ``memory``); the
+    state space a fit once (seconds to a minute) and then O(n · poles) per evaluation. Above
+    :data:`AUTO_CONVOLUTION_LIMIT` multiply–adds the state space is taken, its states advanced
+    exactly (``"state_space_exact"``, stable with every integrator); below it the convolution, the
+    direct evaluation of the Cummins integral with no fit. The reason is recorded in the result
+    (``radiation_choice``)."""
+    if model.hydro is None:
+        return "none", "no water"
+    integ = _integrators.get(integrator)
+    spec = model.hydro
+    T_K = spec.memory() if memory is None else float(memory)
+    n = len(spec.moving)
+    lags = int(math.ceil(T_K / dt))
+    macs = float(n_steps) * getattr(integ, "evaluations", 2) * lags * n * n
+    what = (f"convolution {n_steps} steps × {getattr(integ, 'evaluations', 2)} evaluations × "
+            f"{lags} lags (T_K {T_K:.3g} s / dt {dt:.3g} s) × {n}² moved dofs = {macs:.2g} "
+            f"multiply–adds")
+    if macs > AUTO_CONVOLUTION_LIMIT:
+        return "state_space_exact", f"auto: {what} > {AUTO_CONVOLUTION_LIMIT:.0e}: state space"
+    return "convolution", f"auto: {what} ≤ {AUTO_CONVOLUTION_LIMIT:.0e}: convolution"
+
+
 def _stage_offsets(integrator):
     integ = _integrators.get(integrator)
     offs = getattr(integ, "stage_offsets", None)
@@ -206,20 +238,43 @@ def _rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, record):
     return (state, mem0), _saved(model, loads, state, mem0, record)
 
 
+# per-sample memory (floats) up to which the outputs of a recorded run are computed after the
+# time loop, vmapped over the saved samples (matrix–matrix work) instead of inside it
+DEFERRED_RECORD_MEMORY = 10_000
+DEFERRED_RECORD_WIDTH = 32
+
+
 def _rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, record):
     """``n_blocks`` blocks of ``save_every`` steps from ``carry``: (carry, the saved outputs of
-    each block's last step, stacked)."""
+    each block's last step, stacked). With ``record is True`` and a small memory (the state
+    space's, not the convolution's history) the loop keeps only the state and memory of each
+    saved step and the outputs are evaluated afterwards in one vmapped pass: the serial loop
+    carries the integration alone (RM3: recording every step cost 5× the integration inside it)."""
 
     def one_step(carry, _):
         s, mem = carry
         s = integrator.step(dynamics_function(model, loads, mem), s, dt)
         return (s, _update_memories(model, loads, s, mem)), None
 
+    mem_size = sum(int(np.prod(np.shape(a))) for a in jax.tree_util.tree_leaves(carry[1]))
+    deferred = record is True and mem_size <= DEFERRED_RECORD_MEMORY
+
     def block(carry, _):
         carry, _ = jax.lax.scan(one_step, carry, None, length=save_every)
-        return carry, _saved(model, loads, *carry, record)
+        return carry, (carry if deferred else _saved(model, loads, *carry, record))
 
-    return jax.lax.scan(block, carry, None, length=n_blocks)
+    carry, saved = jax.lax.scan(block, carry, None, length=n_blocks)
+    if deferred:
+        # groups of a fixed width, the last one padded: every sample is computed by the same
+        # vmapped program whatever n_blocks, so a run in chunks (progress bar) gives the same bits
+        W = DEFERRED_RECORD_WIDTH
+        G = -(-n_blocks // W)
+        pad = lambda a: jnp.concatenate([a, jnp.repeat(a[-1:], G * W - n_blocks, 0)]).reshape(  # noqa: E731
+            (G, W) + a.shape[1:])
+        groups = jax.tree_util.tree_map(pad, saved)
+        out = jax.lax.map(jax.vmap(lambda sm: _saved(model, loads, *sm, record)), groups)
+        saved = jax.tree_util.tree_map(lambda a: a.reshape((G * W,) + a.shape[2:])[:n_blocks], out)
+    return carry, saved
 
 
 def _rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_every, record):
@@ -562,7 +617,7 @@ def stable_dt(T_min: float, integ) -> float:
 
 def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="rk4",
              q0=None, qd0=None, loads=None, save_every: int = 1, t0: float = 0.0,
-             ramp: float = 0.0, radiation: str = "convolution", memory: float | None = None,
+             ramp: float = 0.0, radiation: str = "auto", memory: float | None = None,
              state_space_options: dict | None = None, check_stability: bool = True,
              added_mass: str = "lhs", progress: bool | dict = False) -> xr.Dataset:
     """Simulate a model in the time domain.
@@ -574,15 +629,20 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
         or no water at all for a mechanics-only model).
     duration, dt: s. The run has ``round(duration / dt)`` steps.
     integrator: ``"rk4"`` (default), ``"beeman"`` (seed 001 eq. 52), ``"semi_implicit"``,
-        ``"newmark"``, or an instance from :mod:`mfm.integrators`.
+        ``"newmark"``, ``"verlet"`` (one evaluation per step, second order: the fast one, with
+        ``radiation="state_space_exact"``), or an instance from :mod:`mfm.integrators`.
     q0, qd0: initial coordinates and rates, arrays (n_q,) or dicts by coordinate name (others 0).
     loads: an :class:`mfm.loads.Load` or a sequence of them (external loads), added to the
         model's own (its water and its config's loads).
     save_every: keep every k-th step in the output.
     ramp: s, the start-up ramp of the excitation (½(1 − cos πt/ramp)).
-    radiation: ``"convolution"`` (direct, window T_K from the decay of K; ``memory`` overrides it,
+    radiation: ``"auto"`` (default: the cheaper of the next two for this run,
+        :func:`choose_radiation`; the choice and why are in the attribute ``radiation_choice``),
+        ``"convolution"`` (direct, window T_K from the decay of K; ``memory`` overrides it,
         s), ``"state_space"`` (the passive fit of :mod:`hydro.statespace`, options in
-        ``state_space_options``) or ``"none"`` (A∞ only).
+        ``state_space_options``, its states integrated by the integrator),
+        ``"state_space_exact"`` (the same fit, its states advanced exactly over each step: stable
+        at any dt, what ``integrator="verlet"`` needs) or ``"none"`` (A∞ only).
     added_mass: ``"lhs"`` (A∞ in M*, the default) or ``"rhs"``: the scheme of seed 001 §5, A∞ ξ̈
         on the right-hand side with the acceleration iterated in Beeman's corrector (needs
         ``integrator="beeman"``; converges only where A∞ is smaller than the structural mass; the
@@ -631,6 +691,12 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
         raise ValueError(f"added_mass='rhs' (the seed 001 scheme) iterates the acceleration in "
                          f"Beeman's corrector; integrator={integ.name!r} has none: use "
                          "integrator='beeman' or added_mass='lhs'")
+    choice = "given"
+    if radiation == "auto":
+        radiation, choice = choose_radiation(model, dt=dt, n_steps=n_steps, integrator=integ,
+                                             memory=memory)
+        if model.hydro is None:
+            radiation = "convolution"          # no water: nothing to choose
     loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp, radiation=radiation,
                         memory=memory, state_space_options=state_space_options,
                         added_mass=added_mass, integrator=integ) + _as_loads(loads)
@@ -664,7 +730,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     rec = {k: np.asarray(v) for k, v in out[6].items()}
     settings = dict(duration=duration, n_steps=n_steps, save_every=int(save_every), t0=t0,
                     complete="true", ramp_s=ramp, memory_s=memory,
-                    sea="still water" if sea is None else repr(sea),
+                    sea="still water" if sea is None else repr(sea), radiation_choice=choice,
                     no_restoring=", ".join(free) if check_stability else "not checked")
     finite = np.isfinite(q).all(axis=1) & np.isfinite(qd).all(axis=1)
     if not finite.all():

@@ -36,7 +36,7 @@ SEA = hydro.Regular(height=1.0, period=8.0)
     ({"ramp": -1.0}, r"ramp: -1\.0 must be ≥ 0"),
     ({"q0": [np.nan, 0, 0, 0]}, r"q0: not finite for \['spar\.surge'\]"),
     ({"q0": {"spar.heave": "up"}}, r"q0\['spar\.heave'\]: 'up' is not a number"),
-    ({"radiation": "ss"}, r"radiation='ss'; accepted: 'convolution', 'state_space', 'none'"),
+    ({"radiation": "ss"}, r"radiation='ss'; accepted: 'convolution', 'state_space', 'state_space_exact', 'none'"),
     ({"radiation": "state_space", "state_space_options": {"orders": 4}},
      r"unknown option\(s\) \['orders'\]; accepted: \[.*'order'"),
     ({"save_every": 0}, r"save_every: 0 must be a positive divisor"),
@@ -95,6 +95,7 @@ def test_results_carry_their_provenance(rm3):
     assert ds.attrs["config"].endswith("rm3.toml")
     assert "Regular" in ds.attrs["sea"] and ds.attrs["ramp_s"] == 1.0
     assert ds.attrs["radiation"] == "state_space" and ds.attrs["state_space_states"] > 0
+    assert ds.attrs["radiation_choice"] == "given"
     assert len(ds.attrs["database_sha256"]) == 64
     for key in ("mfm_version", "jax_version", "git_commit", "integrator", "dt", "created"):
         assert key in ds.attrs

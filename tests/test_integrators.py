@@ -43,7 +43,8 @@ def exact(t, x0, v0, y0=None):
 
 
 SCHEMES = {"rk4": (mfm.integrators.RK4(), 4), "beeman": (mfm.integrators.Beeman(tol=1e-13), 2),
-           "newmark": (mfm.integrators.Newmark(), 2), "semi_implicit": (mfm.integrators.SemiImplicitEuler(), 1)}
+           "newmark": (mfm.integrators.Newmark(), 2), "semi_implicit": (mfm.integrators.SemiImplicitEuler(), 1),
+           "verlet": (mfm.integrators.Verlet(), 2)}
 
 
 def measured_order(integ, with_state):

@@ -59,3 +59,47 @@ def test_blow_up_stops_with_time_and_cause():
     assert "shortest natural period 0.0628" in msg and "Reduce dt" in msg
     # the same model at a stable dt runs
     mfm.simulate(model, duration=1.0, dt=0.005, q0=[0.1])
+
+
+def test_auto_radiation_takes_the_cheaper_and_says_why():
+    # the convolution's work n_steps × evaluations × (T_K/dt) lags × n² against the limit: M4 134
+    # (24 moved dofs, T_K ≈ 39 s) over 100 T_p at T_p/200 with RK4 is 3e11 multiply–adds
+    # (minutes): the state space; 200 steps of it (3e9) and RM3's 2000 steps (6e7): the convolution.
+    # Verlet does one evaluation per step: a quarter of RK4's work.
+    from mfm.simulate import AUTO_CONVOLUTION_LIMIT, choose_radiation
+
+    m4 = mfm.load(CONFIGS / "m4_134.toml")
+    name, why = choose_radiation(m4, dt=0.006, n_steps=20_000)
+    assert name == "state_space_exact" and "24² moved dofs" in why and "> 2e+10" in why
+    lags = int(why.split(" lags")[0].split()[-1])
+    assert abs(lags - m4.hydro.memory() / 0.006) <= 1
+    assert choose_radiation(m4, dt=0.006, n_steps=200)[0] == "convolution"
+    n_rk4 = int(AUTO_CONVOLUTION_LIMIT / (4 * lags * 24**2))
+    assert choose_radiation(m4, dt=0.006, n_steps=n_rk4 + 1)[0] == "state_space_exact"
+    assert choose_radiation(m4, dt=0.006, n_steps=n_rk4 + 1, integrator="verlet")[0] == "convolution"
+    assert choose_radiation(MODEL, dt=0.01, n_steps=10**9) == ("none", "no water")
+
+
+
+def test_outputs_computed_after_the_loop_equal_those_inside_it(monkeypatch):
+    # a recorded run with a small memory evaluates its outputs after the time loop, vmapped over
+    # the saved samples; forcing them back into the loop must give the same numbers (to round-off:
+    # the vectorised products may sum in another order)
+    import importlib
+
+    import jax
+
+    S = importlib.import_module("mfm.simulate")   # the module (mfm.simulate is also the function)
+    m = mfm.load(CONFIGS / "double_pendulum.toml")
+    kw = dict(duration=1.37, dt=0.01, q0={"upper.angle": 0.8}, save_every=1)
+    after = mfm.simulate(m, **kw)
+    monkeypatch.setattr(S, "DEFERRED_RECORD_MEMORY", -1)
+    jax.clear_caches()                     # the setting is read when the rollout is traced
+    before = S.TRACES["rollout"]
+    inside = mfm.simulate(m, **kw)
+    assert S.TRACES["rollout"] == before + 1
+    assert after.sizes["time"] == 138
+    for v in after.data_vars:
+        if np.issubdtype(after[v].dtype, np.number):
+            np.testing.assert_allclose(after[v].values, inside[v].values, rtol=1e-12, atol=1e-12,
+                                       err_msg=v)

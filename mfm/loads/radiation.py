@@ -8,6 +8,8 @@ A(ω), B(ω) it amounts to, so the frequency domain uses the time domain's radia
   its A(ω), B(ω) by Ogilvie from the same K: A∞ − ∫K sin ωτ dτ/ω and ∫K cos ωτ dτ.
 - :class:`StateSpace`: the passive fit (:mod:`hydro.statespace`) in modal form, ż = p z + ξ̇_j,
   F_i = −Σ Re(C_ik z_k); its A(ω) = A∞ + Im K̂(iω)/ω, B(ω) = Re K̂(iω).
+- :class:`ExactStateSpace`: the same fit, its states advanced exactly over each step for a
+  velocity linear within the step (memory of the load, not states of the integrator).
 - :class:`NoRadiation`: A∞ only (A(ω) = A∞, B = 0).
 - :class:`DatabaseRadiation`: the BEM A(ω), B(ω) as given: frequency domain only (a database
   whose A and B are not Kramers–Kronig consistent has no exact time-domain counterpart).
@@ -24,7 +26,7 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
-STRATEGIES = ("convolution", "state_space", "none")
+STRATEGIES = ("convolution", "state_space", "state_space_exact", "none")
 
 
 class NoRadiation(eqx.Module):
@@ -190,14 +192,97 @@ class StateSpace(NoRadiation):
                    options=tuple(sorted(options.items())), report=report)
 
 
+def _phi(x):
+    """φ₁(x) = (eˣ − 1)/x and φ₂(x) = (eˣ − 1 − x)/x² (complex x), by their series where |x| is
+    small and the closed forms cancel."""
+    x = np.asarray(x, complex)
+    small = np.abs(x) < 1e-3
+    xs = np.where(small, 1.0, x)
+    e = np.exp(xs)
+    phi1 = np.where(small, 1 + x / 2 + x**2 / 6 + x**3 / 24, (e - 1) / xs)
+    phi2 = np.where(small, 0.5 + x / 6 + x**2 / 24 + x**3 / 120, (e - 1 - xs) / xs**2)
+    return np.exp(x), phi1, phi2
+
+
+class ExactStateSpace(StateSpace):
+    """The state space of :class:`StateSpace` with its states advanced exactly over each step,
+    outside the integrator, for an input ξ̇ linear in time within the step (first-order hold,
+    the history the convolution assumes too). For ż = p z + u, u(s) = uₙ + (u_c − uₙ) s/h:
+
+        z(tₙ + h) = e^{ph} zₙ + h φ₁(ph) uₙ + h φ₂(ph) (u_c − uₙ),   h = c dt,
+
+    φ₁(x) = (eˣ − 1)/x, φ₂(x) = (eˣ − 1 − x)/x². A stage at offset c of the integrator reads z at
+    its own velocity u_c; the step's end (c = 1, the accepted velocity) becomes the next zₙ. The
+    states are the load's memory, not the integrator's: stable at any dt (|e^{ph}| < 1 for every
+    stable pole), so a one-evaluation integrator (``verlet``) can carry lightly damped radiation
+    modes; the radiation's own error is that of the hold, O(dt²) (as the convolution's).
+    ``E``, ``G``, ``H`` (S + 1, n_x, 2): e^{ph}, hφ₁, hφ₂ as (re, im) for each stage offset and
+    the full step (last row). Memory: (tₙ, Re zₙ, Im zₙ, uₙ)."""
+    E: jnp.ndarray = None
+    G: jnp.ndarray = None
+    H: jnp.ndarray = None
+    dt: jnp.ndarray = None
+    stage_offsets: tuple[float, ...] = eqx.field(static=True, default=(0.0,))
+    name: ClassVar[str] = "state_space_exact"
+
+    @property
+    def n_states(self):
+        return 0
+
+    def init_memory(self, v, t0):
+        n = len(self.inputs)
+        return (jnp.asarray(t0, jnp.float64), jnp.zeros(n), jnp.zeros(n), v[np.asarray(self.inputs)])
+
+    def _advance(self, r, memory, u):
+        _, zr, zi, u_n = memory
+        E, G, H = self.E[r], self.G[r], self.H[r]
+        du = u - u_n
+        return (E[:, 0] * zr - E[:, 1] * zi + G[:, 0] * u_n + H[:, 0] * du,
+                E[:, 0] * zi + E[:, 1] * zr + G[:, 1] * u_n + H[:, 1] * du)
+
+    def update_memory(self, v, t, memory):
+        u = v[np.asarray(self.inputs)]
+        zr, zi = self._advance(-1, memory, u)
+        return (t, zr, zi, u)
+
+    def force(self, t, v, z, memory):
+        offs = jnp.asarray(self.stage_offsets)
+        r = jnp.argmin(jnp.abs((t - memory[0]) / self.dt - offs))
+        zr, zi = self._advance(r, memory, v[np.asarray(self.inputs)])
+        F = self.C[..., 0] @ zr - self.C[..., 1] @ zi
+        return -jnp.zeros_like(v).at[np.asarray(self.outputs)].set(F), None
+
+    def provenance(self):
+        return {**super().provenance(), "radiation": self.name,
+                "state_space_update": "exact for a velocity linear within the step"}
+
+    @classmethod
+    def build(cls, spec, options, dt, stage_offsets):
+        return cls.from_state_space(StateSpace.build(spec, options), dt, stage_offsets)
+
+    @classmethod
+    def from_state_space(cls, ss: StateSpace, dt, stage_offsets):
+        """The exact update of ``ss``'s states for steps of ``dt`` and stages at ``stage_offsets``."""
+        p = np.asarray(ss.p[:, 0]) + 1j * np.asarray(ss.p[:, 1])
+        h = float(dt) * np.asarray(tuple(stage_offsets) + (1.0,))[:, None]
+        e, phi1, phi2 = _phi(p[None, :] * h)
+        split = lambda a: jnp.asarray(np.stack([a.real, a.imag], -1))  # noqa: E731
+        return cls(p=ss.p, C=ss.C, A_inf=ss.A_inf, inputs=ss.inputs, outputs=ss.outputs,
+                   options=ss.options, report=ss.report, E=split(e), G=split(h * phi1),
+                   H=split(h * phi2), dt=jnp.asarray(dt, jnp.float64),
+                   stage_offsets=tuple(float(c) for c in stage_offsets))
+
+
 def strategy(spec, name, *, dt=None, memory=None, state_space_options=None, stage_offsets=(0.0, 0.5, 1.0),
              frequency_domain=False):
     """The radiation strategy ``name`` for a model's :class:`~hydro.prepare.HydroSpec`."""
     accepted = STRATEGIES + (("database",) if frequency_domain else ())
     if name not in accepted:
         raise ValueError(f"radiation={name!r}; accepted: {', '.join(map(repr, accepted))}")
-    if name == "state_space":
+    if name == "state_space" or (name == "state_space_exact" and frequency_domain):
         return StateSpace.build(spec, state_space_options)
+    if name == "state_space_exact":
+        return ExactStateSpace.build(spec, state_space_options, dt, stage_offsets)
     if name == "convolution":
         if frequency_domain:
             # the coefficients need only K(t) and the memory, not the weights of a time step

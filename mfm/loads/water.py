@@ -149,7 +149,9 @@ class Water(Load):
             # is used instead: A∞ on the left.
             F = F - self.A_inf @ (H @ ctx.qdd_guess)
         body = self.geometry.to_body_wrench(F, kin, model.n_bodies) + self._buoyancy_wrench(kin, model.n_bodies)
-        mass = None if rhs else H.T @ self.A_inf @ H
+        # A∞ H on the moved dofs only: the rows of H the joints cannot move are zero
+        mv = np.asarray(self.spec.moving) if self.spec is not None else slice(None)
+        mass = None if rhs else H[mv].T @ (self.A_inf[mv][:, mv] @ H[mv])
         return LoadOutput(body=body, zd=zd, mass=mass)
 
     def reaction_loads(self, ctx, out):
