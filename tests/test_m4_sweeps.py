@@ -108,7 +108,9 @@ def test_modal_form_reproduces_the_fitted_impedance(m111, sharing):
                 Zm[:, i, j] += c / (1j * om - p)
     np.testing.assert_allclose(Zm, Z, atol=1e-9 * np.abs(Z).max())
     if sharing == "common":
-        assert len(P) == len(set(ins)) * 8       # 16 poles = 8 pairs per input dof
+        # 16 states per input dof: a complex pair is 2 states, a real pole 1 (relaxed vector
+        # fitting may return real poles)
+        assert sum(2 if p.imag > 0 else 1 for p in P) == len(set(ins)) * 16
 
 
 def test_convolution_on_moved_dofs_equals_all_dofs(m111):
