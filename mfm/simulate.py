@@ -67,8 +67,9 @@ def model_loads(model: Model, sea=None, *, dt, duration, t0=0.0, ramp=0.0,
 
 
 # convolution work per run above which radiation="auto" takes the state space: ≈ 10 s of
-# multiply–adds at the ~2e9/s one core does on these small matrix–vector products, about what a
-# state-space fit costs (M4 134 …), so the choice is the cheaper of the two
+# multiply–adds at the ~2e9/s one core does on these small matrix–vector products, the order of
+# a state-space fit (benchmarks/fit_speed.py: 1–3 s for M4, Stansby & Li, Hallak; 22 s for Wu &
+# Yuan's 90 dofs), so short runs keep the fit-free convolution
 AUTO_CONVOLUTION_LIMIT = 2e10
 
 
