@@ -128,9 +128,12 @@ class Verlet:
     Beeman's step (seed 001 eq. 52) with no corrector iteration. q̈ₙ₊₁ is taken at the predicted
     velocity q̇*, which is O(dt²) off q̇ₙ₊₁: with velocity-dependent loads (damping, drag, PTOs) that
     enters q̇ at O(dt³) per step, so the scheme stays second order. On an undamped oscillator it is
-    Störmer–Verlet: period error (ω dt)²/24, half the trapezoid's. Stable for ω dt < 2 (undamped). z advances by Heun's rule (explicit trapezoid),
-    weakly unstable for undamped oscillatory states: use it with radiation='state_space_exact',
-    whose states are advanced exactly outside the integrator. Reverse-mode differentiable.
+    Störmer–Verlet: period error (ω dt)²/24, half the trapezoid's. Stable for ω dt < 2
+    (undamped). z advances by Heun's rule (explicit trapezoid), weakly unstable for undamped
+    oscillatory states: use it with radiation='state_space_exact', whose states are advanced
+    exactly outside the integrator. Reverse-mode differentiable. A coordinate with no restoring
+    (free surge) integrates the O(dt²) error of its mean velocity: its drift is less accurate
+    than RK4's (benchmarks/RESULTS.md).
     """
     name: str = "verlet"
     order: int = 2
