@@ -209,9 +209,19 @@ def err(a, b):
     return float(np.max(np.abs(a / b - 1)))
 
 
+def _cases(old, new, rev, system):
+    """(code label, "integrator/radiation", result, reference) of each timed case, baseline first."""
+    for code, res in (("baseline " + str(rev), old[system] if old else None), ("this tree", new[system])):
+        if res is None:
+            continue
+        for k, v in res.items():
+            if "/" in k and not k.startswith("simulate"):
+                yield code, k, v, res["reference"], res
+
+
 def report(new, old, rev):
     L = []
-    m4, rm3 = new["m4"], new["rm3"]
+    m4 = new["m4"]
     L.append(f"Made by `python benchmarks/speed.py{' --baseline ' + rev if rev else ''} --write` "
              f"({time.strftime('%Y-%m-%d')}; the 2-core machine is shared: compare ratios within "
              "this table, not absolute times across runs).\n")
@@ -222,20 +232,14 @@ def report(new, old, rev):
              "| θ_rms err | power err | surge rms err |")
     L.append("|---|---|---|---|---|---|---|---|---|---|")
     base = old["m4"]["rk4/state_space"]["warm"] if old else None
-    for code, res in (("baseline " + rev, old["m4"] if old else None), ("this tree", m4)):
-        if res is None:
-            continue
-        ref = res["reference"]
-        for k, v in res.items():
-            if "/" not in k or k.startswith("simulate"):
-                continue
-            L.append(f"| {code} | {k} | {v['first']:.1f} s | {v['warm']:.3f} s | "
-                     f"{v['warm'] / N_M4 * 1e6:.0f} | {SEED_PER_STEP * N_M4 / v['warm']:.0f} | "
-                     + (f"{base / v['warm']:.2f} | " if base else "— | "))
-            L[-1] += (f"{err(v['theta_rms'], ref['theta_rms']):.1e} | "
-                      f"{abs(v['power'] / ref['power'] - 1):.1e} | "
-                      f"{abs(v['rms'][0] / ref['rms'][0] - 1):.1e} |" if v["finite"] else
-                      "non-finite | — | — |")
+    for code, k, v, ref, _ in _cases(old, new, rev, "m4"):
+        L.append(f"| {code} | {k} | {v['first']:.1f} s | {v['warm']:.3f} s | "
+                 f"{v['warm'] / N_M4 * 1e6:.0f} | {SEED_PER_STEP * N_M4 / v['warm']:.0f} | "
+                 + (f"{base / v['warm']:.2f} | " if base else "— | "))
+        L[-1] += (f"{err(v['theta_rms'], ref['theta_rms']):.1e} | "
+                  f"{abs(v['power'] / ref['power'] - 1):.1e} | "
+                  f"{abs(v['rms'][0] / ref['rms'][0] - 1):.1e} |" if v["finite"] else
+                  "non-finite | — | — |")
     L.append("")
     f = m4["fit"]
     L.append(f"**The radiation fit of M4 134** (`m.hydro.state_space()`, 24 moved dofs): "
@@ -284,18 +288,12 @@ def report(new, old, rev):
     L.append("| code | integrator / radiation | rollout warm | `simulate` warm | × baseline | pitch rms err | power err | surge rms err |")
     L.append("|---|---|---|---|---|---|---|---|")
     base = old["rm3"]["rk4/state_space"]["warm"] if old else None
-    for code, res in (("baseline " + rev, old["rm3"] if old else None), ("this tree", rm3)):
-        if res is None:
-            continue
-        ref = res["reference"]
-        for k, v in res.items():
-            if "/" not in k or k.startswith("simulate"):
-                continue
-            sim = res[f"simulate {k}"]["warm"]
-            L.append(f"| {code} | {k} | {v['warm'] * 1e3:.0f} ms | {sim * 1e3:.0f} ms | "
-                     + (f"{base / v['warm']:.2f} | " if base else "— | ")
-                     + f"{abs(v['rms'][2] / ref['rms'][2] - 1):.1e} | {abs(v['power'] / ref['power'] - 1):.1e} | "
-                     f"{abs(v['rms'][0] / ref['rms'][0] - 1):.1e} |")
+    for code, k, v, ref, res in _cases(old, new, rev, "rm3"):
+        sim = res[f"simulate {k}"]["warm"]
+        L.append(f"| {code} | {k} | {v['warm'] * 1e3:.0f} ms | {sim * 1e3:.0f} ms | "
+                 + (f"{base / v['warm']:.2f} | " if base else "— | ")
+                 + f"{abs(v['rms'][2] / ref['rms'][2] - 1):.1e} | {abs(v['power'] / ref['power'] - 1):.1e} | "
+                 f"{abs(v['rms'][0] / ref['rms'][0] - 1):.1e} |")
     return "\n".join(L) + "\n"
 
 
