@@ -17,9 +17,11 @@ from .dynamics import (coriolis_matrix, energies, evaluate, forward_dynamics,  #
 from .kinematics import b_matrix, b_matrix_dot, body_poses, kinematics  # noqa: E402
 from .model import Model  # noqa: E402
 from .simulate import AccuracyWarning, SimulationError, StabilityWarning, rollout, simulate, simulate_batch  # noqa: E402
+from . import stability  # noqa: E402
+from .stability import amplification_matrix, floquet, largest_stable_dt  # noqa: E402
 from .tree import ConfigError  # noqa: E402
 
-__all__ = ["AccuracyWarning", "ConfigError", "Model", "SimulationError", "b_matrix", "b_matrix_dot", "body_poses",
+__all__ = ["AccuracyWarning", "amplification_matrix", "floquet", "largest_stable_dt", "stability", "ConfigError", "Model", "SimulationError", "b_matrix", "b_matrix_dot", "body_poses",
            "compile_tree", "config", "coriolis_matrix", "energies", "equilibrium", "evaluate",
            "forward_dynamics", "frequency_response", "natural_frequencies", "water",
            "integrators", "kinematics", "load", "loads", "mass_matrix", "reaction_loads",

@@ -37,6 +37,7 @@ re-derivation of a scheme on paper:
 """
 from __future__ import annotations
 
+import functools
 import math
 import numbers
 import tempfile
@@ -238,17 +239,15 @@ def heave_model(damping_ratio: float = 0.02, database=None):
         raise ValueError(f"damping_ratio: {damping_ratio!r}; give a fraction of critical in [0, 1)")
     root = Path(__file__).resolve().parents[1]
     db = Path(database) if database is not None else root / "hydro" / "data" / "sphere.nc"
-    text = _HEAVE_CONFIG.format(db=str(db), mass=2092.29322, c=0.0)
+    m = 2092.29322
     with tempfile.TemporaryDirectory() as d:
         p = Path(d) / "heave.toml"
-        p.write_text(text)
-        m0 = mfm.load(p)
-        water = model_loads(m0, None, dt=0.1, duration=0.1, radiation="none")[0]
-        A, K = float(water.A_inf[2, 2]), float(water.C_wp[2, 2])
-        m = 2092.29322
-        c = 2.0 * float(damping_ratio) * math.sqrt(K * (m + A))
-        p.write_text(_HEAVE_CONFIG.format(db=str(db), mass=m, c=c))
+        p.write_text(_HEAVE_CONFIG.format(db=str(db), mass=m, c=0.0))
         model = mfm.load(p)
+    water = model_loads(model, None, dt=0.1, duration=0.1, radiation="none")[0]
+    A, K = float(water.A_inf[2, 2]), float(water.C_wp[2, 2])
+    c = 2.0 * float(damping_ratio) * math.sqrt(K * (m + A))
+    model = model.replace(damping=jnp.asarray([c]))
     return model, dict(m=m, A_inf=A, K=K, c=c)
 
 
@@ -267,7 +266,7 @@ principal_inertia = [833.3, 833.3, 833.3]
 type = "free"
 dofs = ["heave"]
 damping = [{c!r}]
-"""
+"""  # the damper is set after loading (model.replace), from the water's A∞ and C33
 
 
 def heave_loads(model, mass_ratio, *, dt, n_steps, added_mass="lhs", integrator="rk4"):
@@ -387,6 +386,54 @@ def _state_names(model, carry, idx):
     return names
 
 
+def _one_step(model, lds, integ, dt):
+    from .simulate import _update_memories, dynamics_function
+
+    def one(carry, _):
+        s, mem = carry
+        s = integ.step(dynamics_function(model, lds, mem), s, dt)
+        return (s, _update_memories(model, lds, s, mem)), None
+
+    return one
+
+
+@functools.partial(jax.jit, static_argnames=("n0", "integ"))
+def _floquet_start(model, lds, q0, qd0, z0, dt, n0, integ):
+    """The rollout's carry after n0 steps from rest (the same step as :func:`mfm.simulate`)."""
+    from .simulate import _init_memories, dynamics_function
+
+    mem0 = _init_memories(model, lds, 0.0, q0, qd0, dt)
+    s = integ.init(dynamics_function(model, lds, mem0), 0.0, q0, qd0, z0)
+    carry, _ = jax.lax.scan(_one_step(model, lds, integ, dt), (s, mem0), None, length=n0)
+    return carry
+
+
+def _carry_to_x(carry, idx):
+    leaves = jax.tree_util.tree_leaves(carry)
+    return jnp.concatenate([jnp.ravel(leaves[i]) for i in idx])
+
+
+def _x_to_carry(x, like, idx):
+    leaves, tree = jax.tree_util.tree_flatten(like)
+    off = 0
+    for i in idx:
+        sz = int(np.prod(np.shape(leaves[i])))
+        leaves[i] = x[off:off + sz].reshape(np.shape(leaves[i]))
+        off += sz
+    return jax.tree_util.tree_unflatten(tree, leaves)
+
+
+def _flow(x, model, lds, like, dt, n, integ, idx):
+    """F(x): the carried state after n steps from x (the clock and stamps of ``like``)."""
+    carry, _ = jax.lax.scan(_one_step(model, lds, integ, dt), _x_to_carry(x, like, idx), None,
+                            length=n)
+    return _carry_to_x(carry, idx)
+
+
+_flow_jit = jax.jit(_flow, static_argnames=("n", "integ", "idx"))
+_monodromy_jit = jax.jit(jax.jacfwd(_flow), static_argnames=("n", "integ", "idx"))
+
+
 def floquet(model, sea, *, period, dt, t_start, integrator="verlet",
             radiation="state_space_exact", loads=None, ramp=0.0, added_mass="lhs",
             state_space_options=None, q0=None, qd0=None, refine: int = 2) -> FloquetResult:
@@ -409,8 +456,7 @@ def floquet(model, sea, *, period, dt, t_start, integrator="verlet",
     period must be a whole number of steps; ``t_start`` a whole number of steps. radiation must
     have finitely many states: "state_space", "state_space_exact" or "none" (the convolution's
     memory is its whole velocity history: allowed, but Φ is then as large as that history)."""
-    from .simulate import _as_loads, _init_memories, _update_memories, dynamics_function, \
-        model_loads, _initial_vector
+    from .simulate import _as_loads, _initial_vector, model_loads
 
     period = _positive(period, "period")
     dt = _positive(dt, "dt")
@@ -432,8 +478,7 @@ def floquet(model, sea, *, period, dt, t_start, integrator="verlet",
     if radiation not in accepted:
         raise ValueError(f"radiation={radiation!r}; accepted: {accepted} (a finite state: "
                          "'state_space_exact' or 'state_space' recommended)")
-    integ = _integrator(integrator, _added_mass(added_mass)) if added_mass == "rhs" \
-        else _integrators.get(integrator)
+    integ = _integrator(integrator, _added_mass(added_mass))
     lds = model_loads(model, sea, dt=dt, duration=t_start + period + dt, ramp=ramp,
                       radiation=radiation, state_space_options=state_space_options,
                       added_mass=added_mass, integrator=integ) + _as_loads(loads)
@@ -443,54 +488,25 @@ def floquet(model, sea, *, period, dt, t_start, integrator="verlet",
     z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
     dt_ = jnp.asarray(dt, jnp.float64)
 
-    def one_step(carry, _):
-        s, mem = carry
-        s = integ.step(dynamics_function(model, lds, mem), s, dt_)
-        return (s, _update_memories(model, lds, s, mem)), None
-
-    @jax.jit
-    def start():
-        mem0 = _init_memories(model, lds, 0.0, q0, qd0, dt_)
-        s = integ.init(dynamics_function(model, lds, mem0), 0.0, q0, qd0, z0)
-        carry, _ = jax.lax.scan(one_step, (s, mem0), None, length=n0)
-        return carry
-
-    carry0 = start()
-    leaves0, tree, idx = _carry_parts(carry0)
-    sizes = [int(np.prod(np.shape(leaves0[i]))) for i in idx]
-    shapes = [np.shape(leaves0[i]) for i in idx]
-
-    def to_carry(x):
-        leaves = list(leaves0)
-        off = 0
-        for i, sz, sh in zip(idx, sizes, shapes):
-            leaves[i] = x[off:off + sz].reshape(sh)
-            off += sz
-        return jax.tree_util.tree_unflatten(tree, leaves)
-
-    def to_x(carry):
-        leaves = jax.tree_util.tree_leaves(carry)
-        return jnp.concatenate([jnp.ravel(leaves[i]) for i in idx])
-
-    def flow(x):
-        carry, _ = jax.lax.scan(one_step, to_carry(x), None, length=n)
-        return to_x(carry)
-
-    flow_jit = jax.jit(flow)
-    jac = jax.jit(jax.jacfwd(flow))
-    x = to_x(carry0)
-    res0 = float(jnp.max(jnp.abs(flow_jit(x) - x)))
+    carry0 = _floquet_start(model, lds, q0, qd0, z0, dt_, n0, integ)
+    _, _, idx = _carry_parts(carry0)
+    idx = tuple(idx)
+    x = _carry_to_x(carry0, idx)
+    args = (model, lds, carry0, dt_)
+    flow = lambda x: _flow_jit(x, *args, n, integ, idx)  # noqa: E731
+    jac = lambda x: np.asarray(_monodromy_jit(x, *args, n, integ, idx))  # noqa: E731
+    res0 = float(jnp.max(jnp.abs(flow(x) - x)))
     res = res0
     for _ in range(int(refine)):
-        Fx = flow_jit(x)
-        J = np.asarray(jac(x))
+        Fx = flow(x)
+        J = jac(x)
         dx, *_ = np.linalg.lstsq(J - np.eye(J.shape[0]), -np.asarray(Fx - x), rcond=1e-10)
         x_new = x + jnp.asarray(dx)
-        r_new = float(jnp.max(jnp.abs(flow_jit(x_new) - x_new)))
+        r_new = float(jnp.max(jnp.abs(flow(x_new) - x_new)))
         if not np.isfinite(r_new) or r_new > res:
             break
         x, res = x_new, r_new
-    Phi = np.asarray(jac(x))
+    Phi = jac(x)
     mu, vec = np.linalg.eig(Phi)
     order = np.argsort(-np.abs(mu), kind="stable")
     mu, vec = mu[order], vec[:, order]

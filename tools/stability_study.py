@@ -1,0 +1,285 @@
+"""Stability where methods fail: the stability map of the integrators against the added-mass
+ratio, and the RM3 long-run finding explained by Floquet multipliers (docs/stability.md).
+
+    PYTHONPATH=. python tools/stability_study.py map       # predicted and measured map (≈ 5 min)
+    PYTHONPATH=. python tools/stability_study.py runs      # RM3 4000 s runs (≈ 1 min each)
+    PYTHONPATH=. python tools/stability_study.py floquet   # RM3 multipliers and variants (≈ 1 min each)
+    PYTHONPATH=. python tools/stability_study.py figures   # the PNGs from the stored numbers
+
+Numbers go to notebooks/figures/stability/*.json, figures to notebooks/figures/stability/*.png.
+"""
+from __future__ import annotations
+
+import copy
+import dataclasses
+import json
+import math
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "notebooks" / "figures" / "stability"
+
+RATIOS = [0.0, 0.25, 0.5, 0.75, 0.9, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0]
+# (label, integrator name or constructor, added-mass placement)
+SCHEMES = [("rk4, A∞ in M*", "rk4", "lhs"),
+           ("semi-implicit Euler, A∞ in M*", "semi_implicit", "lhs"),
+           ("verlet, A∞ in M*", "verlet", "lhs"),
+           ("beeman, A∞ in M*", "beeman", "lhs"),
+           ("newmark, A∞ in M*", "newmark", "lhs"),
+           ("beeman, A∞ on the rhs, corrector (tol 1 %)", "beeman", "rhs"),
+           ("beeman, A∞ on the rhs, no corrector", "beeman0", "rhs")]
+
+RM3_SEA = dict(height=2.5, period=8.0)
+RM3_RAMP = 20.0          # Floquet: the orbit after the ramp, whatever its length
+RUN_RAMP = 40.0          # the README's RM3 case
+# the exponential phase of a run: periods whose deviation from 8 s periodicity is between these
+# (above the start-up transient's decay, below the nonlinear saturation at 0.43 rad)
+LINEAR_PHASE = (2e-3, 5e-2)
+T_START = 120.0
+
+
+def _integrator(name):
+    import mfm
+
+    return mfm.integrators.Beeman(max_iter=0) if name == "beeman0" else name
+
+
+def stability_map(n_steps=2000):
+    """Largest stable dt/T_min per scheme and A∞/m, predicted (spectral radius of the engine's
+    step on the linear heave equation) and measured (rollouts of the heave model)."""
+    from mfm import stability as st
+
+    model, p = st.heave_model(0.02)
+    m, K, c = p["m"], p["K"], p["c"]
+    rows = []
+    for label, name, am in SCHEMES:
+        integ = _integrator(name)
+        for r in RATIOS:
+            T_min = 2 * math.pi * math.sqrt((m + r * m) / K)
+            t0 = time.time()
+            pred = st.largest_stable_dt(integ, m, c, K, A_inf=r * m, added_mass=am,
+                                        dt_max=2 * T_min)
+            meas = st.measured_stable_dt(model, r, integrator=integ, added_mass=am,
+                                         dt_lo=1e-3 * T_min, dt_hi=2 * T_min, n_steps=n_steps,
+                                         iterations=12)
+            rows.append(dict(scheme=label, integrator=name, added_mass=am, ratio=r, T_min=T_min,
+                             predicted=pred / T_min, measured=meas / T_min))
+            print(f"{label:45s} A∞/m {r:4.2f}: predicted {pred / T_min:.4f}, measured "
+                  f"{meas / T_min:.4f} T_min ({time.time() - t0:.1f} s)", flush=True)
+    OUT.mkdir(parents=True, exist_ok=True)
+    (OUT / "map.json").write_text(json.dumps(dict(
+        heave_model=p, n_steps=n_steps, growth="|q| > 1e3 × 1 cm in the last quarter",
+        rows=rows), indent=1, default=float))
+
+
+def rm3(drag=False):
+    import mfm
+
+    model = mfm.load(ROOT / "configs" / "rm3.toml")
+    if drag:
+        # C_D = 1 [A]: spar column 6 m × 35 m draft and the 30 m plate; float 20 m × 5 m and its
+        # 20 m disc (WEC-Sim RM3 dimensions, docs/GEOMETRY.md §5)
+        spec = copy.copy(model.hydro)
+        areas = {"float": [100.0, 100.0, 314.2], "spar": [210.0, 210.0, 706.9]}
+        spec.drag = 0.5 * spec.rho * np.asarray([areas[n] for n in spec.config_names], dtype=float)
+        model = dataclasses.replace(model, hydro=spec)
+    return model
+
+
+def mooring(model, k):
+    """A horizontal linear spring of k N/m at the spar's still-water-line point."""
+    from mfm.loads.body_matrix import LinearBodyMatrix
+
+    return LinearBodyMatrix.create(model, "spar", point=[0.0, 0.0, 0.0],
+                                   stiffness=[k, 0, 0, 0, 0, 0], name="mooring")
+
+
+def rm3_runs():
+    import hydro
+    import mfm
+    from mfm import stability as st
+
+    model = rm3()
+    sea = hydro.Regular(**RM3_SEA)
+    out = {}
+    for integ, rad, dt in [("verlet", "state_space_exact", 0.1), ("rk4", "state_space_exact", 0.1),
+                           ("verlet", "state_space_exact", 0.05), ("rk4", "state_space", 0.1)]:
+        t0 = time.time()
+        ds = mfm.simulate(model, sea, duration=4000.0, dt=dt, integrator=integ, radiation=rad,
+                          ramp=RUN_RAMP, save_every=int(round(0.2 / dt)))
+        t = ds.time.values
+        pitch = ds.q.sel(coordinate="spar.pitch").values
+        power = ds.pto_power.values.reshape(len(t), -1)[:, 0]
+        # the envelope of the deviation from 8 s periodicity, whole run; σ fitted on its
+        # exponential phase (LINEAR_PHASE), from the first period past its lower bound to the
+        # first past its upper one
+        _, mids, peaks = st.envelope_growth_rate(t, pitch, 8.0, 0.0, 3990.0)
+        a = mids[np.argmax((peaks > LINEAR_PHASE[0]) & (mids > 2 * RUN_RAMP))] - 4.0
+        b = mids[np.argmax((peaks > LINEAR_PHASE[1]) & (mids > a))] + 4.0
+        sigma, _, _ = st.envelope_growth_rate(t, pitch, 8.0, a, b)
+        key = f"{integ} {rad} dt {dt}"
+        win = lambda a, b: (t >= a) & (t < b)  # noqa: E731
+        out[key] = dict(sigma=sigma, fit_window=[float(a), float(b)], wall_s=time.time() - t0,
+                        pitch_max_100_140=float(np.abs(pitch[win(100, 140)]).max()),
+                        pitch_max_3000_4000=float(np.abs(pitch[win(3000, 4000)]).max()),
+                        power_kw_100_140=float(power[win(100, 140)].mean() / 1e3),
+                        power_kw_3000_4000=float(power[win(3000, 4000)].mean() / 1e3),
+                        t=t[::5].tolist(), pitch=pitch[::5].tolist(),
+                        env_t=mids.tolist(), env=peaks.tolist())
+        print(key, {k: v for k, v in out[key].items() if not isinstance(v, list)}, flush=True)
+    OUT.mkdir(parents=True, exist_ok=True)
+    (OUT / "rm3_runs.json").write_text(json.dumps(out))
+
+
+def rm3_floquet(which=None):
+    import hydro
+    from mfm import stability as st
+
+    base = rm3()
+    cases = {
+        "verlet exact dt 0.1": dict(),
+        "verlet exact dt 0.05": dict(dt=0.05),
+        "rk4 exact dt 0.1": dict(integrator="rk4"),
+        "rk4 state_space dt 0.1": dict(integrator="rk4", radiation="state_space"),
+        "rk4 exact dt 0.05": dict(integrator="rk4", dt=0.05),
+        "drag C_D 1": dict(model=rm3(drag=True)),
+        "mooring 3e4 N/m": dict(loads=[mooring(base, 3e4)]),
+        "mooring 3e5 N/m": dict(loads=[mooring(base, 3e5)]),
+    }
+    for T in (6.0, 7.0, 7.5, 8.5, 9.0, 10.0):
+        cases[f"T {T:g} s"] = dict(period=T)
+    for H in (0.5, 1.0, 1.5, 2.0, 3.0):
+        cases[f"H {H:g} m"] = dict(height=H)
+    OUT.mkdir(parents=True, exist_ok=True)
+    path = OUT / "floquet.json"
+    out = json.loads(path.read_text()) if path.exists() else {}
+    for name, kw in cases.items():
+        if which and name not in which:
+            continue
+        kw = dict(kw)
+        T = kw.pop("period", RM3_SEA["period"])
+        H = kw.pop("height", RM3_SEA["height"])
+        model = kw.pop("model", base)
+        dt = kw.pop("dt", 0.1)
+        t0 = time.time()
+        r = st.floquet(model, hydro.Regular(height=H, period=T), period=T, dt=dt,
+                       t_start=T_START, ramp=RM3_RAMP, **{"integrator": "verlet",
+                                                          "radiation": "state_space_exact", **kw})
+        mu = r.multipliers
+        q_idx = [i for i, nm in enumerate(r.state_names) if nm.startswith("q[")]
+        v = r.modes[:, 0]
+        out[name] = dict(period=T, height=H, dt=dt, multipliers_re=mu.real[:12].tolist(),
+                         multipliers_im=mu.imag[:12].tolist(), all_re=mu.real.tolist(),
+                         all_im=mu.imag.tolist(), sigma=float(r.growth_rates[0]),
+                         residual=list(r.residual), n_x=len(r.x), wall_s=time.time() - t0,
+                         mode_q={r.state_names[i]: abs(complex(v[i])) for i in q_idx})
+        print(f"{name:28s} μ₁ = {mu[0]:.5f} (|μ| {abs(mu[0]):.5f}), σ = {r.growth_rates[0]:+.5f} /s,"
+              f" μ₂ = {mu[1]:.5f}, residual {r.residual[0]:.2g} → {r.residual[1]:.2g}, "
+              f"{time.time() - t0:.0f} s", flush=True)
+        path.write_text(json.dumps(out, indent=1))
+
+
+def figures():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    if (OUT / "map.json").exists():
+        map_figure(plt, json.loads((OUT / "map.json").read_text()))
+    if (OUT / "rm3_runs.json").exists() and (OUT / "floquet.json").exists():
+        floquet_figure(plt, json.loads((OUT / "rm3_runs.json").read_text()),
+                       json.loads((OUT / "floquet.json").read_text()))
+
+
+def map_figure(plt, data):
+    rows = data["rows"]
+    fig, axes = plt.subplots(1, 2, figsize=(13, 6.5), sharey=True)
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    ymax = 0.6
+    for k, (label, _, am) in enumerate(SCHEMES):
+        ax = axes[0 if am == "lhs" else 1]
+        rr = [r for r in rows if r["scheme"] == label]
+        x = [r["ratio"] for r in rr]
+        pred = [min(r["predicted"], ymax) for r in rr]
+        meas = [min(r["measured"], ymax) for r in rr]
+        ax.plot(x, pred, "-", color=colors[k], label=f"{label}: predicted (ρ(G) = 1)")
+        ax.plot(x, meas, "o", mfc="none", color=colors[k], label=f"{label}: measured (runs)")
+    for ax, title in zip(axes, ("A∞ in M* (mfm)", "A∞ q̈ on the right-hand side (seed 001)")):
+        ax.set_xlabel("added-mass ratio A∞/m")
+        ax.set_title(title)
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2)
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("largest stable dt / T_min  (T_min = 2π √((m + A∞)/K))")
+    axes[0].axhline(ymax, color="0.8", lw=0.8)
+    axes[0].text(0.02, ymax * 0.97, "no limit up to 2 T_min (newmark), drawn at 0.6", va="top",
+                 fontsize=8, color="0.4")
+    fig.suptitle("Stability map: heave of a floating hemisphere, 2 % damping; below each line is "
+                 "stable")
+    fig.tight_layout()
+    fig.savefig(OUT / "stability_map.png", dpi=130)
+    plt.close(fig)
+
+
+
+def floquet_figure(plt, runs, fq):
+    fig, axes = plt.subplots(1, 3, figsize=(16, 4.8))
+    ax = axes[0]
+    key = "verlet state_space_exact dt 0.1"
+    r = runs[key]
+    ax.plot(r["t"], r["pitch"], lw=0.4, color="0.6", label="pitch (rad)")
+    ax.semilogy(r["env_t"], r["env"], ".", ms=3, label="|θ(t + 8 s) − θ(t)| per period (run)")
+    sig = fq["verlet exact dt 0.1"]["sigma"]
+    t_fit = np.asarray([40.0, 450.0])
+    e = np.asarray(r["env"]); te = np.asarray(r["env_t"])
+    i0 = int(np.argmin(abs(te - 200.0)))
+    ax.semilogy(t_fit, e[i0] * np.exp(sig * (t_fit - te[i0])), "k--",
+                label=f"Floquet: σ = ln|μ|/T = {sig:.4f} /s")
+    ax.set_yscale("log")
+    ax.set_xlim(0, 1000)
+    ax.set_ylim(1e-4, 2)
+    ax.set_xlabel("t (s)")
+    ax.set_title(f"RM3, H 2.5 m T 8 s: measured σ = {r['sigma']:.4f} /s")
+    ax.legend(fontsize=7)
+    ax = axes[1]
+    th = np.linspace(0, 2 * np.pi, 400)
+    ax.plot(np.cos(th), np.sin(th), color="0.7", lw=0.8)
+    for name, mk in (("verlet exact dt 0.1", "o"), ("rk4 exact dt 0.05", "x"),
+                     ("drag C_D 1", "s"), ("T 10 s", "^")):
+        if name in fq:
+            ax.plot(fq[name]["all_re"], fq[name]["all_im"], mk, mfc="none", ms=5, label=name)
+    ax.set_aspect("equal")
+    ax.set_xlim(-1.3, 1.3)
+    ax.set_ylim(-1.1, 1.1)
+    ax.set_title("Floquet multipliers μ (unit circle)")
+    ax.legend(fontsize=7)
+    ax = axes[2]
+    Ts = sorted((v["period"], v["sigma"]) for k, v in fq.items() if k.startswith("T ")
+                or k == "verlet exact dt 0.1")
+    ax.plot([a for a, _ in Ts], [b for _, b in Ts], "o-", label="wave period (H 2.5 m)")
+    ax.axhline(0, color="0.5", lw=0.8)
+    ax.set_xlabel("wave period T (s)")
+    ax.set_ylabel("σ = ln|μ₁|/T (1/s)")
+    ax2 = ax.twiny()
+    Hs = sorted((v["height"], v["sigma"]) for k, v in fq.items() if k.startswith("H ")
+                or k == "verlet exact dt 0.1")
+    ax2.plot([a for a, _ in Hs], [b for _, b in Hs], "s--", color="C1", label="wave height (T 8 s)")
+    ax2.set_xlabel("wave height H (m)", color="C1")
+    ax.legend(fontsize=7, loc="upper left")
+    ax2.legend(fontsize=7, loc="upper right")
+    ax.set_title("growth rate against the wave")
+    fig.tight_layout()
+    fig.savefig(OUT / "rm3_floquet.png", dpi=130)
+    plt.close(fig)
+
+
+if __name__ == "__main__":
+    warnings.simplefilter("ignore")
+    what = sys.argv[1] if len(sys.argv) > 1 else "figures"
+    {"map": stability_map, "runs": rm3_runs,
+     "floquet": lambda: rm3_floquet(sys.argv[2:] or None), "figures": figures}[what]()
