@@ -106,11 +106,19 @@ def linear_dynamics(M, C, K, A_inf=None, added_mass="lhs"):
               :class:`mfm.loads.water.Water` does at the start of a run)
 
     M, C, K, A∞: (n, n) arrays (numbers for one coordinate); no auxiliary states (ż is empty)."""
+    return _linear_f(*_system(M, C, K, A_inf), _added_mass(added_mass))
+
+
+def _system(M, C, K, A_inf):
+    """The checked float64 matrices (M, C, K, A∞), each (n, n)."""
     M = _matrix(M, "M")
     n = M.shape[0]
     C, K = _matrix(C, "C", n), _matrix(K, "K", n)
     A = np.zeros((n, n)) if A_inf is None else _matrix(A_inf, "A_inf", n)
-    added_mass = _added_mass(added_mass)
+    return M, C, K, A
+
+
+def _linear_f(M, C, K, A, added_mass):
     M, C, K, A = (jnp.asarray(x) for x in (M, C, K, A))
     Mt = M + A
 
@@ -158,15 +166,24 @@ def _probe_state(integ, f, n, seed=0):
     return integ.init(f, 0.0, q0, qd0, jnp.zeros(0))
 
 
+@functools.partial(jax.jit, static_argnames=("integ", "added_mass"))
+def _linear_G(dt, M, C, K, A, integ, added_mass):
+    """G of one step on the linear system: compiled once per (integrator, placement, n), reused
+    for every dt and matrix (a bisection evaluates it a hundred times)."""
+    f = _linear_f(M, C, K, A, added_mass)
+    s0 = _probe_state(integ, f, M.shape[0])
+    return jax.jacfwd(lambda x: _pack(integ.step(f, _unpack(x, s0), dt)))(_pack(s0))
+
+
 def amplification_matrix(integrator, dt, M, C, K, A_inf=None, *, added_mass="lhs") -> np.ndarray:
     """The amplification matrix G (3n × 3n) of one step of ``integrator`` (a name or an instance of
     :mod:`mfm.integrators`) on (M + A∞) q̈ + C q̇ + K q = 0 with the added mass placed as
     ``added_mass`` says (:func:`linear_dynamics`); x = (q, q̇, q̈). See :func:`step_jacobian`."""
     added_mass = _added_mass(added_mass)
     integ = _integrator(integrator, added_mass)
-    f = linear_dynamics(M, C, K, A_inf, added_mass)
-    n = np.atleast_2d(np.asarray(M, dtype=float)).shape[0]
-    return step_jacobian(integ, f, _probe_state(integ, f, n), dt)
+    dt = _positive(dt, "dt")
+    return np.asarray(_linear_G(jnp.asarray(dt), *map(jnp.asarray, _system(M, C, K, A_inf)),
+                                integ=integ, added_mass=added_mass))
 
 
 def spectral_radius(G) -> float:
@@ -186,19 +203,16 @@ def largest_stable_dt(integrator, M, C, K, A_inf=None, *, added_mass="lhs", dt_m
     dt). ``tol``: a neutral scheme (Verlet on an undamped oscillator) has ρ = 1 to round-off."""
     added_mass = _added_mass(added_mass)
     integ = _integrator(integrator, added_mass)
-    f = linear_dynamics(M, C, K, A_inf, added_mass)
-    Mm = _matrix(M, "M")
-    n = Mm.shape[0]
+    Mm, Cm, Km, Am = _system(M, C, K, A_inf)
     if dt_max is None:
-        Mt = Mm + (0.0 if A_inf is None else _matrix(A_inf, "A_inf", n))
-        lam = np.linalg.eigvals(np.linalg.solve(Mt, _matrix(K, "K", n))).real.max()
+        lam = np.linalg.eigvals(np.linalg.solve(Mm + Am, Km)).real.max()
         if lam <= 0:
             raise ValueError("K: no positive stiffness, so no shortest period to scale dt by; give "
                              "dt_max (s)")
         dt_max = 2.0 * 2 * math.pi / math.sqrt(lam)
     dt_max = _positive(dt_max, "dt_max")
-    s0 = _probe_state(integ, f, n)
-    step = jax.jit(lambda dt: jax.jacfwd(lambda x: _pack(integ.step(f, _unpack(x, s0), dt)))(_pack(s0)))
+    mats = tuple(jnp.asarray(a) for a in (Mm, Cm, Km, Am))
+    step = lambda dt: _linear_G(dt, *mats, integ=integ, added_mass=added_mass)  # noqa: E731
 
     def unstable(dt):
         return spectral_radius(step(jnp.asarray(dt))) > 1.0 + tol
@@ -430,8 +444,12 @@ def _flow(x, model, lds, like, dt, n, integ, idx):
     return _carry_to_x(carry, idx)
 
 
-_flow_jit = jax.jit(_flow, static_argnames=("n", "integ", "idx"))
-_monodromy_jit = jax.jit(jax.jacfwd(_flow), static_argnames=("n", "integ", "idx"))
+@functools.partial(jax.jit, static_argnames=("n", "integ", "idx"))
+def _flow_and_monodromy(x, model, lds, like, dt, n, integ, idx):
+    """(F(x), Φ = ∂F/∂x): forward mode, the tangents of every state entry pushed through the
+    same n steps as the value, in one compiled function."""
+    y, push = jax.linearize(lambda x_: _flow(x_, model, lds, like, dt, n, integ, idx), x)
+    return y, jax.vmap(push, out_axes=1)(jnp.eye(x.shape[0], dtype=x.dtype))
 
 
 def floquet(model, sea, *, period, dt, t_start, integrator="verlet",
@@ -492,21 +510,19 @@ def floquet(model, sea, *, period, dt, t_start, integrator="verlet",
     _, _, idx = _carry_parts(carry0)
     idx = tuple(idx)
     x = _carry_to_x(carry0, idx)
-    args = (model, lds, carry0, dt_)
-    flow = lambda x: _flow_jit(x, *args, n, integ, idx)  # noqa: E731
-    jac = lambda x: np.asarray(_monodromy_jit(x, *args, n, integ, idx))  # noqa: E731
-    res0 = float(jnp.max(jnp.abs(flow(x) - x)))
-    res = res0
+    fj = lambda x: _flow_and_monodromy(x, model, lds, carry0, dt_, n, integ, idx)  # noqa: E731
+    y, J = fj(x)
+    res0 = res = float(jnp.max(jnp.abs(y - x)))
     for _ in range(int(refine)):
-        Fx = flow(x)
-        J = jac(x)
-        dx, *_ = np.linalg.lstsq(J - np.eye(J.shape[0]), -np.asarray(Fx - x), rcond=1e-10)
+        dx, *_ = np.linalg.lstsq(np.asarray(J) - np.eye(J.shape[0]), -np.asarray(y - x),
+                                 rcond=1e-10)
         x_new = x + jnp.asarray(dx)
-        r_new = float(jnp.max(jnp.abs(flow(x_new) - x_new)))
+        y_new, J_new = fj(x_new)
+        r_new = float(jnp.max(jnp.abs(y_new - x_new)))
         if not np.isfinite(r_new) or r_new > res:
             break
-        x, res = x_new, r_new
-    Phi = jac(x)
+        x, y, J, res = x_new, y_new, J_new, r_new
+    Phi = np.asarray(J)
     mu, vec = np.linalg.eig(Phi)
     order = np.argsort(-np.abs(mu), kind="stable")
     mu, vec = mu[order], vec[:, order]

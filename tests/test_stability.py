@@ -76,12 +76,12 @@ def heave():
 
 @pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 @pytest.mark.parametrize("name, added_mass, ratio", [
-    ("rk4", "lhs", 4.0), ("beeman", "rhs", 0.5), ("beeman0", "rhs", 0.9)])
+    ("verlet", "lhs", 4.0), ("beeman", "rhs", 0.5), ("beeman0", "rhs", 0.9)])
 def test_predicted_boundary_within_ten_percent_of_runs(heave, name, added_mass, ratio):
     # the acceptance: the dt of ρ(G) = 1 (the linear heave equation of the model's own numbers)
     # against rollouts of the engine (its water load, A∞ scaled to A∞/m = ratio): a run at 0.9 of
     # the predicted dt stays bounded and one at 1.1 of it grows (2000 steps; > 1e3 × its start).
-    # Three points (each integrator costs a compilation of the rollout, seconds); the whole map,
+    # Three points (each integrator costs a compilation of the rollout, 5–10 s); the whole map,
     # every integrator × 11 ratios, is measured by tools/stability_study.py map (docs/stability.md)
     model, p = heave
     integ = mfm.integrators.Beeman(max_iter=0) if name == "beeman0" else name
@@ -93,13 +93,12 @@ def test_predicted_boundary_within_ten_percent_of_runs(heave, name, added_mass, 
 
 
 @pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
-def test_unstable_everywhere_and_stable_everywhere_measured(heave):
+def test_unstable_at_every_dt_measured(heave):
+    # A∞/m = 2 on the right-hand side: predicted 0 (unstable at every dt); a run at T_min/100 grows.
+    # (Newmark's "no limit", measured bounded at 2 T_min for every ratio, is in the map.)
     model, p = heave
     T_min = 2 * math.pi * math.sqrt(3 * p["m"] / p["K"])
-    # A∞/m = 2 on the right-hand side: predicted 0 (unstable at every dt); a run at T_min/100 grows
     assert st.run_grows(model, 2.0, T_min / 100, integrator="beeman", added_mass="rhs")
-    # Newmark: no limit predicted; a run at dt = 2 T_min stays bounded
-    assert not st.run_grows(model, 2.0, 2 * T_min, integrator="newmark")
 
 
 # -- Floquet multipliers -----------------------------------------------------------------------
