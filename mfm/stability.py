@@ -478,11 +478,12 @@ def floquet(model, sea, *, period, dt, t_start, integrator="verlet",
 
     period = _positive(period, "period")
     dt = _positive(dt, "dt")
-    t_start = float(t_start) if isinstance(t_start, numbers.Real) and not isinstance(t_start, bool) \
-        and math.isfinite(t_start) and t_start >= 0 else None
-    if t_start is None:
-        raise ValueError("t_start: give a time ≥ 0 (s) at which the run has reached its periodic "
-                         "steady state")
+    ok = isinstance(t_start, numbers.Real) and not isinstance(t_start, bool) \
+        and math.isfinite(t_start) and t_start >= 0
+    if not ok:
+        raise ValueError(f"t_start: {t_start!r}; give a time ≥ 0 (s) at which the run has reached "
+                         "its periodic steady state")
+    t_start = float(t_start)
     n = int(round(period / dt))
     if n < 1 or abs(n * dt - period) > 1e-9 * period:
         raise ValueError(f"period: {period!r} s is not a whole number of steps of dt = {dt!r} s "
@@ -557,7 +558,8 @@ def envelope_growth_rate(t, y, period, t_from, t_to):
         a += period
     mids, peaks = np.asarray(mids), np.asarray(peaks)
     if len(mids) < 3:
-        raise ValueError(f"t_from, t_to: [{t_from}, {t_to}] s holds fewer than 3 periods of the run")
+        raise ValueError(f"t_from, t_to: [{t_from}, {t_to}] s holds fewer than 3 periods of the "
+                         "run; give a longer window")
     sigma = np.polyfit(mids, np.log(peaks), 1)[0]
     return float(sigma), mids, peaks
 

@@ -216,7 +216,7 @@ def test_bad_arguments_name_the_argument_value_and_what_is_accepted(tmp_path):
         st.floquet(model, None, period=1.05, dt=0.1, t_start=0.0, integrator="rk4")
     with pytest.raises(ValueError, match=r"radiation='fast'; accepted"):
         st.floquet(model, None, period=1.0, dt=0.1, t_start=0.0, radiation="fast")
-    with pytest.raises(ValueError, match=r"t_start: give a time ≥ 0"):
+    with pytest.raises(ValueError, match=r"t_start: -1.0; give a time ≥ 0"):
         st.floquet(model, None, period=1.0, dt=0.1, t_start=-1.0)
     with pytest.raises(ValueError, match=r"mass_ratio: -1.0; give A∞/m ≥ 0"):
         st.heave_loads(model, -1.0, dt=0.1, n_steps=10)

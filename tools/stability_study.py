@@ -3,8 +3,9 @@ ratio, and the RM3 long-run finding explained by Floquet multipliers (docs/stabi
 
     PYTHONPATH=. python tools/stability_study.py map       # predicted and measured map (≈ 5 min)
     PYTHONPATH=. python tools/stability_study.py runs      # RM3 4000 s runs (≈ 1 min each)
-    PYTHONPATH=. python tools/stability_study.py floquet   # RM3 multipliers and variants (≈ 1 min each)
+    PYTHONPATH=. python tools/stability_study.py floquet   # RM3 multipliers and variants (1–4 min each)
     PYTHONPATH=. python tools/stability_study.py figures   # the PNGs from the stored numbers
+    PYTHONPATH=. python tools/stability_study.py table     # the Floquet variants as markdown
 
 Numbers go to notebooks/figures/stability/*.json, figures to notebooks/figures/stability/*.png.
 """
@@ -99,16 +100,20 @@ def mooring(model, k):
                                    stiffness=[k, 0, 0, 0, 0, 0], name="mooring")
 
 
-def rm3_runs():
+def rm3_runs(which=None):
     import hydro
     import mfm
     from mfm import stability as st
 
     model = rm3()
     sea = hydro.Regular(**RM3_SEA)
-    out = {}
+    path = OUT / "rm3_runs.json"
+    out = json.loads(path.read_text()) if path.exists() else {}
     for integ, rad, dt in [("verlet", "state_space_exact", 0.1), ("rk4", "state_space_exact", 0.1),
-                           ("verlet", "state_space_exact", 0.05), ("rk4", "state_space", 0.1)]:
+                           ("verlet", "state_space_exact", 0.05), ("rk4", "state_space", 0.1),
+                           ("rk4", "convolution", 0.1)]:
+        if which and f"{integ} {rad} dt {dt}" not in which:
+            continue
         t0 = time.time()
         ds = mfm.simulate(model, sea, duration=4000.0, dt=dt, integrator=integ, radiation=rad,
                           ramp=RUN_RAMP, save_every=int(round(0.2 / dt)))
@@ -132,8 +137,8 @@ def rm3_runs():
                         t=t[::5].tolist(), pitch=pitch[::5].tolist(),
                         env_t=mids.tolist(), env=peaks.tolist())
         print(key, {k: v for k, v in out[key].items() if not isinstance(v, list)}, flush=True)
-    OUT.mkdir(parents=True, exist_ok=True)
-    (OUT / "rm3_runs.json").write_text(json.dumps(out))
+        OUT.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(out))
 
 
 def rm3_floquet(which=None):
@@ -151,7 +156,7 @@ def rm3_floquet(which=None):
         "mooring 3e4 N/m": dict(loads=[mooring(base, 3e4)]),
         "mooring 3e5 N/m": dict(loads=[mooring(base, 3e5)]),
     }
-    for T in (6.0, 7.0, 7.5, 7.7, 7.8, 7.9, 8.1, 8.2, 8.3, 8.5, 9.0, 10.0):
+    for T in (6.0, 7.0, 7.5, 7.6, 7.7, 7.8, 7.9, 8.1, 8.2, 8.3, 8.5, 9.0, 10.0):
         cases[f"T {T:g} s"] = dict(period=T)
     for H in (0.5, 1.0, 1.5, 1.75, 2.0, 2.25, 3.0):
         cases[f"H {H:g} m"] = dict(height=H)
@@ -178,7 +183,8 @@ def rm3_floquet(which=None):
                          all_im=mu.imag.tolist(), sigma=float(r.growth_rates[0]),
                          residual=list(r.residual), n_x=len(r.x), wall_s=time.time() - t0,
                          mode_q={r.state_names[i]: abs(complex(v[i])) for i in q_idx})
-        print(f"{name:28s} μ₁ = {mu[0]:.5f} (|μ| {abs(mu[0]):.5f}), σ = {r.growth_rates[0]:+.5f} /s,"
+        print(f"{name:28s} μ₁ = {mu[0]:.5f} (|μ| {abs(mu[0]):.5f}), "
+              f"σ = {r.growth_rates[0]:+.5f} /s,"
               f" μ₂ = {mu[1]:.5f}, residual {r.residual[0]:.2g} → {r.residual[1]:.2g}, "
               f"{time.time() - t0:.0f} s", flush=True)
         path.write_text(json.dumps(out, indent=1))
@@ -227,12 +233,38 @@ def map_figure(plt, data):
 
 
 
+def leading(v):
+    """(μ, σ) of the largest multiplier other than the free surge's μ = 1 (|μ − 1| > 1e-3)."""
+    mu = np.asarray(v["all_re"]) + 1j * np.asarray(v["all_im"])
+    mu = mu[np.abs(mu - 1) > 1e-3]
+    m = mu[np.argmax(np.abs(mu))]
+    return m, float(np.log(abs(m)) / v["period"])
+
+
+def table():
+    """The variants of docs/stability.md as a markdown table."""
+    fq = json.loads((OUT / "floquet.json").read_text())
+    order = ["verlet exact dt 0.1", "drag C_D 1", "mooring 3e4 N/m", "mooring 3e5 N/m"]
+    order += sorted((k for k in fq if k.startswith("T ")), key=lambda k: fq[k]["period"])
+    order += sorted((k for k in fq if k.startswith("H ")), key=lambda k: fq[k]["height"])
+    print("| change | leading multiplier but the free surge's μ = 1 | \\|μ\\| | σ (s⁻¹) | stable |")
+    print("|---|---|---|---|---|")
+    for k in order:
+        m, sg = leading(fq[k])
+        mu = f"{m.real:+.5f}"
+        if abs(m.imag) > 1e-9:
+            mu += f" {'+' if m.imag >= 0 else '−'} {abs(m.imag):.5f}i"
+        name = "none (H 2.5 m, T 8 s)" if k == "verlet exact dt 0.1" else k
+        print(f"| {name} | {mu.replace('-', '−')} | {abs(m):.5f} | {sg:+.5f} | "
+              f"{'yes' if abs(m) <= 1 else '**no**'} |".replace("+-", "−").replace("| -", "| −"))
+
+
 def floquet_figure(plt, runs, fq):
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.8))
     ax = axes[0]
     key = "verlet state_space_exact dt 0.1"
     r = runs[key]
-    ax.plot(r["t"], r["pitch"], lw=0.4, color="0.6", label="pitch (rad)")
+    ax.plot(r["t"], np.abs(r["pitch"]), lw=0.4, color="0.6", label="|pitch| (rad)")
     ax.semilogy(r["env_t"], r["env"], ".", ms=3, label="|θ(t + 8 s) − θ(t)| per period (run)")
     sig = fq["verlet exact dt 0.1"]["sigma"]
     a, b = r["fit_window"]
@@ -261,14 +293,14 @@ def floquet_figure(plt, runs, fq):
     ax.set_title("Floquet multipliers μ (unit circle)")
     ax.legend(fontsize=7)
     ax = axes[2]
-    Ts = sorted((v["period"], v["sigma"]) for k, v in fq.items() if k.startswith("T ")
+    Ts = sorted((v["period"], leading(v)[1]) for k, v in fq.items() if k.startswith("T ")
                 or k == "verlet exact dt 0.1")
     ax.plot([a for a, _ in Ts], [b for _, b in Ts], "o-", label="wave period (H 2.5 m)")
     ax.axhline(0, color="0.5", lw=0.8)
     ax.set_xlabel("wave period T (s)")
-    ax.set_ylabel("σ = ln|μ₁|/T (1/s)")
+    ax.set_ylabel("σ = ln|μ|/T of the leading multiplier but surge's 1 (1/s)")
     ax2 = ax.twiny()
-    Hs = sorted((v["height"], v["sigma"]) for k, v in fq.items() if k.startswith("H ")
+    Hs = sorted((v["height"], leading(v)[1]) for k, v in fq.items() if k.startswith("H ")
                 or k == "verlet exact dt 0.1")
     ax2.plot([a for a, _ in Hs], [b for _, b in Hs], "s--", color="C1", label="wave height (T 8 s)")
     ax2.set_xlabel("wave height H (m)", color="C1")
@@ -283,5 +315,6 @@ def floquet_figure(plt, runs, fq):
 if __name__ == "__main__":
     warnings.simplefilter("ignore")
     what = sys.argv[1] if len(sys.argv) > 1 else "figures"
-    {"map": stability_map, "runs": rm3_runs,
-     "floquet": lambda: rm3_floquet(sys.argv[2:] or None), "figures": figures}[what]()
+    {"map": stability_map, "runs": lambda: rm3_runs(sys.argv[2:] or None),
+     "floquet": lambda: rm3_floquet(sys.argv[2:] or None), "figures": figures,
+     "table": table}[what]()
