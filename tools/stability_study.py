@@ -134,7 +134,8 @@ def rm3_runs(which=None):
                         pitch_max_3000_4000=float(np.abs(pitch[win(3000, 4000)]).max()),
                         power_kw_100_140=float(power[win(100, 140)].mean() / 1e3),
                         power_kw_3000_4000=float(power[win(3000, 4000)].mean() / 1e3),
-                        t=t[::5].tolist(), pitch=pitch[::5].tolist(),
+                        # the first 1000 s at 1 s for the figure
+                        t=t[t <= 1000.0][::5].tolist(), pitch=pitch[t <= 1000.0][::5].tolist(),
                         env_t=mids.tolist(), env=peaks.tolist())
         print(key, {k: v for k, v in out[key].items() if not isinstance(v, list)}, flush=True)
         OUT.mkdir(parents=True, exist_ok=True)
