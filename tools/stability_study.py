@@ -156,6 +156,8 @@ def rm3_floquet(which=None):
         "drag C_D 1": dict(model=rm3(drag=True)),
         "mooring 3e4 N/m": dict(loads=[mooring(base, 3e4)]),
         "mooring 3e5 N/m": dict(loads=[mooring(base, 3e5)]),
+        "PTO 0.6e6 N s/m": dict(model=base.replace(damping=base.damping.at[3].set(0.6e6))),
+        "PTO 2.4e6 N s/m": dict(model=base.replace(damping=base.damping.at[3].set(2.4e6))),
     }
     for T in (6.0, 7.0, 7.5, 7.6, 7.7, 7.8, 7.9, 8.1, 8.2, 8.3, 8.5, 9.0, 10.0):
         cases[f"T {T:g} s"] = dict(period=T)
@@ -245,7 +247,8 @@ def leading(v):
 def table():
     """The variants of docs/stability.md as a markdown table."""
     fq = json.loads((OUT / "floquet.json").read_text())
-    order = ["verlet exact dt 0.1", "drag C_D 1", "mooring 3e4 N/m", "mooring 3e5 N/m"]
+    order = ["verlet exact dt 0.1", "drag C_D 1", "mooring 3e4 N/m", "mooring 3e5 N/m",
+             "PTO 0.6e6 N s/m", "PTO 2.4e6 N s/m"]
     order += sorted((k for k in fq if k.startswith("T ")), key=lambda k: fq[k]["period"])
     order += sorted((k for k in fq if k.startswith("H ")), key=lambda k: fq[k]["height"])
     print("| change | leading multiplier but the free surge's μ = 1 | \\|μ\\| | σ (s⁻¹) | stable |")
