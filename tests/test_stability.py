@@ -120,27 +120,18 @@ damping = [{c!r}]
 """
 
 
-def _oscillator(tmp_path, m, k, c):
-    p = tmp_path / "osc.toml"
-    p.write_text(OSCILLATOR.format(m=m, k=k, c=c))
+@pytest.fixture(scope="module")
+def oscillator(tmp_path_factory):
+    """A one-coordinate spring–damper; set m, k, c with :func:`_osc` (one model, so the Floquet
+    tests share their compiled flow maps)."""
+    p = tmp_path_factory.mktemp("osc") / "osc.toml"
+    p.write_text(OSCILLATOR.format(m=1.0, k=1.0, c=0.0))
     return mfm.load(p)
 
 
-def test_floquet_of_a_time_invariant_system_is_the_step_power(tmp_path):
-    # LTI: the flow map over n steps is Gⁿ, so the multipliers are R(λ dt)ⁿ for RK4 (λ the
-    # eigenvalues of the oscillator), which tend to e^{λT}: exact to round-off against the
-    # discrete form (1e-10), to RK4's error against the continuous one (ω dt = 0.05: 1e-6)
-    m, k, c = 2.0, 8.0, 0.4
-    model = _oscillator(tmp_path, m, k, c)
-    T, dt = 3.0, 0.025
-    r = st.floquet(model, None, period=T, dt=dt, t_start=0.0, integrator="rk4", refine=0)
-    lam = np.roots([m, c, k])
-    z = lam * dt
-    R = 1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24
-    nonzero = np.sort_complex(r.multipliers[np.abs(r.multipliers) > 1e-8])
-    np.testing.assert_allclose(nonzero, np.sort_complex(R ** round(T / dt)), atol=1e-10)
-    np.testing.assert_allclose(nonzero, np.sort_complex(np.exp(lam * T)), atol=1e-6)
-    np.testing.assert_allclose(r.growth_rates[0], lam.real[0], rtol=1e-6)
+def _osc(model, m, k, c):
+    return model.replace(mass=jnp.asarray([m]), stiffness=jnp.asarray([k]),
+                         damping=jnp.asarray([c]))
 
 
 class _Mathieu(Load):
@@ -156,7 +147,7 @@ class _Mathieu(Load):
         return None
 
 
-def test_floquet_of_the_damped_mathieu_equation_against_scipy(tmp_path):
+def test_floquet_of_the_damped_mathieu_equation_against_scipy(oscillator):
     # m q̈ + c q̇ + k (1 + ε cos 2ω₀t) q = 0 in its first instability tongue: the monodromy over
     # the forcing period π/ω₀ by scipy's solve_ivp (rtol 1e-11, an independent integrator) against
     # the engine's (RK4, dt = T/400: RK4's error over one period ≈ 1e-9); 1e-7 on the multipliers.
@@ -168,7 +159,7 @@ def test_floquet_of_the_damped_mathieu_equation_against_scipy(tmp_path):
     w0 = math.sqrt(k / m)
     c = 2 * zeta * w0 * m
     T = math.pi / w0
-    model = _oscillator(tmp_path, m, k, c)
+    model = _osc(oscillator, m, k, c)
     load = _Mathieu(k=k, eps=eps, Omega=2 * w0)
     dt = T / 400
     r = st.floquet(model, None, period=T, dt=dt, t_start=0.0, integrator="rk4", loads=[load],
@@ -186,6 +177,26 @@ def test_floquet_of_the_damped_mathieu_equation_against_scipy(tmp_path):
     assert r.growth_rates[0] == pytest.approx(eps * w0 / 4 - zeta * w0, rel=0.1)
 
 
+def test_floquet_of_a_time_invariant_system_is_the_step_power(oscillator):
+    # LTI (the Mathieu load below with ε = 0: the same compiled flow map): the flow map over n
+    # steps is Gⁿ, so the multipliers are R(λ dt)ⁿ for RK4 (λ the eigenvalues of the oscillator),
+    # which tend to e^{λT}: exact to round-off against the discrete form (1e-10), to RK4's error
+    # against the continuous one (ω dt = 0.016: 1e-8 over the period; 1e-6)
+    m, k, c = 2.0, 8.0, 0.4
+    model = _osc(oscillator, m, k, c)
+    T, n = math.pi, 400
+    dt = T / n
+    r = st.floquet(model, None, period=T, dt=dt, t_start=0.0, integrator="rk4", refine=0,
+                   loads=[_Mathieu(k=k, eps=0.0, Omega=2.0)])
+    lam = np.roots([m, c, k])
+    z = lam * dt
+    R = 1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24
+    nonzero = np.sort_complex(r.multipliers[np.abs(r.multipliers) > 1e-8])
+    np.testing.assert_allclose(nonzero, np.sort_complex(R ** n), atol=1e-10)
+    np.testing.assert_allclose(nonzero, np.sort_complex(np.exp(lam * T)), atol=1e-6)
+    np.testing.assert_allclose(r.growth_rates[0], lam.real[0], rtol=1e-6)
+
+
 def test_envelope_growth_rate_of_a_synthetic_run():
     # a T-periodic forced part plus a growing period-doubled one: the fit must return σ (1e-3:
     # the per-period peak of a sampled sinusoid is within 0.02 % of its envelope at 40 samples)
@@ -198,7 +209,7 @@ def test_envelope_growth_rate_of_a_synthetic_run():
 
 # -- bad arguments --------------------------------------------------------------------------------
 
-def test_bad_arguments_name_the_argument_value_and_what_is_accepted(tmp_path):
+def test_bad_arguments_name_the_argument_value_and_what_is_accepted(oscillator):
     with pytest.raises(ValueError, match=r"added_mass='middle'; accepted: 'lhs'.*'rhs'"):
         st.amplification_matrix("rk4", 0.1, 1.0, 0.0, 1.0, added_mass="middle")
     with pytest.raises(ValueError, match=r"integrator='euler' is not known; accepted"):
@@ -210,7 +221,7 @@ def test_bad_arguments_name_the_argument_value_and_what_is_accepted(tmp_path):
     with pytest.raises(ValueError, match=r"added_mass='rhs' with integrator='rk4'.*accepted: "
                                          r"integrator='beeman'"):
         st.largest_stable_dt("rk4", 1.0, 0.0, 1.0, A_inf=0.5, added_mass="rhs")
-    model = _oscillator(tmp_path, 1.0, 1.0, 0.1)
+    model = _osc(oscillator, 1.0, 1.0, 0.1)
     with pytest.raises(ValueError, match=r"period: 1.05 s is not a whole number of steps of "
                                          r"dt = 0.1 s"):
         st.floquet(model, None, period=1.05, dt=0.1, t_start=0.0, integrator="rk4")
