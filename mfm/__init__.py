@@ -18,9 +18,10 @@ from .kinematics import b_matrix, b_matrix_dot, body_poses, kinematics  # noqa: 
 from .model import Model  # noqa: E402
 from .simulate import AccuracyWarning, SimulationError, StabilityWarning, rollout, simulate, simulate_batch  # noqa: E402
 from .tree import ConfigError  # noqa: E402
+from .sweep import SweepError, sweep  # noqa: E402
 
 __all__ = ["AccuracyWarning", "ConfigError", "Model", "SimulationError", "b_matrix", "b_matrix_dot", "body_poses",
            "compile_tree", "config", "coriolis_matrix", "energies", "equilibrium", "evaluate",
            "forward_dynamics", "frequency_response", "natural_frequencies", "water",
            "integrators", "kinematics", "load", "loads", "mass_matrix", "reaction_loads",
-           "results", "rollout", "se3", "simulate", "simulate_batch", "StabilityWarning", "wec"]
+           "results", "rollout", "se3", "simulate", "simulate_batch", "StabilityWarning", "sweep", "SweepError", "wec"]
