@@ -252,9 +252,8 @@ def sweep(model, seas, *, dt, n_steps: int, chunk_size: int = 16, client=None,
     c, to_close, scheduler = _open_client(client, n_workers)
     workers = 1
     try:
-        bar = _simulate._progress_bar(progress, len(todo), f"{m0.name} sweep of {B}")
-        if bar is not None:
-            bar.unit = "chunk"
+        bar = _simulate._progress_bar(None if progress is None else {"unit": "chunk", **progress},
+                                      len(todo), f"{m0.name} sweep of {B}")
         results = {}
         args = dict(n_steps=int(n_steps), options=options, vary_loads=vary_loads)
         if c is None:
