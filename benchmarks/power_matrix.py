@@ -3,8 +3,8 @@
     python benchmarks/power_matrix.py [--workers 1 2] [--chunk-size 16] [--n-steps 20000]
                                       [--skip-batch]
 
-10 H_s (0.01–0.06 m) × 12 T_p (0.8–1.8 s) JONSWAP (γ 3.3, seed 1, ω 1–25 rad/s, the sea states of
-benchmarks/speed.py), 100 T_p at dt = T_p/200 (20,000 steps) each, ramp 5 T_p, Verlet with the
+10 H_s (0.01–0.06 m) × 12 T_p (0.8–1.8 s) JONSWAP (γ 3.3, seed 1, ω 1–25 rad/s, the sea
+states of benchmarks/speed.py), 100 T_p at dt = T_p/200 (20,000 steps) each, ramp 5 T_p, Verlet with the
 exact state-space radiation, every 10th step kept. Each way of running it is a fresh child process
 (its own compilation, fit and peak memory): one in-process ``simulate_batch`` over the 120 cases;
 ``mfm.sweep`` in this process in chunks; ``mfm.sweep`` on a ``LocalCluster`` of N single-threaded

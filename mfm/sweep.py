@@ -20,10 +20,8 @@ from __future__ import annotations
 import collections
 import hashlib
 import importlib
-import math
 import numbers
 import pickle
-import sys
 import time
 import traceback
 from dataclasses import dataclass
@@ -61,8 +59,8 @@ class _Chunk:
 
 
 def plan_chunks(n_cases: int, chunk_size: int) -> list[_Chunk]:
-    """Split n_cases into ⌈n_cases / chunk_size⌉ chunks of one size s = ⌈n_cases / n_chunks⌉ ≤
-    chunk_size (balanced: 120 cases at chunk_size 16 are 8 chunks of 15, no padding); the last
+    """Split n_cases into ⌈n_cases / chunk_size⌉ chunks of one size
+    s = ⌈n_cases / n_chunks⌉ ≤ chunk_size (balanced: 120 cases at chunk_size 16 are 8 chunks of 15, no padding); the last
     chunk is padded to s by repeating its last case."""
     n_chunks = -(-n_cases // chunk_size)
     size = -(-n_cases // n_chunks)
@@ -90,10 +88,7 @@ def _run_chunk(models, token, cases, n_real, seas, dts, ramps, n_steps, options,
                 models = kept
                 _WORKER_MODELS.move_to_end(token)
         m = [models[i] for i in cases] if isinstance(models, list) else models
-        vl = None
-        if vary_loads is not None:
-            def vl(i, loads):
-                return vary_loads(int(cases[i]), loads)
+        vl = None if vary_loads is None else (lambda i, loads: vary_loads(int(cases[i]), loads))
         ds = _simulate.simulate_batch(m, list(seas), dt=np.asarray(dts), ramp=np.asarray(ramps),
                                       n_steps=n_steps, vary_loads=vl, **options)
         ds = ds.isel(case=slice(0, n_real)).assign_coords(case=np.asarray(cases[:n_real]))
@@ -154,8 +149,12 @@ def _open_client(client, n_workers):
                              "scheduler address such as 'tcp://10.0.0.1:8786', or a "
                              "distributed.Client") from None
         return c, [c], client
-    if type(client).__name__ == "Client" and hasattr(client, "submit"):
-        return client, [], str(getattr(client, "scheduler", None) and client.scheduler.address)
+    try:
+        import distributed
+    except ImportError:             # then it cannot be a Client either
+        distributed = None
+    if distributed is not None and isinstance(client, distributed.Client):
+        return client, [], str(client.scheduler.address)
     raise ValueError(f"client: {client!r}; give None (the chunks in this process), 'local' (a "
                      "distributed.LocalCluster), a scheduler address such as "
                      "'tcp://10.0.0.1:8786', or a distributed.Client")
@@ -173,8 +172,8 @@ def sweep(model, seas, *, dt, n_steps: int, chunk_size: int = 16, client=None,
         Model: one topology, one hydro spec), as ``simulate_batch`` takes.
     seas: a sea state or one per case (``hydro.waves``; None for still water).
     dt, ramp: s, one number or one per case. n_steps: steps of every case.
-    chunk_size: the most cases per vmapped call. The cases are split into ⌈B / chunk_size⌉ chunks
-        of one size (the last padded by repeating a case, dropped after): one compilation per
+    chunk_size: the most cases per vmapped call. The cases are split into ⌈B / chunk_size⌉
+        chunks of one size (the last padded by repeating a case, dropped after): one compilation per
         process.
     client: None (default: the chunks one after another in this process; no dask needed),
         ``"local"`` (a ``distributed.LocalCluster`` of ``n_workers`` single-threaded worker
@@ -195,8 +194,8 @@ def sweep(model, seas, *, dt, n_steps: int, chunk_size: int = 16, client=None,
 
     Returns ``simulate_batch``'s dataset (case, step, coordinate; sea labels ``sea_hs``,
     ``sea_tp``, ``sea_gamma``, ``sea_heading``, … and the parameters as coordinates on ``case``)
-    with ``sweep_chunk`` (case) the chunk each case ran in and ``failed`` (case) True where its chunk
-    failed (its data NaN; the attribute ``sweep_failed_chunks`` names each such chunk, its cases
+    with ``sweep_chunk`` (case) the chunk each case ran in and ``failed`` (case) True where its
+    chunk failed (its data NaN; the attribute ``sweep_failed_chunks`` names each such chunk, its cases
     and its error), and the sweep's settings in the attributes (``sweep_chunk_size``,
     ``sweep_chunks``, ``sweep_scheduler``, ``sweep_workers``, ``sweep_wall_s``). A power matrix:
     ``ds.set_index(case=["sea_hs", "sea_tp"]).unstack("case")``.
@@ -216,7 +215,8 @@ def sweep(model, seas, *, dt, n_steps: int, chunk_size: int = 16, client=None,
         raise ValueError(f"n_workers: {n_workers!r} applies to client='local' only (client is "
                          f"{client!r})")
     if vary_loads is not None and not callable(vary_loads):
-        raise ValueError(f"vary_loads: {vary_loads!r}; give a function (case_index, loads) -> loads")
+        raise ValueError(f"vary_loads: {vary_loads!r}; give a function (case_index, loads) -> "
+                         "loads")
     progress = _simulate._progress_options(progress)
     if isinstance(n_steps, bool) or not isinstance(n_steps, numbers.Integral) or n_steps < 1:
         raise ValueError(f"n_steps: {n_steps!r} must be a whole number ≥ 1")
@@ -409,7 +409,8 @@ def _gather(results, chunks, resume, B, seas_l, dts, params, options, ramp, swee
     else:
         ds["dt"] = ("case", dts, ds["dt"].attrs)
     chunk_of = np.concatenate([np.full(c.n_real, c.index) for c in chunks])
-    ds = ds.assign_coords(sweep_chunk=("case", chunk_of, {"long_name": "the chunk each case ran in"}))
+    ds = ds.assign_coords(sweep_chunk=("case", chunk_of,
+                                       {"long_name": "the chunk each case ran in"}))
     ds["failed"] = ("case", failed_cases, {"long_name": "the case's chunk failed: its data are NaN "
                                            "(see the attribute sweep_failed_chunks)"})
     report = []

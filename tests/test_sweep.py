@@ -3,9 +3,11 @@ processes, against one in-process ``simulate_batch`` over the same cases (the in
 reference: one vmapped call, no chunks, no pickling, no cluster); a failed chunk marked and rerun
 alone; bad arguments.
 
-Cost (2 shared cores): two compilations of RM3 here (the reference's 4-case shape, the chunks'
-2-case shape), a cluster of two workers (start and one compilation per worker, in parallel);
-the M4 134 power matrix through it is measured by benchmarks/power_matrix.py.
+Cost: two compilations of RM3 here (the reference's 4-case shape, the chunks' 2-case shape; the
+other tests reuse them or compile nothing) and a cluster of two workers (its start, one cheap-XLA
+compilation per worker, in parallel): 67–94 s of CPU in this process, 116–233 s of wall time on the
+2 shared cores at load 8–12 (`pytest -n 0 tests/test_sweep.py --durations=10`, 2026-11-23). The
+M4 134 power matrix through a sweep is measured by benchmarks/power_matrix.py.
 """
 import os
 import sys
@@ -174,7 +176,8 @@ def test_two_worker_cluster_equals_one_batch_and_compiles_once_per_worker(rm3, s
              " --xla_llvm_disable_expensive_passes=true").strip()
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None,
-                                  env={"XLA_FLAGS": flags, "OPENBLAS_NUM_THREADS": "1"}) as cluster, \
+                                  env={"XLA_FLAGS": flags, "OPENBLAS_NUM_THREADS": "1"}
+                                  ) as cluster, \
             distributed.Client(cluster) as client:
         # the same call given a scheduler address: 3 chunks on 2 workers
         ds = mfm.sweep(rm3, seas + seas[:1], dt=0.1, chunk_size=2,
