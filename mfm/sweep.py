@@ -41,6 +41,10 @@ BATCH_OPTIONS = ("integrator", "radiation", "state_space_options", "memory", "sa
 _WORKER_MODELS: collections.OrderedDict = collections.OrderedDict()
 _WORKER_MODELS_KEPT = 4
 
+# names of simulate_batch's result and the sweep's own: not parameter names
+RESERVED = ("case", "step", "coordinate", "coordinate_unit", "pto", "time", "q", "qd", "dt",
+            "pto_power", "pto_displacement", "eta", "failed", "sweep_chunk")
+
 
 class SweepError(RuntimeError):
     """Every chunk of a sweep failed: there is nothing to gather. ``errors`` lists each chunk's
@@ -333,6 +337,10 @@ def _parameter_labels(parameters, B):
             arr = None
         if not isinstance(name, str) or arr is None or arr.shape != (B,):
             raise ValueError(f"parameters[{name!r}]: {v!r}; give one number per case ({B} cases)")
+        if name in RESERVED or name.startswith("sea_"):
+            raise ValueError(f"parameters: {name!r} is a name of the result already (its "
+                             f"variables {sorted(RESERVED)} and the sea labels sea_*); choose "
+                             "another name")
         out[name] = (arr, {"long_name": "sweep parameter", **({"units": units} if units else {})})
     return out
 
@@ -396,9 +404,8 @@ def _gather(results, chunks, resume, B, seas_l, dts, params, options, ramp, swee
     ds = ds.assign_coords(case=np.arange(B))
     # labels and dt from the arguments (a failed chunk's template carries another case's)
     for name, (values, attrs) in {**_simulate._sea_labels(seas_l), **params}.items():
-        if name in ds.data_vars:
-            raise ValueError(f"parameters: {name!r} is already a variable of the result; choose "
-                             "another name")
+        if name in ds.data_vars:        # a load's output of that name: keep both
+            name = f"parameter_{name}"
         ds = ds.assign_coords({name: ("case", np.asarray(values), attrs)})
     failed_cases = np.zeros(B, dtype=bool)
     for k in failed:

@@ -146,6 +146,8 @@ def test_bad_arguments_name_the_argument_and_what_is_accepted(rm3, seas):
                       (dict(n_workers=2), "n_workers: 2 applies to client='local'"),
                       (dict(parameters={"c": [1.0]}), r"parameters\['c'\]: \[1.0\]; give one "
                                                       "number per case \\(4 cases\\)"),
+                      (dict(parameters={"q": [1.0] * 4}), "parameters: 'q' is a name of the "
+                                                            "result already"),
                       (dict(resume=xr.Dataset()), "resume: Dataset; give the dataset"),
                       (dict(progress="yes"), "progress: 'yes'"),
                       (dict(dt=[0.1, 0.1]), "one length or 1"),
