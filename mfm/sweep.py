@@ -141,8 +141,15 @@ def _open_client(client, n_workers):
     if isinstance(client, str):
         distributed = _distributed()
         if client == "local":
-            cluster = distributed.LocalCluster(n_workers=n_workers, threads_per_worker=1,
-                                               processes=True, dashboard_address=None)
+            try:
+                cluster = distributed.LocalCluster(n_workers=n_workers, threads_per_worker=1,
+                                                   processes=True, dashboard_address=None)
+            except RuntimeError as e:
+                # the usual cause: the workers are new processes that import the main script
+                raise RuntimeError(
+                    f"client='local': the LocalCluster's workers did not start ({e}). A script "
+                    "that starts one needs its code under `if __name__ == '__main__':` (the "
+                    "workers import the script); or run the chunks here with client=None") from e
             c = distributed.Client(cluster)
             return c, [c, cluster], f"LocalCluster ({len(cluster.workers)} workers)"
         try:
