@@ -5,8 +5,8 @@ alone; bad arguments.
 
 Cost: two compilations of RM3 here (the reference's 4-case shape, the chunks' 2-case shape; the
 other tests reuse them or compile nothing) and a cluster of two workers (its start, one cheap-XLA
-compilation per worker, in parallel): 67–94 s of CPU in this process, 116–233 s of wall time on the
-2 shared cores at load 8–12 (`pytest -n 0 tests/test_sweep.py --durations=10`, 2026-11-23). The
+compilation per worker, in parallel): 56 s of wall time on the 2 shared cores at load ~5, 116–233 s
+at load 8–12 (`pytest -n 0 tests/test_sweep.py --durations=10`, 2026-11-23). The
 M4 134 power matrix through a sweep is measured by benchmarks/power_matrix.py.
 """
 import os
