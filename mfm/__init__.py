@@ -20,9 +20,10 @@ from .simulate import AccuracyWarning, SimulationError, StabilityWarning, rollou
 from . import stability  # noqa: E402
 from .stability import amplification_matrix, floquet, largest_stable_dt  # noqa: E402
 from .tree import ConfigError  # noqa: E402
+from .sweep import SweepError, sweep  # noqa: E402
 
 __all__ = ["AccuracyWarning", "amplification_matrix", "floquet", "largest_stable_dt", "stability", "ConfigError", "Model", "SimulationError", "b_matrix", "b_matrix_dot", "body_poses",
            "compile_tree", "config", "coriolis_matrix", "energies", "equilibrium", "evaluate",
            "forward_dynamics", "frequency_response", "natural_frequencies", "water",
            "integrators", "kinematics", "load", "loads", "mass_matrix", "reaction_loads",
-           "results", "rollout", "se3", "simulate", "simulate_batch", "StabilityWarning", "wec"]
+           "results", "rollout", "se3", "simulate", "simulate_batch", "StabilityWarning", "sweep", "SweepError", "wec"]
