@@ -1,0 +1,191 @@
+"""Model no more than a scene needs: the fidelity ladder and :func:`reduce`, which picks its
+cheapest level whose answer stays within a tolerance of the full model on the scene.
+
+The levels, cheapest first:
+
+- ``"spectral"``: the linear frequency-domain response summed over the sea's components
+  (:func:`mfm.spectral.spectral_response`), no time stepping. Linear about the equilibrium: no
+  drag, no large rotations, no stops.
+- ``"fast"``: the full nonlinear model stepped once per step (``integrator="verlet"``) with the
+  radiation states advanced exactly (``radiation="state_space_exact"``): second order in dt.
+- ``"full"``: the full nonlinear model with RK4 and the engine's default radiation
+  (``radiation="auto"``), the reference.
+
+Whether a level holds is measured, not guessed: :func:`reduce` runs the full model and each cheaper
+level on a pilot window of the scene (the same sea, the same components and phases, so the time
+series agree sample by sample where the model is linear) and compares the scene's outputs — the
+mean power of each PTO and the standard deviation of named coordinates — over the pilot's settled
+part. A level is chosen when every output is within ``tolerance``; the cost is a pilot of the full
+model, paid once for a scene that is then run long or swept.
+"""
+from __future__ import annotations
+
+import importlib
+import math
+import numbers
+import time as _time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .model import Model
+
+LEVELS = ("spectral", "fast", "full")
+# the run options each time-domain level gives mfm.simulate
+LEVEL_OPTIONS = {"fast": {"integrator": "verlet", "radiation": "state_space_exact"},
+                 "full": {"integrator": "rk4", "radiation": "auto"}}
+
+
+def _sea_period(sea, period):
+    if period is not None:
+        return period
+    for name in ("tp", "period"):
+        v = getattr(sea, name, None)
+        if isinstance(v, numbers.Real):
+            return float(v)
+    raise ValueError(f"sea: {sea!r} has no peak period (tp) or period; give period= (s), the "
+                     "period that sets the pilot's length and time step")
+
+
+@dataclass(frozen=True)
+class Reduction:
+    """The answer of :func:`reduce`.
+
+    level: the chosen level (one of :data:`LEVELS`). options: what :func:`mfm.simulate` is given
+    for it (empty for "spectral"). errors: {level: {output: relative error against "full"}} on the
+    pilot. wall_s: {level: s} the warm wall time of each level on the pilot. reason: why this
+    level, in words. tolerance, dt, pilot: the settings of the measurement.
+    """
+    level: str
+    options: dict
+    errors: dict
+    wall_s: dict
+    reason: str
+    tolerance: float
+    dt: float
+    pilot: tuple = field(default=())
+
+    def run(self, model: Model, sea, *, duration: float, ramp: float | None = None):
+        """Run the scene at the chosen level: a dataset with ``time``, ``q``, ``qd`` and
+        ``pto_power`` whichever the level (spectral: synthesised on the same time grid; no ramp,
+        its response is the steady state)."""
+        duration = _positive(duration, "duration")
+        if self.level == "spectral":
+            from .spectral import spectral_response
+            t = self.dt * np.arange(int(round(duration / self.dt)) + 1)
+            return spectral_response(model, sea, t=t)
+        simulate = importlib.import_module("mfm.simulate").simulate
+        ramp = self.pilot[1] if ramp is None else ramp
+        return simulate(model, sea, duration=duration, dt=self.dt, ramp=ramp, **self.options)
+
+
+def _positive(value, what):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value) \
+            or value <= 0:
+        raise ValueError(f"{what}: {value!r}; give a positive number")
+    return float(value)
+
+
+def _measures(ds, window, coordinates):
+    """Mean power per PTO (W) and the standard deviation of named coordinates over the window."""
+    sel = ds.sel(time=window)
+    out = {f"pto_power[{p}]": float(sel.pto_power.sel(pto=p).mean()) for p in
+           ds.pto.values} if "pto_power" in ds else {}
+    for c in coordinates:
+        out[f"std[{c}]"] = float(sel.q.sel(coordinate=c).std())
+    return out
+
+
+def _errors(measured, reference):
+    """Relative errors: each PTO against the total mean power (a PTO that absorbs little does not
+    inflate the error), each standard deviation against its own."""
+    total = sum(abs(v) for k, v in reference.items() if k.startswith("pto_power")) or 1.0
+    out = {}
+    for k, ref in reference.items():
+        scale = total if k.startswith("pto_power") else (abs(ref) or 1.0)
+        out[k] = abs(measured[k] - ref) / scale
+    return out
+
+
+def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period=None,
+           pilot_periods: float = 40.0, settle_periods: float = 15.0,
+           steps_per_period: int = 200, levels=LEVELS, timing: bool = True) -> Reduction:
+    """The cheapest level of the fidelity ladder (module docstring) whose mean PTO powers and
+    coordinate standard deviations stay within ``tolerance`` of the full model on a pilot run of
+    the scene.
+
+    model: a Model with hydrodynamics; sea: its sea state (:mod:`hydro.waves`).
+    tolerance: the largest relative error accepted (0.02 = 2 %): each PTO's mean power against the
+    total mean power, each named coordinate's standard deviation against its own.
+    coordinates: coordinate names whose standard deviation counts too (free coordinates without
+    restoring drift in the time domain and should not be named).
+    period: s, the scene's period (default the sea's ``tp`` or ``period``); the pilot runs
+    ``pilot_periods`` periods at dt = period / ``steps_per_period`` with a ramp of 5 periods, and
+    compares the part after ``settle_periods`` periods.
+    levels: the levels to consider ("full" is always run: it is the reference).
+    timing: run each level a second time for its warm wall time (compiled, fitted: what a long
+    run or a sweep pays per run), reported in ``wall_s`` and the reason; False runs each once and
+    reports no times.
+
+    Returns a :class:`Reduction`; ``reduction.run(model, sea, duration=...)`` runs the scene at the
+    chosen level. Refuses a cheaper level (returns "full", saying why) when none is within the
+    tolerance, e.g. large motions where the linear answer is wrong.
+    """
+    tolerance = _positive(tolerance, "tolerance")
+    if model.hydro is None:
+        raise ValueError(f"model {model.name!r} has no hydrodynamics: the fidelity ladder is that "
+                         "of a floating model in a sea")
+    if sea is None or not hasattr(sea, "components"):
+        raise ValueError(f"sea: {sea!r}; give a sea state of hydro.waves")
+    levels = tuple(levels)
+    bad = [lv for lv in levels if lv not in LEVELS]
+    if bad or not levels:
+        raise ValueError(f"levels: {levels!r}; accepted: a non-empty subset of {LEVELS}")
+    names = list(model.coordinates)
+    bad = [c for c in coordinates if c not in names]
+    if bad:
+        raise ValueError(f"coordinates: {bad} are not coordinates of {model.name!r}; accepted: "
+                         f"{names}")
+    T = _positive(_sea_period(sea, period), "period")
+    pilot_periods = _positive(pilot_periods, "pilot_periods")
+    settle_periods = _positive(settle_periods, "settle_periods")
+    if settle_periods >= pilot_periods:
+        raise ValueError(f"settle_periods: {settle_periods} must be less than pilot_periods "
+                         f"({pilot_periods}): nothing would be compared")
+    if isinstance(steps_per_period, bool) or not isinstance(steps_per_period, numbers.Integral) \
+            or steps_per_period < 10:
+        raise ValueError(f"steps_per_period: {steps_per_period!r}; give a whole number ≥ 10")
+    dt = T / int(steps_per_period)
+    duration, ramp = pilot_periods * T, 5.0 * T
+    window = slice(settle_periods * T, None)
+    def timed(level):
+        fn = lambda: Reduction(level, LEVEL_OPTIONS.get(level, {}), {}, {}, "", tolerance, dt,  # noqa: E731
+                               (duration, ramp)).run(model, sea, duration=duration)
+        ds = fn()
+        if not timing:
+            return ds, None
+        start = _time.perf_counter()
+        fn()
+        return ds, _time.perf_counter() - start
+
+    ref, wall_full = timed("full")
+    reference = _measures(ref, window, coordinates)
+    errors, wall = {"full": {k: 0.0 for k in reference}}, {"full": wall_full}
+    for level in [lv for lv in LEVELS if lv in levels and lv != "full"]:
+        ds, wall[level] = timed(level)
+        errors[level] = _errors(_measures(ds, window, coordinates), reference)
+    within = [lv for lv in LEVELS if lv in errors and max(errors[lv].values(), default=0.0) <= tolerance]
+    level = within[0]
+    worst = {lv: max(errors[lv].values(), default=0.0) for lv in errors}
+    if level == "full":
+        reason = ("no cheaper level within the tolerance: " + ", ".join(
+            f"{lv} {worst[lv]:.3g}" for lv in errors if lv != "full") + f" > {tolerance:g}")
+    else:
+        reason = (f"{level}: largest error {worst[level]:.3g} ≤ {tolerance:g} on a pilot of "
+                  f"{pilot_periods:g} periods")
+        if timing:
+            reason += f", {wall_full / wall[level]:.3g}× faster than full"
+    if not timing:
+        wall = {}
+    return Reduction(level, LEVEL_OPTIONS.get(level, {}), errors, wall, reason, tolerance, dt,
+                     (duration, ramp))
