@@ -57,10 +57,8 @@ def test_notebook_runs_in_smoke_mode(path, monkeypatch):
 def run_in_smoke_mode(path, monkeypatch):
     monkeypatch.setenv("MFM_SMOKE", "1")
     monkeypatch.setenv("MPLBACKEND", "Agg")
-    # compiling is most of a smoke run: XLA's cheapest optimisation in the kernel (the same
-    # numbers to round-off; the short runs of smoke mode do not mind slower steps)
-    monkeypatch.setenv("XLA_FLAGS", (os.environ.get("XLA_FLAGS", "") + " --xla_backend_optimization_level=0"
-                                     " --xla_llvm_disable_expensive_passes=true").strip())
+    # the kernel inherits XLA_FLAGS: conftest's cheapest optimisation (compiling is most of a
+    # smoke run)
     # the kernel starts in notebooks/: put this checkout first, not whatever `pip install -e`
     # points at (another worktree's code would be tested otherwise)
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))

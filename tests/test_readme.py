@@ -60,12 +60,10 @@ def test_readme_python_blocks_run(tmp_path):
         (tmp_path / name).symlink_to(ROOT / name)
     (tmp_path / "blocks.json").write_text(json.dumps(blocks))
     (tmp_path / "runner.py").write_text(RUNNER)
-    # XLA's cheapest optimisation: compiling is most of these short runs (as in the notebooks'
-    # smoke runs)
+    # os.environ carries conftest's XLA_FLAGS (the cheapest optimisation: compiling is most of
+    # these short runs)
     env = dict(os.environ, MFM_SMOKE="1", MPLBACKEND="Agg", PYTHONPATH=str(ROOT),
-               OPENBLAS_NUM_THREADS="1",
-               XLA_FLAGS=(os.environ.get("XLA_FLAGS", "") + " --xla_backend_optimization_level=0"
-                          " --xla_llvm_disable_expensive_passes=true").strip())
+               OPENBLAS_NUM_THREADS="1")
     r = subprocess.run([sys.executable, "runner.py", "blocks.json"], cwd=tmp_path, env=env,
                        capture_output=True, text=True, timeout=900)
     print(r.stdout[-3000:])
