@@ -158,6 +158,7 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
     dt = T / int(steps_per_period)
     duration, ramp = pilot_periods * T, 5.0 * T
     window = slice(settle_periods * T, None)
+
     def timed(level):
         fn = lambda: Reduction(level, LEVEL_OPTIONS.get(level, {}), {}, {}, "", tolerance, dt,  # noqa: E731
                                (duration, ramp)).run(model, sea, duration=duration)
@@ -185,6 +186,10 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
                   f"{pilot_periods:g} periods")
         if timing:
             reason += f", {wall_full / wall[level]:.3g}× faster than full"
+        refused = [lv for lv in LEVELS[:LEVELS.index(level)] if lv in errors]
+        if refused:
+            reason += "; refused: " + ", ".join(f"{lv} {worst[lv]:.3g} > {tolerance:g}"
+                                                for lv in refused)
     if not timing:
         wall = {}
     return Reduction(level, LEVEL_OPTIONS.get(level, {}), errors, wall, reason, tolerance, dt,
