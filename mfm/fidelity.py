@@ -21,7 +21,6 @@ model, paid once for a scene that is then run long or swept.
 from __future__ import annotations
 
 import importlib
-import math
 import numbers
 import time as _time
 from dataclasses import dataclass, field
@@ -29,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .model import Model
+from .spectral import _check_sea
 
 LEVELS = ("spectral", "fast", "full")
 # the run options each time-domain level gives mfm.simulate
@@ -80,10 +80,7 @@ class Reduction:
 
 
 def _positive(value, what):
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value) \
-            or value <= 0:
-        raise ValueError(f"{what}: {value!r}; give a positive number")
-    return float(value)
+    return importlib.import_module("mfm.simulate")._number(value, what, positive=True)
 
 
 def _measures(ds, window, coordinates):
@@ -135,8 +132,7 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: the fidelity ladder is that "
                          "of a floating model in a sea")
-    if sea is None or not hasattr(sea, "components"):
-        raise ValueError(f"sea: {sea!r}; give a sea state of hydro.waves")
+    _check_sea(sea)
     levels = tuple(levels)
     bad = [lv for lv in levels if lv not in LEVELS]
     if bad or not levels:

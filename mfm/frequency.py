@@ -218,6 +218,14 @@ def _terms(model, sys, omega, heading, options):
     return Z, F
 
 
+def _amplitudes(model, sys, omega, heading, options):
+    """x̂ (n_ω, n_q) per metre of wave amplitude: [−ω² M − iω C + K + Σ Z_load(ω)] x̂ = F(ω, β)."""
+    Zl, F = _terms(model, sys, omega, heading, options)
+    w = omega[:, None, None]
+    Z = -w**2 * sys.M[None] - 1j * w * sys.C[None] + sys.K[None] + Zl
+    return np.linalg.solve(Z, F[..., None])[..., 0]
+
+
 def _reaction_function(model, loads):
     """The joint reactions of :func:`mfm.simulate` (``_record``: every load's
     :meth:`~mfm.loads.base.Load.reaction_loads` on the bodies, gravity, then
@@ -353,10 +361,7 @@ def frequency_response(model: Model, omega, heading: float = 0.0, *, q0=None,
     heading = float(heading)
     options = {"radiation": radiation, "state_space_options": state_space_options}
     sys = linear_system(model, q0, loads=loads)
-    Zl, F = _terms(model, sys, omega, heading, options)
-    w = omega[:, None, None]
-    Z = -w**2 * sys.M[None] - 1j * w * sys.C[None] + sys.K[None] + Zl
-    x = np.linalg.solve(Z, F[..., None])[..., 0]
+    x = _amplitudes(model, sys, omega, heading, options)
     extra = [ld.frequency_outputs(model, sys.kin0, x, omega) for ld in sys.loads]
     reactions = _joint_reactions(model, sys, omega, heading, options, x) if joint_reactions else None
     settings = {"radiation": radiation}

@@ -27,23 +27,10 @@ from . import frequency as _fd
 from . import results
 from .model import Model
 
-# time samples per block of the harmonic sum (n_t × n_ω complex exponentials: ~25 MB at 300 ω)
-_BLOCK = 4096
-
-
 def _check_sea(sea):
     if sea is None or not hasattr(sea, "components"):
         raise ValueError(f"sea: {sea!r}; give a sea state of hydro.waves (Regular, Jonswap, "
                          "PiersonMoskowitz, UserSpectrum, ...)")
-
-
-def _harmonic(t, omega, coef):
-    """Re Σ_j coef_j e^{−iω_j t} for t (n_t,), coef (n_ω, k) → (n_t, k), in blocks of time."""
-    out = np.empty((t.size, coef.shape[1]))
-    for s in range(0, t.size, _BLOCK):
-        e = np.exp(-1j * np.outer(t[s:s + _BLOCK], omega))
-        out[s:s + _BLOCK] = (e @ coef).real
-    return out
 
 
 def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
@@ -63,7 +50,8 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
     = c q̇² (W) and ``eta`` (time) the elevation at the origin (m). Attributes: provenance, the
     sea, ``level = "spectral"``, ``n_components`` and the wall time of the synthesis.
     """
-    from hydro.waves import elevation
+    # the harmonic sum of the time-domain excitation and elevation (hydro.waves), chunked over t
+    from hydro.waves import _harmonic_sum, elevation
 
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: spectral_response needs a "
@@ -84,11 +72,7 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
     x = np.zeros((len(comps), n), dtype=complex)
     for beta in np.unique(comps.heading):
         sel = comps.heading == beta
-        w = comps.omega[sel]
-        Zl, F = _fd._terms(model, sys, w, float(beta), options)
-        ww = w[:, None, None]
-        Z = -ww**2 * sys.M[None] - 1j * ww * sys.C[None] + sys.K[None] + Zl
-        x[sel] = np.linalg.solve(Z, F[..., None])[..., 0]
+        x[sel] = _fd._amplitudes(model, sys, comps.omega[sel], float(beta), options)
     a = comps.complex_amplitude
     damped = [k for k in range(n) if float(model.damping[k]) > 0]
     c = np.asarray(model.damping, dtype=float)[damped]
@@ -107,7 +91,7 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
     if t is not None:
         coef = a[:, None] * x
         # q and q̇ in one harmonic sum (the exponentials are most of the cost)
-        both = _harmonic(t, comps.omega, np.concatenate([coef, -1j * comps.omega[:, None] * coef], 1))
+        both = _harmonic_sum(comps.omega, np.concatenate([coef, -1j * comps.omega[:, None] * coef], 1), t)
         q, qd = sys.q0[None] + both[:, :n], both[:, n:]
         data.update(
             q=(("time", "coordinate"), q, {"long_name": "generalised coordinates",
@@ -124,7 +108,6 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
         "title": f"mfm spectral response of {model.name}",
         **results.provenance(model, sys.loads, level="spectral", sea=repr(sea),
                              n_components=len(comps), radiation=radiation,
-                             convention="exp(-i omega t)", wall_time_s=wall)})
-    if model.hydro is not None:
-        ds.attrs["source"] = model.hydro.source
+                             convention="exp(-i omega t)", wall_time_s=wall),
+        "source": model.hydro.source})
     return ds
