@@ -32,8 +32,11 @@ class HydroSpec:
     ``com0`` (K, 3): each body's centre of mass at q = 0; ``drag`` (K, 3): C_D A per inertial axis
     (m²); ``moving``: the hydro dofs the mechanics can move (radiation is modelled on these).
 
-    Identity-hashed on purpose: it rides on the Model as static metadata, so a Model keeps one
-    compiled simulation as long as it keeps its HydroSpec.
+    Hashed and compared by content (:meth:`fingerprint`: the database's every array and attribute,
+    the bodies, drag and options): it rides on the Model as static metadata, part of each compiled
+    function's cache key, so the same config loaded twice (a test's fixture, a notebook re-run, a
+    sweep's unpickled copy) reuses the first one's compilations instead of compiling again, while
+    any difference in the data compiles anew.
     """
 
     def __init__(self, db: xr.Dataset, body_index: Sequence[int], config_names: Sequence[str],
@@ -71,6 +74,42 @@ class HydroSpec:
                              "(A∞ corrected to agree with A(ω) and B(ω)), 'database'")
         self.added_mass_inf_option = added_mass_inf
         self._cache = {}
+
+    def fingerprint(self) -> str:
+        """sha256 of everything the spec holds: the database's every array and attribute (hashed
+        once: the dataset is not modified in place) and each of the spec's own attributes, hashed
+        on every call (microseconds) so that an attribute set after the spec was made counts."""
+        import hashlib
+
+        def add(h, *items):
+            for x in items:
+                a = np.asarray(x) if not isinstance(x, (str, bytes)) else None
+                if a is not None and a.dtype.kind in "fciub":
+                    h.update(f"{a.dtype.str}{a.shape}".encode())
+                    h.update(np.ascontiguousarray(a).tobytes())
+                else:
+                    h.update(repr(x).encode())
+
+        if "db_fingerprint" not in self._cache:
+            h = hashlib.sha256()
+            for name in sorted(map(str, self.db.variables)):
+                v = self.db.variables[name]
+                add(h, name, v.dims, v.values, sorted(v.attrs.items()))
+            # when a WAMIT file set was read is provenance, not data
+            add(h, sorted((k, v) for k, v in self.db.attrs.items() if k != "date_read"))
+            self._cache["db_fingerprint"] = h.hexdigest()
+        h = hashlib.sha256(self._cache["db_fingerprint"].encode())
+        for k in sorted(vars(self)):
+            if k not in ("db", "_cache"):
+                add(h, k, getattr(self, k))
+        return h.hexdigest()
+
+    def __eq__(self, other):
+        return self is other or (isinstance(other, HydroSpec)
+                                 and self.fingerprint() == other.fingerprint())
+
+    def __hash__(self):
+        return hash(self.fingerprint())
 
     def provenance(self) -> dict:
         """Where the data came from and how they are used, for a result's attributes."""

@@ -35,9 +35,9 @@ _simulate = importlib.import_module("mfm.simulate")     # the module (mfm.simula
 BATCH_OPTIONS = ("integrator", "radiation", "state_space_options", "memory", "save_every", "t0",
                  "q0", "qd0", "loads", "outputs")
 
-# the models a worker process keeps, by the hash of their pickled bytes: a model's HydroSpec is
-# hashed by identity in the compiled function's cache key, so a model unpickled again would
-# compile again; the first one unpickled is reused instead
+# the models a worker process keeps, by the hash of their pickled bytes: a model unpickled again
+# would find its compilations (the HydroSpec is compared by content) but not its HydroSpec's
+# kernels and fits, which would be computed again; the first one unpickled is reused instead
 _WORKER_MODELS: collections.OrderedDict = collections.OrderedDict()
 _WORKER_MODELS_KEPT = 4
 

@@ -1,4 +1,6 @@
 """The jax contract: static topology, dynamic parameters (no recompiles), vmap and grad."""
+import copy
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -60,3 +62,32 @@ def test_gradient_wrt_pto_damping_matches_finite_difference():
     fd_nm = (final_angle(MODEL.set_damping("float3.angle", d0 + h), "newmark")
              - final_angle(MODEL.set_damping("float3.angle", d0 - h), "newmark")) / (2 * h)
     np.testing.assert_allclose(g_nm, fd_nm, rtol=1e-6)
+
+
+def test_the_same_config_loaded_twice_compiles_once():
+    # the HydroSpec rides on the model as static metadata (part of the compiled function's key):
+    # compared by content, a second load of the config reuses the first one's compilation
+    import hydro
+
+    a, b = mfm.load(CONFIGS / "sphere.toml"), mfm.load(CONFIGS / "sphere.toml")
+    assert a.hydro is not b.hydro and a.hydro == b.hydro and hash(a.hydro) == hash(b.hydro)
+    sea = hydro.Regular(height=0.2, period=3.0)
+    ra = mfm.simulate(a, sea, duration=1.0, dt=0.05)
+    before = dict(TRACES)
+    rb = mfm.simulate(b, sea, duration=1.0, dt=0.05)
+    assert dict(TRACES) == before, "a second load of the same config compiled the rollout again"
+    np.testing.assert_array_equal(ra.q.values, rb.q.values)
+    # any difference in the data is another key: other drag, or an attribute set after the spec
+    # was made (its hash is not frozen at construction)
+    spec = a.hydro
+    other = mfm.water.HydroSpec(spec.db, spec.body_index, spec.config_names, spec.ref0 - spec.d_ref,
+                                np.array([[0.0, 0.0, 1.0]]))
+    assert other != spec
+    changed = copy.copy(spec)
+    assert changed == spec
+    changed.C_wp = 0.5 * changed.C_wp
+    assert changed != spec and hash(changed) != hash(spec)
+    salt = copy.copy(spec)
+    salt.db = spec.db.assign_attrs(rho=1025.0)
+    salt._cache = {}
+    assert salt != spec
