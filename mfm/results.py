@@ -213,11 +213,9 @@ def time_series(model, loads, integ, dt, t, q, qd, qdd, iters, rec, settings) ->
     return ds
 
 
-def linear_time_series(model, loads, t, q, qd, qdd, q0, eta, ptos, settings, source=None
-                       ) -> xr.Dataset:
+def linear_time_series(model, loads, t, q, qd, qdd, q0, eta, settings, source=None) -> xr.Dataset:
     """The dataset of :func:`mfm.linear.linear_response`: q, q̇, q̈ (time, coordinate), the joint
-    dampers' power and ``ptos`` [(names, power (time, P), stroke (time, P))] (hydraulic), ``eta``
-    and the ``equilibrium`` it is linearised about."""
+    dampers' power, ``eta`` and the ``equilibrium`` it is linearised about."""
     ds = xr.Dataset(
         {"q": (("time", "coordinate"), q, _coordinate_attrs(model, 0)),
          "qd": (("time", "coordinate"), qd, _coordinate_attrs(model, 1)),
@@ -231,10 +229,7 @@ def linear_time_series(model, loads, t, q, qd, qdd, q0, eta, ptos, settings, sou
                **provenance(model, loads, **settings)})
     if source is not None:
         ds.attrs["source"] = source
-    ds = _joint_dampers(ds, model, model.damping, q, qd, "time")
-    for names, power, stroke in ptos:
-        ds = add_ptos(ds, names, power, stroke)
-    return ds
+    return _joint_dampers(ds, model, model.damping, q, qd, "time")
 
 
 def batch(model, models, loads, integ, t, q, qd, dts, settings, save_every, labels=None,
