@@ -55,9 +55,9 @@ class Reduction:
     """The answer of :func:`reduce`.
 
     level: the chosen level (one of :data:`LEVELS`). options: what :func:`mfm.simulate` is given
-    for it (empty for "spectral"). errors: {level: {output: relative error against "full"}} on the
-    pilot. wall_s: {level: s} the warm wall time of each level on the pilot. reason: why this
-    level, in words. tolerance, dt, pilot: the settings of the measurement.
+    for it (empty for "spectral" and "linear"). errors: {level: {output: relative error against
+    "full"}} on the pilot. wall_s: {level: s} the warm wall time of each level on the pilot.
+    reason: why this level, in words. tolerance, dt, pilot: the settings of the measurement.
     """
     level: str
     options: dict
