@@ -243,7 +243,7 @@ def stationarity(t, y, start, windows, blocks=12):
 def longrun(which=None):
     """Long runs bounded: RM3 3 h in JONSWAP Hs 2.5 m Tp 8 s and M4 134 10⁶ steps, default and fast
     settings; per window the mean and std of every coordinate, of the free ones' velocity and of
-    the PTO power, with the batch-means z of their differences (stationarity.)"""
+    the PTO power, with the batch-means z of their differences (:func:`stationarity`)."""
     import mfm
 
     path = OUT / "longrun.json"
