@@ -19,6 +19,7 @@ have zero velocity and their loads do no work.
 """
 from __future__ import annotations
 
+import math
 from fractions import Fraction
 from typing import ClassVar
 
@@ -190,6 +191,24 @@ class StateSpace(NoRadiation):
                    A_inf=jnp.asarray(np.asarray(ss.added_mass_inf) * spec.mask),
                    inputs=tuple(ins), outputs=tuple(outs),
                    options=tuple(sorted(options.items())), report=report)
+
+
+def phi_functions(x, n: int):
+    """(e^x, φ₁(x), …, φ_n(x)) for complex x, φ_k(x) = Σ_j x^j/(j + k)! (φ₁ = (eˣ − 1)/x,
+    φ₂ = (eˣ − 1 − x)/x², φ₃ = (eˣ − 1 − x − x²/2)/x³): ∫₀ʰ s^{k−1} e^{λ(h−s)} ds / (k−1)! =
+    h^k φ_k(λh), the weights of an exact step of ẏ = λy + (polynomial input). By the series
+    (20 terms) where |x| < 0.5, where the recurrence φ_{k+1} = (φ_k − 1/k!)/x cancels; by the
+    recurrence elsewhere (its error there is ≤ ε/|x|^n · n!)."""
+    x = np.asarray(x, complex)
+    small = np.abs(x) < 0.5
+    xs = np.where(small, 1.0, x)
+    out = [np.exp(x)]
+    rec = np.exp(xs)
+    for k in range(1, n + 1):
+        rec = (rec - 1.0 / math.factorial(k - 1)) / xs
+        series = sum(x**j / math.factorial(j + k) for j in range(20))
+        out.append(np.where(small, series, rec))
+    return tuple(out)
 
 
 def _phi(x):
