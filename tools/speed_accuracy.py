@@ -17,9 +17,9 @@ The grid (each distinct integrator, number of steps and radiation structure is a
 - ``integrators``: rk4, beeman, semi_implicit, newmark, verlet × dt = T/25 … T/400, one radiation
   model for all: ``state_space_exact`` (the default fit, its states advanced exactly over a step:
   stable with every integrator, what verlet needs);
-- ``radiation``: at RK4, dt = T/100: the convolution with memory windows T, 3T, 10T and the full
-  T_K (from the decay of K), and the state space integrated by RK4 (``state_space``) at three
-  orders and the default (``order="auto"``);
+- ``radiation``: at RK4, dt = T/100: the convolution with memory windows of a few periods (T, 3T,
+  10T) and the full T_K (from the decay of K), and the state space integrated by RK4
+  (``state_space``) at two or three orders and the default (``order="auto"``);
 - ``fidelity``: the levels of :mod:`mfm.fidelity` at dt = T/200: spectral (no time stepping;
   statistics only, and the series on the run's grid), fast (verlet, ``state_space_exact``), full
   (rk4, ``radiation="auto"``).
@@ -73,7 +73,6 @@ SAVE_PER_PERIOD = 25           # every case saves at T/25: the measures use the 
 REFERENCE = dict(integrator="rk4", n_per_T=800, radiation="state_space", option=None)
 RADIATION_AT = dict(integrator="rk4", n_per_T=100)
 FIDELITY_AT = 200              # mfm.reduce's pilot: dt = T/200
-WINDOWS_T = (1.0, 3.0, 10.0)   # convolution memory windows in periods, and the full T_K
 
 
 def _sea(system):
@@ -90,16 +89,21 @@ def _sea(system):
 
 
 # period T (s), run length and settling time in periods (the ramp is 5 periods), the coordinates
-# whose standard deviation and series are compared, the state-space orders tried
+# whose standard deviation and series are compared, the convolution windows (periods; the full
+# T_K is always run) and state-space orders (beside "auto") tried. M4 and Stansby & Li run 20
+# periods with two windows and two orders: their compilations are the study's cost (RM3 ran
+# first with 30 periods, three windows and three orders)
 SYSTEMS = {
-    "m4_134": dict(config="m4_134.toml", T=1.2, periods=30, settle=10,
+    "m4_134": dict(config="m4_134.toml", T=1.2, periods=20, settle=8,
                    coordinates=("float3.angle", "float7.angle", "float6.angle", "float8.angle"),
-                   orders=(8, 16, 24)),
+                   windows=(1.0, 10.0), orders=(8, 16)),
     # RM3 ≤ 300 s: past ~600 s its parametric resonance grows (docs/stability.md)
     "rm3": dict(config="rm3.toml", T=8.0, periods=30, settle=15,
-                coordinates=("spar.pitch", "float.stroke"), orders=(2, 4, 6)),
-    "stansby_li": dict(config="stansby_li.toml", T=12.0, periods=30, settle=10,
-                       coordinates=("floatB.angle", "floatC.angle"), orders=(8, 16, 24)),
+                coordinates=("spar.pitch", "float.stroke"), windows=(1.0, 3.0, 10.0),
+                orders=(2, 4, 6)),
+    "stansby_li": dict(config="stansby_li.toml", T=12.0, periods=20, settle=8,
+                       coordinates=("floatB.angle", "floatC.angle"), windows=(1.0, 10.0),
+                       orders=(8, 16)),
 }
 
 
@@ -233,7 +237,7 @@ def plan(cfg):
         for n in STEPS_PER_PERIOD:
             out.append(("integrators", dict(integrator=integ, n_per_T=n,
                                             radiation="state_space_exact", option=None)))
-    for opt in ("full",) + WINDOWS_T:
+    for opt in ("full",) + tuple(cfg["windows"]):
         out.append(("radiation", dict(RADIATION_AT, radiation="convolution", option=opt)))
     for opt in ("auto",) + tuple(cfg["orders"]):
         out.append(("radiation", dict(RADIATION_AT, radiation="state_space", option=opt)))
@@ -246,11 +250,13 @@ def plan(cfg):
     return out
 
 
-def study(system, *, path=None, slices=None, cases=None, reference=None, log=print, **overrides):
+def study(system, *, path=None, slices=None, cases=None, reference=None, time_it=True, log=print,
+          **overrides):
     """Run (or resume) a system's study; returns the stored dict. ``slices`` limits the slices
     run (the reference always runs); ``cases`` replaces :func:`plan`'s list of (slice, case);
     ``reference`` the reference case (default :data:`REFERENCE`); ``overrides`` change the
-    settings (e.g. a short smoke run); ``path`` None writes nothing."""
+    settings (e.g. a short smoke run); ``time_it`` False runs each case once, untimed; ``path``
+    None writes nothing."""
     reference = dict(REFERENCE if reference is None else reference)
     import mfm
 
@@ -279,10 +285,10 @@ def study(system, *, path=None, slices=None, cases=None, reference=None, log=pri
         if k not in cache:
             if case["integrator"] == "spectral":
                 t = cache[_key(reference)][1][0]
-                cache[k] = spectral_case(model, sea, cfg, t)
+                cache[k] = spectral_case(model, sea, cfg, t, time_it=time_it)
             else:
-                cache[k] = run_case(model, sea, cfg, **{n: case[n] for n in
-                                                       ("integrator", "n_per_T", "radiation", "option")})
+                cache[k] = run_case(model, sea, cfg, time_it=time_it, **{
+                    n: case[n] for n in ("integrator", "n_per_T", "radiation", "option")})
         return cache[k]
 
     ref_rec, ref_series = series_of(reference)
@@ -438,6 +444,23 @@ def table(data):
         e = r["errors"]
         lines.append(f"| {label(r)} | {r['slice']} | {r['warm_s']:.3g} | {r['compile_s']:.3g} | "
                      f"{e['std']:.2e} | {e['power']:.2e} | {e['series']:.2e} |")
+    return "\n".join(lines)
+
+
+def cheapest(data, metric, tolerance):
+    """The fastest case (warm wall time) whose ``metric`` error is ≤ tolerance, or None."""
+    ok = [r for r in data["cases"] if r["status"] == "ok" and r["slice"] != "reference_check"
+          and r["errors"][metric] <= tolerance]
+    return min(ok, key=lambda r: r["warm_s"]) if ok else None
+
+
+def front_table(data, metric):
+    """The Pareto front of one measure as markdown rows, fastest first."""
+    ok = [r for r in data["cases"] if r["status"] == "ok" and r["slice"] != "reference_check"]
+    front = pareto([(r["warm_s"], max(r["errors"][metric], FLOOR)) for r in ok])
+    lines = [f"| Pareto front, {metric} error | warm s | {metric} error |", "|---|---|---|"]
+    lines += [f"| {label(ok[i])} | {ok[i]['warm_s']:.3g} | {ok[i]['errors'][metric]:.2e} |"
+              for i in front]
     return "\n".join(lines)
 
 
