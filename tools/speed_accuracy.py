@@ -14,7 +14,8 @@ notebooks/figures/speed_accuracy/<system>.png. notebooks/speed_accuracy.ipynb re
 The grid (each distinct integrator, number of steps and radiation structure is a compilation of
 10–60 s, so the grid is a sum of three slices rather than a product):
 
-- ``integrators``: rk4, beeman, semi_implicit, newmark, verlet × dt = T/25 … T/400, one radiation
+- ``integrators``: rk4, beeman, semi_implicit, newmark, verlet × dt = T/25, T/50, T/100, T/200,
+  T/400 (fewer where the compilations did not fit the time: :data:`COARSE`), one radiation
   model for all: ``state_space_exact`` (the default fit, its states advanced exactly over a step:
   stable with every integrator, what verlet needs);
 - ``radiation``: at RK4, dt = T/100: the convolution with memory windows of a few periods (T, 3T,
@@ -44,7 +45,7 @@ T/25 (every case saves there: the same estimator for all):
   ‖x − x_ref‖ / ‖x_ref − mean x_ref‖.
 
 Wall time: ``warm_s`` is the median of repeated warm calls (3 when a call is under 2 s, 2 under
-10 s, else 1) of what a run costs once compiled: the loads for this sea and grid
+5 s — RM3's rows: 10 s —, else 1; each row has its ``repeats``) of what a run costs once compiled: the loads for this sea and grid
 (:func:`mfm.simulate.model_loads`: excitation tables, convolution weights, exact propagators) and
 the compiled rollout (:func:`mfm.simulate.rollout`, no per-sample outputs) to its last sample;
 ``compile_s`` is the first call's excess over it (tracing and XLA compilation; the state-space fit
@@ -69,6 +70,15 @@ OUT = ROOT / "notebooks" / "figures" / "speed_accuracy"
 
 INTEGRATORS = ("rk4", "beeman", "semi_implicit", "newmark", "verlet")
 STEPS_PER_PERIOD = (25, 50, 100, 200, 400)
+# the time steps per integrator where not all of STEPS_PER_PERIOD: on the shared machine (load
+# 5–6) a compilation of M4 or Stansby & Li took ≈ 45 s and a warm M4 RK4 step 1.6 ms, so the
+# schemes that are never on RM3's Pareto front (semi-implicit: first order; Newmark: implicit,
+# 5–20× slower; Beeman: Verlet's error at Verlet's cost) run T/25, T/100, T/400 on M4, and on
+# Stansby & Li (run last) every integrator does (Newmark T/25, T/100)
+COARSE = {"m4_134": dict(beeman=(25, 100, 400), semi_implicit=(25, 100, 400),
+                         newmark=(25, 100, 400)),
+          "stansby_li": dict(rk4=(25, 100, 400), verlet=(25, 100, 400), beeman=(25, 100, 400),
+                             semi_implicit=(25, 100, 400), newmark=(25, 100))}
 SAVE_PER_PERIOD = 25           # every case saves at T/25: the measures use the same samples
 REFERENCE = dict(integrator="rk4", n_per_T=800, radiation="state_space", option=None)
 RADIATION_AT = dict(integrator="rk4", n_per_T=100)
@@ -179,7 +189,7 @@ def run_case(model, sea, cfg, *, integrator, n_per_T, radiation, option=None, ti
             s = time.perf_counter()
             go()
             times.append(time.perf_counter() - s)
-            if len(times) >= (3 if times[0] < 2 else 2 if times[0] < 10 else 1):
+            if len(times) >= (3 if times[0] < 2 else 2 if times[0] < 5 else 1):
                 break
         rec.update(warm_s=statistics.median(times), repeats=len(times),
                    compile_s=max(rec["first_s"] - statistics.median(times), 0.0))
@@ -229,24 +239,26 @@ def errors(m, ref):
                 series=float(np.sqrt((dx ** 2).sum() / ((ref["x"] - ref["x"].mean(0)) ** 2).sum())))
 
 
-def plan(cfg):
-    """The cases of a system: (slice, case) in the order run (the reference first)."""
+def plan(cfg, system=None):
+    """The cases of a system: (slice, case) in the order run: the reference and its check, the
+    fidelity levels and the radiation models (a few cases that say most), then the integrator
+    grid (the many compilations; a study cut short keeps the others)."""
     out = [("reference", dict(REFERENCE)),
            ("reference_check", dict(REFERENCE, n_per_T=REFERENCE["n_per_T"] // 2))]
-    for integ in INTEGRATORS:
-        for n in STEPS_PER_PERIOD:
-            out.append(("integrators", dict(integrator=integ, n_per_T=n,
-                                            radiation="state_space_exact", option=None)))
-    for opt in ("full",) + tuple(cfg["windows"]):
-        out.append(("radiation", dict(RADIATION_AT, radiation="convolution", option=opt)))
-    for opt in ("auto",) + tuple(cfg["orders"]):
-        out.append(("radiation", dict(RADIATION_AT, radiation="state_space", option=opt)))
+    out.append(("fidelity", dict(integrator="spectral", n_per_T=None, radiation="database",
+                                 option=None, level="spectral")))
     out.append(("fidelity", dict(integrator="verlet", n_per_T=FIDELITY_AT,
                                  radiation="state_space_exact", option=None, level="fast")))
     out.append(("fidelity", dict(integrator="rk4", n_per_T=FIDELITY_AT, radiation="auto",
                                  option=None, level="full")))
-    out.append(("fidelity", dict(integrator="spectral", n_per_T=None, radiation="database",
-                                 option=None, level="spectral")))
+    for opt in ("full",) + tuple(cfg["windows"]):
+        out.append(("radiation", dict(RADIATION_AT, radiation="convolution", option=opt)))
+    for opt in ("auto",) + tuple(cfg["orders"]):
+        out.append(("radiation", dict(RADIATION_AT, radiation="state_space", option=opt)))
+    for integ in INTEGRATORS:
+        for n in COARSE.get(system, {}).get(integ, STEPS_PER_PERIOD):
+            out.append(("integrators", dict(integrator=integ, n_per_T=n,
+                                            radiation="state_space_exact", option=None)))
     return out
 
 
@@ -266,7 +278,7 @@ def study(system, *, path=None, slices=None, cases=None, reference=None, time_it
                 cases=[])
     if path is not None and Path(path).exists():
         old = json.loads(Path(path).read_text())
-        if old.get("settings") == data["settings"]:
+        if old.get("settings") == json.loads(json.dumps(data["settings"])):   # tuples as lists
             data = old
     done = {(c["slice"], _key(c)): c for c in data["cases"]}
     fit_start = time.perf_counter()
@@ -295,7 +307,7 @@ def study(system, *, path=None, slices=None, cases=None, reference=None, time_it
     ref = measures(model, cfg, ref_series)
     data["reference"] = dict(ref_rec, std=ref["std"].tolist(), power=ref["power"])
     conv = None
-    for sl, case in (plan(cfg) if cases is None else cases):
+    for sl, case in (plan(cfg, system) if cases is None else cases):
         if sl == "reference" or (slices is not None and sl not in slices):
             continue
         k = (sl, _key(case))
