@@ -240,17 +240,17 @@ def errors(m, ref):
 
 
 def plan(cfg, system=None):
-    """The cases of a system: (slice, case) in the order run: the reference and its check, the
-    fidelity levels and the radiation models (a few cases that say most), then the integrator
-    grid (the many compilations; a study cut short keeps the others)."""
+    """The cases of a system: (slice, case) in the order run: the reference, the fidelity levels,
+    the reference's check and the radiation models (a few cases that say most), then the
+    integrator grid (the many compilations; a study cut short keeps the others)."""
     out = [("reference", dict(REFERENCE)),
+           ("fidelity", dict(integrator="spectral", n_per_T=None, radiation="database",
+                             option=None, level="spectral")),
+           ("fidelity", dict(integrator="verlet", n_per_T=FIDELITY_AT,
+                             radiation="state_space_exact", option=None, level="fast")),
+           ("fidelity", dict(integrator="rk4", n_per_T=FIDELITY_AT, radiation="auto",
+                             option=None, level="full")),
            ("reference_check", dict(REFERENCE, n_per_T=REFERENCE["n_per_T"] // 2))]
-    out.append(("fidelity", dict(integrator="spectral", n_per_T=None, radiation="database",
-                                 option=None, level="spectral")))
-    out.append(("fidelity", dict(integrator="verlet", n_per_T=FIDELITY_AT,
-                                 radiation="state_space_exact", option=None, level="fast")))
-    out.append(("fidelity", dict(integrator="rk4", n_per_T=FIDELITY_AT, radiation="auto",
-                                 option=None, level="full")))
     for opt in ("full",) + tuple(cfg["windows"]):
         out.append(("radiation", dict(RADIATION_AT, radiation="convolution", option=opt)))
     for opt in ("auto",) + tuple(cfg["orders"]):
