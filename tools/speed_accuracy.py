@@ -2,10 +2,11 @@
 time step, radiation models and fidelity levels, the error against a reference solution against
 the warm wall time, with the Pareto front.
 
-    PYTHONPATH=. python tools/speed_accuracy.py rm3          # ≈ 12 min on 2 shared cores
-    PYTHONPATH=. python tools/speed_accuracy.py m4_134       # ≈ 15 min
-    PYTHONPATH=. python tools/speed_accuracy.py stansby_li   # ≈ 15 min
+    PYTHONPATH=. python tools/speed_accuracy.py rm3          # 28 min on 2 shared cores (load 5–6)
+    PYTHONPATH=. python tools/speed_accuracy.py m4_134       # 44 min (10 of them the convolution)
+    PYTHONPATH=. python tools/speed_accuracy.py stansby_li   # ≈ 30 min
     PYTHONPATH=. python tools/speed_accuracy.py figures      # the PNGs from the stored numbers
+    PYTHONPATH=. python tools/speed_accuracy.py stansby_li --slices integrators   # one slice
 
 Each system's cases go to notebooks/figures/speed_accuracy/<system>.json as they finish (a rerun
 skips the cases already there: delete the file to start afresh), the figures to
@@ -130,6 +131,10 @@ def load_system(system, **overrides):
     cfg = dict(SYSTEMS[system], **overrides)
     model = mfm.load(ROOT / "configs" / cfg["config"])
     return model, _sea(system), cfg
+
+
+SEA_TEXT = {"m4_134": "JONSWAP Hs 0.04 m, Tp 1.2 s, γ 3.3", "rm3": "regular wave H 2.5 m, T 8 s",
+            "stansby_li": "JONSWAP Hs 2 m, Tp 12 s, γ 3.3, heading 45°"}
 
 
 def _key(c):
@@ -383,7 +388,7 @@ def figure(data, path=None, *, show_labels=True):
     from matplotlib.ticker import NullFormatter
 
     rows = [r for r in data["cases"] if r["slice"] != "reference_check"]
-    fig, axes = plt.subplots(1, 3, figsize=(17, 5.6))
+    fig, axes = plt.subplots(1, 3, figsize=(17, 6.2))
     markers = dict(integrators="o", radiation="s", fidelity="D")
     for ax, (metric, title) in zip(axes, METRICS):
         ok = [r for r in rows if r["status"] == "ok"]
@@ -434,11 +439,12 @@ def figure(data, path=None, *, show_labels=True):
                 Line2D([], [], color="0.4", marker="D", ls="none", label="fidelity levels (T/200)"),
                 Line2D([], [], color="crimson", marker="o", mfc="none", ms=10, ls="-",
                        label="Pareto front")]
-    axes[-1].legend(handles=handles, fontsize=7, loc="lower left")
+    fig.legend(handles=handles, fontsize=8, loc="lower center", ncol=6)
     s = data["settings"]
-    fig.suptitle(f"{data['system']}: {data['sea']}; {s['periods']} periods, compared after "
-                 f"{s['settle']} T; reference {s.get('reference', _key(REFERENCE))}", fontsize=10)
-    fig.tight_layout()
+    fig.suptitle(f"{data['system']}: {SEA_TEXT.get(data['system'], data['sea'])}; {s['periods']} "
+                 f"periods, compared after {s['settle']} T; reference "
+                 f"{s.get('reference', _key(REFERENCE))}", fontsize=10)
+    fig.tight_layout(rect=(0, 0.09, 1, 1))
     if path is not None:
         fig.savefig(path, dpi=110)
     return fig
@@ -490,8 +496,11 @@ def main(argv):
                 figure(json.loads(p.read_text()), OUT / f"{system}.png")
                 print("wrote", OUT / f"{system}.png")
         return 0
+    slices = None
+    if "--slices" in argv:       # e.g. --slices integrators,radiation: only these (and the reference)
+        slices = tuple(argv[argv.index("--slices") + 1].split(","))
     start = time.perf_counter()
-    study(argv[0], path=OUT / f"{argv[0]}.json", log=lambda s: print(s, flush=True))
+    study(argv[0], path=OUT / f"{argv[0]}.json", slices=slices, log=lambda s: print(s, flush=True))
     print(f"{argv[0]}: {time.perf_counter() - start:.0f} s")
     return 0
 
