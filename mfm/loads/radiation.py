@@ -211,18 +211,6 @@ def phi_functions(x, n: int):
     return tuple(out)
 
 
-def _phi(x):
-    """φ₁(x) = (eˣ − 1)/x and φ₂(x) = (eˣ − 1 − x)/x² (complex x), by their series where |x| is
-    small and the closed forms cancel."""
-    x = np.asarray(x, complex)
-    small = np.abs(x) < 1e-3
-    xs = np.where(small, 1.0, x)
-    e = np.exp(xs)
-    phi1 = np.where(small, 1 + x / 2 + x**2 / 6 + x**3 / 24, (e - 1) / xs)
-    phi2 = np.where(small, 0.5 + x / 6 + x**2 / 24 + x**3 / 120, (e - 1 - xs) / xs**2)
-    return np.exp(x), phi1, phi2
-
-
 class ExactStateSpace(StateSpace):
     """The state space of :class:`StateSpace` with its states advanced exactly over each step,
     outside the integrator, for an input ξ̇ linear in time within the step (first-order hold,
@@ -284,7 +272,7 @@ class ExactStateSpace(StateSpace):
         """The exact update of ``ss``'s states for steps of ``dt`` and stages at ``stage_offsets``."""
         p = np.asarray(ss.p[:, 0]) + 1j * np.asarray(ss.p[:, 1])
         h = float(dt) * np.asarray(tuple(stage_offsets) + (1.0,))[:, None]
-        e, phi1, phi2 = _phi(p[None, :] * h)
+        e, phi1, phi2 = phi_functions(p[None, :] * h, 2)
         split = lambda a: jnp.asarray(np.stack([a.real, a.imag], -1))  # noqa: E731
         return cls(p=ss.p, C=ss.C, A_inf=ss.A_inf, inputs=ss.inputs, outputs=ss.outputs,
                    options=ss.options, report=ss.report, E=split(e), G=split(h * phi1),
