@@ -20,13 +20,15 @@ from .simulate import AccuracyWarning, SimulationError, StabilityWarning, rollou
 from . import stability  # noqa: E402
 from .stability import amplification_matrix, floquet, largest_stable_dt  # noqa: E402
 from .spectral import spectral_response  # noqa: E402
+from . import linear  # noqa: E402
+from .linear import linear_response  # noqa: E402
 from . import fidelity  # noqa: E402
 from .fidelity import reduce  # noqa: E402
 from .tree import ConfigError  # noqa: E402
 from .sweep import SweepError, sweep  # noqa: E402
 
 __all__ = ["AccuracyWarning", "amplification_matrix", "fidelity", "floquet", "largest_stable_dt",
-           "reduce", "spectral_response", "stability", "ConfigError", "Model", "SimulationError", "b_matrix", "b_matrix_dot", "body_poses",
+           "reduce", "spectral_response", "linear", "linear_response", "stability", "ConfigError", "Model", "SimulationError", "b_matrix", "b_matrix_dot", "body_poses",
            "compile_tree", "config", "coriolis_matrix", "energies", "equilibrium", "evaluate",
            "forward_dynamics", "frequency_response", "natural_frequencies", "water",
            "integrators", "kinematics", "load", "loads", "mass_matrix", "reaction_loads",

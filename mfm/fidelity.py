@@ -6,6 +6,9 @@ The levels, cheapest first:
 - ``"spectral"``: the linear frequency-domain response summed over the sea's components
   (:func:`mfm.spectral.spectral_response`), no time stepping. Linear about the equilibrium: no
   drag, no large rotations, no stops.
+- ``"linear"``: the same linear model in the time domain (:func:`mfm.linear.linear_response`):
+  radiation by the state-space fit, the modes stepped exactly; it has the start-up transient and
+  ramp that the spectral level's steady state has not.
 - ``"fast"``: the full nonlinear model stepped once per step (``integrator="verlet"``) with the
   radiation states advanced exactly (``radiation="state_space_exact"``): second order in dt.
 - ``"full"``: the full nonlinear model with RK4 and the engine's default radiation
@@ -30,7 +33,7 @@ import numpy as np
 from .model import Model
 from .spectral import _check_sea
 
-LEVELS = ("spectral", "fast", "full")
+LEVELS = ("spectral", "linear", "fast", "full")
 # the run options each time-domain level gives mfm.simulate
 LEVEL_OPTIONS = {"fast": {"integrator": "verlet", "radiation": "state_space_exact"},
                  "full": {"integrator": "rk4", "radiation": "auto"}}
@@ -52,9 +55,9 @@ class Reduction:
     """The answer of :func:`reduce`.
 
     level: the chosen level (one of :data:`LEVELS`). options: what :func:`mfm.simulate` is given
-    for it (empty for "spectral"). errors: {level: {output: relative error against "full"}} on the
-    pilot. wall_s: {level: s} the warm wall time of each level on the pilot. reason: why this
-    level, in words. tolerance, dt, pilot: the settings of the measurement.
+    for it (empty for "spectral" and "linear"). errors: {level: {output: relative error against
+    "full"}} on the pilot. wall_s: {level: s} the warm wall time of each level on the pilot.
+    reason: why this level, in words. tolerance, dt, pilot: the settings of the measurement.
     """
     level: str
     options: dict
@@ -68,14 +71,17 @@ class Reduction:
     def run(self, model: Model, sea, *, duration: float, ramp: float | None = None):
         """Run the scene at the chosen level: a dataset with ``time``, ``q``, ``qd`` and
         ``pto_power`` whichever the level (spectral: synthesised on the same time grid; no ramp,
-        its response is the steady state)."""
+        its response is the steady state; linear: from rest at the equilibrium, with the ramp)."""
         duration = _positive(duration, "duration")
         if self.level == "spectral":
             from .spectral import spectral_response
             t = self.dt * np.arange(int(round(duration / self.dt)) + 1)
             return spectral_response(model, sea, t=t)
-        simulate = importlib.import_module("mfm.simulate").simulate
         ramp = self.pilot[1] if ramp is None else ramp
+        if self.level == "linear":
+            from .linear import linear_response
+            return linear_response(model, sea, duration=duration, dt=self.dt, ramp=ramp)
+        simulate = importlib.import_module("mfm.simulate").simulate
         return simulate(model, sea, duration=duration, dt=self.dt, ramp=ramp, **self.options)
 
 

@@ -213,6 +213,25 @@ def time_series(model, loads, integ, dt, t, q, qd, qdd, iters, rec, settings) ->
     return ds
 
 
+def linear_time_series(model, loads, t, q, qd, qdd, q0, eta, settings, source=None) -> xr.Dataset:
+    """The dataset of :func:`mfm.linear.linear_response`: q, q̇, q̈ (time, coordinate), the joint
+    dampers' power, ``eta`` and the ``equilibrium`` it is linearised about."""
+    ds = xr.Dataset(
+        {"q": (("time", "coordinate"), q, _coordinate_attrs(model, 0)),
+         "qd": (("time", "coordinate"), qd, _coordinate_attrs(model, 1)),
+         "qdd": (("time", "coordinate"), qdd, _coordinate_attrs(model, 2)),
+         "eta": (("time",), eta, {"long_name": "undisturbed wave elevation at the origin",
+                                  "units": "m"}),
+         "equilibrium": (("coordinate",), q0, {"long_name": "static equilibrium about which the "
+                                               "model is linearised", "units": "m or rad"})},
+        coords={"time": ("time", t, {"units": "s"}), **_coordinate_coords(model)},
+        attrs={"title": f"mfm linearised time-domain response of {model.name}",
+               **provenance(model, loads, **settings)})
+    if source is not None:
+        ds.attrs["source"] = source
+    return _joint_dampers(ds, model, model.damping, q, qd, "time")
+
+
 def batch(model, models, loads, integ, t, q, qd, dts, settings, save_every, labels=None,
           recorded=None) -> xr.Dataset:
     """The dataset of :func:`mfm.simulate_batch`: (case, step, …); ``labels`` per-case values

@@ -68,12 +68,19 @@ def test_exact_update_is_stable_beyond_any_explicit_limit():
 
 
 def test_phi_series_and_closed_forms_agree():
-    from mfm.loads.radiation import _phi
+    import math
 
-    x = np.array([1e-3 + 1e-3j, -2e-3, 0.5 - 0.2j])
-    e, p1, p2 = _phi(x)
+    from mfm.loads.radiation import phi_functions
+
+    # both branches: the series (|x| < 0.5) against the closed forms where they do not cancel
+    # badly, and the recurrence (|x| ≥ 0.5) against a 60-term series (converged for |x| ≤ 3)
+    x = np.array([1e-3 + 1e-3j, -2e-3, 0.3 - 0.2j, 0.5 - 0.2j, -2.5 + 1.5j, 3.0j])
+    e, p1, p2, p3 = phi_functions(x, 3)
     assert np.allclose(e, np.exp(x), rtol=1e-15)
     assert np.allclose(p1, (np.exp(x) - 1) / x, rtol=1e-10)
     assert np.allclose(p2, (np.exp(x) - 1 - x) / x**2, rtol=1e-7)   # cancellation in the closed form
+    for k, got in ((1, p1), (2, p2), (3, p3)):
+        ref = np.array([sum(xi**j / math.factorial(j + k) for j in range(60)) for xi in x])
+        np.testing.assert_allclose(got, ref, rtol=1e-13)
     with pytest.raises(AssertionError):
         assert np.allclose(p2, 0.5, rtol=1e-6)

@@ -6,6 +6,7 @@ ratio, and the RM3 long-run finding explained by Floquet multipliers (docs/stabi
     PYTHONPATH=. python tools/stability_study.py floquet   # RM3 multipliers and variants (1–4 min each)
     PYTHONPATH=. python tools/stability_study.py figures   # the PNGs from the stored numbers
     PYTHONPATH=. python tools/stability_study.py table     # the Floquet variants as markdown
+    PYTHONPATH=. python tools/stability_study.py longrun   # 3 h RM3, 10⁶ steps M4 134 (≈ 30 min)
 
 Numbers go to notebooks/figures/stability/*.json, figures to notebooks/figures/stability/*.png.
 """
@@ -13,6 +14,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import importlib
 import json
 import math
 import sys
@@ -193,6 +195,134 @@ def rm3_floquet(which=None):
         path.write_text(json.dumps(out, indent=1))
 
 
+# long runs (issue 14 item 2): irregular seas (RM3's regular H 2.5 m T 8 s wave has a genuine
+# parametric resonance, section 2 of docs/stability.md); "default" is simulate's defaults (RK4,
+# radiation auto), "fast" the fidelity ladder's fast level
+LONG_SETTINGS = {"default": {}, "fast": {"integrator": "verlet", "radiation": "state_space_exact"}}
+
+
+def _long_cases():
+    import hydro
+
+    return {
+        # 3 h full scale after a 200 s settle (ramp 40 s), dt = Tp/80, kept every 0.5 s; Tp 8 s puts
+        # the peak on the 7.8 s parametric resonance of the 15.6 s pitch–surge mode
+        "rm3": dict(config="rm3.toml", sea=hydro.Jonswap(hs=2.5, tp=8.0, gamma=3.3, seed=1),
+                    dt=0.1, n_steps=110_000, save_every=5, ramp=40.0, settle=200.0, windows=3),
+        # 10⁶ steps at Tp/200 in the sea of benchmarks/speed.py (model scale: 6000 s), kept every
+        # 20 steps, five 1176 s windows after 120 s
+        "m4_134": dict(config="m4_134.toml",
+                       sea=hydro.Jonswap(hs=0.04, tp=1.2, gamma=3.3, seed=1, omega_range=(1.0, 25.0)),
+                       dt=1.2 / 200, n_steps=1_000_000, save_every=20, ramp=6.0, settle=120.0,
+                       windows=5),
+    }
+
+
+def stationarity(t, y, start, windows, blocks=12):
+    """Each of ``windows`` equal windows of y(t) after ``start``: its mean and standard deviation
+    with their sampling errors by batch means (``blocks`` blocks per window: the spread of the
+    block means (stds) over √blocks), and the largest z = |a_i − a_j| / √(se_i² + se_j²) over the
+    pairs of windows for the mean and for the std (≈ N(0, 1) per pair when y is stationary and the
+    blocks are longer than its correlation time)."""
+    sel = t >= start
+    y = np.asarray(y)[sel]
+    n = len(y) // (windows * blocks) * windows * blocks
+    B = y[:n].reshape(windows, blocks, -1)
+    mean, std = B.mean(axis=(1, 2)), B.reshape(windows, -1).std(axis=1)
+    se_mean = B.mean(axis=2).std(axis=1, ddof=1) / math.sqrt(blocks)
+    se_std = B.std(axis=2).std(axis=1, ddof=1) / math.sqrt(blocks)
+
+    def zmax(a, se):
+        return max((abs(a[i] - a[j]) / max(math.hypot(se[i], se[j]), 1e-300)
+                    for i in range(windows) for j in range(i + 1, windows)), default=0.0)
+
+    return dict(mean=mean.tolist(), std=std.tolist(), se_mean=se_mean.tolist(),
+                se_std=se_std.tolist(), z_mean=zmax(mean, se_mean), z_std=zmax(std, se_std))
+
+
+def longrun(which=None):
+    """Long runs bounded: RM3 3 h in JONSWAP Hs 2.5 m Tp 8 s and M4 134 10⁶ steps, default and fast
+    settings; per window the mean and std of every coordinate, of the free ones' velocity and of
+    the PTO power, with the batch-means z of their differences (:func:`stationarity`)."""
+    import mfm
+
+    path = OUT / "longrun.json"
+    out = json.loads(path.read_text()) if path.exists() else {}
+    for name, case in _long_cases().items():
+        model = mfm.load(ROOT / "configs" / case["config"])
+        free = importlib.import_module("mfm.simulate").no_restoring(model)
+        for setting, options in LONG_SETTINGS.items():
+            key = f"{name} {setting}"
+            if which and key not in which:
+                continue
+            t0 = time.time()
+            ds = mfm.simulate(model, case["sea"], duration=case["n_steps"] * case["dt"],
+                              dt=case["dt"], ramp=case["ramp"], save_every=case["save_every"],
+                              progress={"mininterval": 30.0}, **options)
+            wall = time.time() - t0
+            t = ds.time.values
+            finite = bool(np.isfinite(ds.q.values).all() and np.isfinite(ds.qd.values).all())
+            series = {c: ds.q.sel(coordinate=c).values for c in model.coordinates}
+            series.update({f"{c} velocity": ds.qd.sel(coordinate=c).values for c in free})
+            power = ds.pto_power.values.reshape(len(t), -1).sum(axis=1)
+            series["pto_power"] = power
+            stats = {k: stationarity(t, v, case["settle"], case["windows"]) for k, v in series.items()}
+            # 60 s (RM3) or 12 s (M4) block statistics for the figure
+            blk = int(round((60.0 if name == "rm3" else 12.0) / (t[1] - t[0])))
+            nb = len(t) // blk
+            fig = {k: dict(mean=v[:nb * blk].reshape(nb, blk).mean(1).tolist(),
+                           std=v[:nb * blk].reshape(nb, blk).std(1).tolist())
+                   for k, v in series.items()}
+            out[key] = dict(wall_s=wall, n_steps=case["n_steps"], dt=case["dt"],
+                            duration=case["n_steps"] * case["dt"], sea=repr(case["sea"]),
+                            settle=case["settle"], windows=case["windows"], finite=finite,
+                            free=free, radiation=ds.attrs.get("radiation", ""),
+                            integrator=ds.attrs.get("integrator", ""), stats=stats,
+                            max_abs={k: float(np.abs(v).max()) for k, v in series.items()},
+                            block_t=(t[:nb * blk].reshape(nb, blk).mean(1)).tolist(), blocks=fig)
+            print(key, f"wall {wall:.0f} s, finite {finite}, radiation {out[key]['radiation']}",
+                  flush=True)
+            for k, v in stats.items():
+                print(f"  {k:24s} mean {np.round(v['mean'], 5)} std {np.round(v['std'], 5)} "
+                      f"z_mean {v['z_mean']:.2f} z_std {v['z_std']:.2f}", flush=True)
+            OUT.mkdir(parents=True, exist_ok=True)
+            path.write_text(json.dumps(out))
+            del ds
+
+
+def longrun_figure(plt, data):
+    keys = [k for k in ("rm3 default", "rm3 fast", "m4_134 default", "m4_134 fast") if k in data]
+    models = sorted({k.split()[0] for k in keys}, key=lambda m: m != "rm3")
+    fig, axes = plt.subplots(len(models), 2, figsize=(11, 3.4 * len(models)), squeeze=False)
+    key_coord = {"rm3": "spar.pitch", "m4_134": "float3.angle"}
+    for r, mname in enumerate(models):
+        for setting, style in (("default", "-"), ("fast", "--")):
+            d = data.get(f"{mname} {setting}")
+            if d is None:
+                continue
+            t = np.asarray(d["block_t"]) / (3600.0 if mname == "rm3" else 1.0)
+            for c, (what, label) in enumerate(((key_coord[mname], "std"), ("pto_power", "mean"))):
+                y = np.asarray(d["blocks"][what][label])
+                ax = axes[r, c]
+                ax.plot(t, y, style, lw=0.8, label=f"{setting} ({d['integrator']}, {d['radiation']}), "
+                        f"{d['wall_s'] / 60:.1f} min")
+                # the window statistics of the study
+                st = d["stats"][what]
+                edges = np.linspace(d["settle"], d["duration"], d["windows"] + 1) / (
+                    3600.0 if mname == "rm3" else 1.0)
+                for i in range(d["windows"]):
+                    ax.hlines(st[label][i], edges[i], edges[i + 1], colors="k", lw=1.5)
+                ax.set_title(f"{mname}: {what} {'std per block' if label == 'std' else 'mean per block'}"
+                             f" (z {st['z_' + label]:.2f} across windows)", fontsize=9)
+                ax.set_xlabel("t (h)" if mname == "rm3" else "t (s, model scale)")
+        for ax in axes[r]:
+            ax.legend(fontsize=7)
+    fig.suptitle("Long runs bounded: block statistics (thin) and window statistics (black)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(OUT / "longrun.png", dpi=110)
+    plt.close(fig)
+
+
 def figures():
     import matplotlib
 
@@ -201,6 +331,8 @@ def figures():
 
     if (OUT / "map.json").exists():
         map_figure(plt, json.loads((OUT / "map.json").read_text()))
+    if (OUT / "longrun.json").exists():
+        longrun_figure(plt, json.loads((OUT / "longrun.json").read_text()))
     if (OUT / "rm3_runs.json").exists() and (OUT / "floquet.json").exists():
         floquet_figure(plt, json.loads((OUT / "rm3_runs.json").read_text()),
                        json.loads((OUT / "floquet.json").read_text()))
@@ -321,4 +453,4 @@ if __name__ == "__main__":
     what = sys.argv[1] if len(sys.argv) > 1 else "figures"
     {"map": stability_map, "runs": lambda: rm3_runs(sys.argv[2:] or None),
      "floquet": lambda: rm3_floquet(sys.argv[2:] or None), "figures": figures,
-     "table": table}[what]()
+     "table": table, "longrun": lambda: longrun(sys.argv[2:] or None)}[what]()

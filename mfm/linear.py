@@ -1,0 +1,300 @@
+"""The linearised time-domain level of the fidelity ladder: the model linearised about its
+equilibrium (:func:`mfm.frequency.linear_system`, the linearisation of ``frequency_response``), its
+radiation memory realised by the passive state-space fit (:mod:`hydro.statespace`, the fit of
+``simulate(radiation="state_space")``), excited by the time series ``simulate`` uses, and stepped
+exactly.
+
+About q₀, with x = q − q₀:
+
+    M ẍ + C ẋ + K x = H₀ᵀ (F_exc(t) + F_rad),    M with the fit's A∞ (H₀ᵀ A∞ H₀),
+    ż = P z + S H₀ ẋ,   F_rad = −R z              (the fit's modal form; real and imaginary parts)
+
+(K, C and M from every load at rest, H₀ the hydro Jacobian at q₀, F_exc the excitation of
+``hydro.excitation.excitation_time_series`` on the same components and ramp) is the LTI system
+
+    ẏ = A y + B f(t),   y = (x, ẋ, z),   f = H₀ᵀ F_exc   (n_q generalised forces).
+
+With A = V Λ V⁻¹ (its modes) and f linear within each step (first-order hold on the samples
+f_k = f(t_k), the hold of ``simulate``'s excitation table too), each mode w = V⁻¹ y obeys
+ẇ = λ w + b f(t), b = V⁻¹ B, and is advanced exactly:
+
+    w_{k+1} = e^{λh} w_k + h φ₁(λh) b f_k + h φ₂(λh) b (f_{k+1} − f_k)
+
+(:func:`mfm.loads.radiation.phi_functions`); y = Re V w, a conjugate pair of modes stepped once
+and counted twice. Nothing depends on the position of a free coordinate (a zero column of K: an
+unmoored surge), which would make A defective (0 a double eigenvalue): it is left out of y and
+integrated exactly from its velocity,
+
+    q_f(t_{k+1}) − q_f(t_k) = Re v_f ∫ w dt,   ∫_{t_k}^{t_{k+1}} w dt = h φ₁ w_k + h² φ₂ b f_k + h² φ₃ b (f_{k+1} − f_k).
+
+No step size limit and no time-stepping error: against the linear model the one error is the hold's
+on the force, O((ωh)²) (the spectral level's steady state has none; this level has the start-up
+transient and the ramp, as ``simulate`` has). Cost per step: one (modes × n_q) complex product.
+"""
+from __future__ import annotations
+
+import functools
+import hashlib
+import numbers
+import time as _time
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import xarray as xr
+
+from . import frequency as _fd
+from . import results
+from .model import Model
+from .spectral import _check_sea
+
+# the largest condition number of the mode matrix V accepted: the modes' round-off grows as
+# cond(V)·ε (1e10: 1e-6 relative; in the 1-norm RM3 has 4.6e3, M4 134 2.1e4)
+MAX_MODE_CONDITION = 1e10
+
+
+def _number(value, what, **kw):
+    from .simulate import _number as number
+
+    return number(value, what, **kw)
+
+
+def lti_matrices(M, C, K, H0=None, rad=None, free=()):
+    """(A, B, layout) of the LTI system of the module docstring: M, C, K (n, n); H0 (6K, n) and
+    ``rad`` (a :class:`~mfm.loads.radiation.StateSpace`) for the radiation states, or None; ``free``
+    the coordinates whose position is left out of y. layout: the rows of y: ``x`` (positions kept,
+    their coordinate indices ``stiff``), ``v`` (velocities), then the radiation states."""
+    n = M.shape[0]
+    stiff = [k for k in range(n) if k not in set(free)]
+    ns = len(stiff)
+    nx = 0 if rad is None else len(rad.inputs)
+    N = ns + n + 2 * nx
+    Minv = np.linalg.solve(M, np.eye(n))
+    A = np.zeros((N, N))
+    vs = slice(ns, ns + n)
+    A[np.arange(ns), ns + np.asarray(stiff, dtype=int)] = 1.0
+    A[vs, :ns] = -Minv @ K[:, stiff]
+    A[vs, vs] = -Minv @ C
+    if nx:
+        pr, pi = np.asarray(rad.p[:, 0]), np.asarray(rad.p[:, 1])
+        zr, zi = slice(ns + n, ns + n + nx), slice(ns + n + nx, N)
+        Cr, Ci = np.asarray(rad.C[..., 0]), np.asarray(rad.C[..., 1])
+        out = np.zeros((H0.shape[0], nx)), np.zeros((H0.shape[0], nx))
+        out[0][np.asarray(rad.outputs)] = Cr
+        out[1][np.asarray(rad.outputs)] = Ci
+        # F_rad = −(Cr zr − Ci zi) on the output dofs; M ẍ gets H₀ᵀ F_rad
+        A[vs, zr] = -Minv @ H0.T @ out[0]
+        A[vs, zi] = Minv @ H0.T @ out[1]
+        A[zr, zr] = np.diag(pr)
+        A[zr, zi] = -np.diag(pi)
+        A[zi, zr] = np.diag(pi)
+        A[zi, zi] = np.diag(pr)
+        A[zr, vs] = H0[np.asarray(rad.inputs)]
+    B = np.zeros((N, n))
+    B[vs] = Minv
+    return A, B, {"stiff": stiff, "free": list(free), "x": slice(0, ns), "v": vs, "Minv": Minv}
+
+
+# the modes of the last few systems, by the bytes of (A, B, layout, dt): the eigendecomposition
+# (seconds for M4 134's 1,021 states) depends on the model and dt only, not on the sea, so a
+# sweep over sea states pays it once (as the state-space fit is cached on the HydroSpec)
+_MODES_CACHE: dict = {}
+_MODES_CACHE_SIZE = 4
+
+
+def modal_step(A, B, layout, dt):
+    """The exact modal step of the module docstring for steps of ``dt``: the complex arrays the
+    scan needs, and the condition number of V (1-norm, ‖V‖ ‖V⁻¹‖). Raises ValueError when A's
+    modes are too ill-conditioned to use."""
+    key = hashlib.sha1(b"".join([A.tobytes(), B.tobytes(), repr((layout["stiff"], layout["free"],
+                                                                 float(dt))).encode()])).hexdigest()
+    if key not in _MODES_CACHE:
+        if len(_MODES_CACHE) >= _MODES_CACHE_SIZE:
+            _MODES_CACHE.pop(next(iter(_MODES_CACHE)))
+        _MODES_CACHE[key] = _modal_step(A, B, layout, dt)
+    return _MODES_CACHE[key]
+
+
+def _modal_step(A, B, layout, dt):
+    from .loads.radiation import phi_functions
+
+    lam, V = np.linalg.eig(A)
+    W = np.linalg.solve(V, np.eye(len(lam)))
+    cond = float(np.linalg.norm(V, 1) * np.linalg.norm(W, 1))
+    if not cond < MAX_MODE_CONDITION:
+        raise ValueError(f"the linearised system's modes are ill-conditioned (cond V = {cond:.3g} "
+                         f"> {MAX_MODE_CONDITION:.0e}): nearly repeated eigenvalues of a "
+                         "non-normal system; use the time domain (mfm.simulate)")
+    keep = lam.imag >= 0        # LAPACK gives a real A's pairs exactly conjugate, real ones real
+    weight = np.where(lam.imag[keep] > 0, 2.0, 1.0)
+    W = W[keep]
+    lam, V = lam[keep], V[:, keep] * weight[None]
+    b = (W @ B).astype(complex)        # complex even where every mode is real
+    e, p1, p2, p3 = phi_functions(lam * dt, 3)
+    v = layout["v"]
+    stiff, free = layout["stiff"], layout["free"]
+    n = len(stiff) + len(free)
+    # output rows: q (positions kept), q̇ (all), q̈ = (A y)_v + M⁻¹ f (A V = V Λ)
+    Yq = np.zeros((n, len(lam)), complex)
+    Yq[stiff] = V[layout["x"]]
+    Yv = V[v]
+    return dict(e=jnp.asarray(e), c0=jnp.asarray(dt * (p1 - p2)), c1=jnp.asarray(dt * p2),
+                b=jnp.asarray(b), Yq=jnp.asarray(Yq), Yv=jnp.asarray(Yv),
+                Ya=jnp.asarray(Yv * lam[None]), Minv=jnp.asarray(layout["Minv"]),
+                # free positions: their velocity rows against ∫ w dt over the step
+                Yf=jnp.asarray(Yv[free] if free else np.zeros((0, len(lam)))),
+                d_w=jnp.asarray(dt * p1), d0=jnp.asarray(dt**2 * (p2 - p3)),
+                d1=jnp.asarray(dt**2 * p3), free=jnp.asarray(np.asarray(free, dtype=int))), cond
+
+
+# force samples per chunk of the scan, times the modes: the chunk's modal inputs b f_k are one
+# matrix product, its outputs another (the serial loop is elementwise only); 5e5 complex numbers
+# (8 MB, cache-sized: larger chunks measured slower) per chunk
+CHUNK_ENTRIES = 500_000
+
+
+@functools.partial(jax.jit, static_argnames=("save_every", "chunk"))
+def _scan(modes, f, save_every, chunk):
+    """(x, ẋ, ẍ) (n_saved, n) at t₀ and every ``save_every`` steps for the force samples f
+    (n_steps + 1, n_q), from rest (w = 0), in chunks of ``chunk`` steps (a multiple of
+    ``save_every``). The serial loop is w_{k+1} = e w_k + g_k alone; the inputs g_k, the outputs
+    and the free positions' increments Re Y_f ∫ w dt are matrix products over each chunk."""
+    m = modes
+    free = m["free"]
+    n, nf = m["Minv"].shape[0], free.shape[0]
+    n_steps = f.shape[0] - 1
+    n_chunks = -(-n_steps // chunk)
+    # zero force past the end: later samples do not reach earlier ones (dropped below)
+    f_all = jnp.concatenate([f, jnp.zeros((n_chunks * chunk - n_steps, f.shape[1]))])
+    fs_all = f_all[1:].reshape(n_chunks, chunk, f.shape[1])
+    # every output row against the modes in one real product, Re(W Yᵀ) = Re W Re Yᵀ − Im W Im Yᵀ
+    # (XLA's complex products on the CPU are twice as slow): q, q̇, q̈ − M⁻¹f, and the free
+    # positions' increments' part h φ₁ w_k
+    Y = jnp.concatenate([m["Yq"], m["Yv"], m["Ya"], m["Yf"] * m["d_w"][None]])
+    Yr, Yi = jnp.real(Y).T, jnp.imag(Y).T
+    br, bi = jnp.real(m["b"]).T, jnp.imag(m["b"]).T
+    Yf_0, Yf_1 = m["Yf"] * m["d0"][None], m["Yf"] * m["d1"][None]
+
+    def step(w, g):
+        w = m["e"] * w + g
+        return w, w
+
+    def one_chunk(carry, fs):
+        w0, u0, qf0 = carry
+        U = (fs @ br) + 1j * (fs @ bi)                     # b f_{k+1} over the chunk (f real)
+        U_prev = jnp.concatenate([u0[None], U[:-1]])       # b f_k
+        w_end, W = jax.lax.scan(step, w0, m["c0"] * U_prev + m["c1"] * U)
+        W_prev = jnp.concatenate([w0[None], W[:-1]])
+        out = jnp.real(W) @ Yr - jnp.imag(W) @ Yi
+        free_w = jnp.real(W_prev) @ Yr[:, 3 * n:] - jnp.imag(W_prev) @ Yi[:, 3 * n:]
+        qf = qf0 + jnp.cumsum(free_w + jnp.real(U_prev @ Yf_0.T + U @ Yf_1.T), axis=0)
+        k = slice(save_every - 1, None, save_every)
+        return (w_end, U[-1], qf[-1]), outputs(out[k], qf[k], fs[k])
+
+    def outputs(out, qf, fk):
+        x = out[:, :n].at[:, free].set(qf)
+        return x, out[:, n:2 * n], out[:, 2 * n:3 * n] + fk @ m["Minv"].T
+
+    zero = jnp.zeros(m["e"].shape[0], complex)
+    qf0 = jnp.zeros(nf)
+    _, saved = jax.lax.scan(one_chunk, (zero, m["b"] @ f[0], qf0), fs_all)
+    first = outputs(jnp.zeros((1, 3 * n + nf)), qf0[None], f[:1])
+    n_saved = n_steps // save_every
+    return tuple(jnp.concatenate([a, b.reshape((-1,) + b.shape[2:])[:n_saved]])
+                 for a, b in zip(first, saved))
+
+
+def lti_response(M, C, K, f, dt, *, save_every: int = 1, H0=None, rad=None, free=()):
+    """The response from rest of M ẍ + C ẋ + K x = f(t) (+ the radiation of ``rad`` through
+    ``H0``) to the force samples f (n_steps + 1, n) at t_k = k dt, linear between them, stepped
+    exactly (module docstring): (x, ẋ, ẍ) (n_steps // save_every + 1, n) numpy, and cond(V)."""
+    f = np.asarray(f, dtype=float)
+    A, B, layout = lti_matrices(np.asarray(M, float), np.asarray(C, float), np.asarray(K, float),
+                                None if H0 is None else np.asarray(H0, float), rad, free)
+    modes, cond = modal_step(A, B, layout, float(dt))
+    nk = modes["e"].shape[0]
+    n_steps = f.shape[0] - 1
+    chunk = save_every * max(1, min(CHUNK_ENTRIES // (nk * save_every), n_steps // save_every))
+    x, v, a = _scan(modes, jnp.asarray(f), save_every=int(save_every), chunk=int(chunk))
+    return np.asarray(x), np.asarray(v), np.asarray(a), cond
+
+
+def _free_columns(K):
+    """Coordinates nothing depends on the position of: a zero column of K (≤ 1e-9 of its largest
+    entry, the threshold of :func:`mfm.simulate.free_coordinates`)."""
+    scale = max(float(np.abs(K).max()), 1e-300)
+    return [k for k in range(K.shape[1]) if float(np.abs(K[:, k]).max()) <= 1e-9 * scale]
+
+
+def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: float = 0.0,
+                    save_every: int = 1, q0=None, loads=None,
+                    state_space_options: dict | None = None) -> xr.Dataset:
+    """The model's response to ``sea`` linearised in the time domain (module docstring): from rest
+    at the equilibrium, the excitation of :func:`mfm.simulate` (same components, phases and
+    ``ramp``), radiation by the passive state-space fit (``state_space_options`` as for
+    ``simulate``), stepped exactly at ``dt`` (any dt is stable; the force is held linear between
+    samples).
+
+    model: a Model with hydrodynamics; sea: a sea state of :mod:`hydro.waves`. duration, dt: s
+    (``round(duration / dt)`` steps); save_every: keep every k-th step. q0, loads: as
+    :func:`mfm.frequency_response` (q0 the linearisation point, default the equilibrium).
+
+    Returns an xarray.Dataset with ``q``, ``qd``, ``qdd`` (time, coordinate), ``pto_power`` and
+    ``pto_displacement`` (time, pto) of each joint damper (c q̇², as :func:`mfm.spectral_response`;
+    hydraulic pistons' power is in :func:`mfm.frequency_response`), ``eta`` (time) and
+    ``equilibrium`` (coordinate); attributes: provenance, ``level = "linear"``, the state-space
+    fit, ``free_positions``, ``mode_condition`` (‖V‖₁‖V⁻¹‖₁), the wall time.
+    Raises ValueError on bad input, NotImplementedError for a load with frequency-dependent terms
+    other than the water's (no time-domain realisation of them here).
+    """
+    from hydro.excitation import excitation_time_series
+    from hydro.waves import elevation
+
+    from .loads.base import Load
+    from .loads.radiation import StateSpace
+    from .loads.water import Water
+
+    if model.hydro is None:
+        raise ValueError(f"model {model.name!r} has no hydrodynamics: linear_response needs a "
+                         "config with a [hydro] table")
+    _check_sea(sea)
+    dt = _number(dt, "dt", positive=True)
+    duration = _number(duration, "duration", positive=True)
+    ramp = _number(ramp, "ramp", nonnegative=True)
+    n_steps = int(round(duration / dt))
+    if n_steps < 1:
+        raise ValueError(f"duration = {duration} s is shorter than one step dt = {dt} s")
+    if isinstance(save_every, bool) or not isinstance(save_every, numbers.Integral) or save_every < 1 \
+            or n_steps % save_every:
+        raise ValueError(f"save_every: {save_every!r} must be a positive divisor of the {n_steps} "
+                         "steps")
+    start = _time.perf_counter()
+    sys = _fd.linear_system(model, q0, loads=loads)
+    other = [type(ld).__name__ for ld in sys.loads if not isinstance(ld, Water)
+             and type(ld).frequency_terms is not Load.frequency_terms]
+    if other:
+        raise NotImplementedError(f"loads {other} add frequency-dependent terms that have no "
+                                  "time-domain realisation in the linear level; use mfm.simulate")
+    water = _fd._water(sys.loads)
+    spec = model.hydro
+    rad = StateSpace.build(spec, state_space_options)
+    H0 = np.asarray(water.geometry.h_matrix(sys.kin0)[0])
+    # the fit's A∞ (its corrected one) in place of the database's that the linearisation holds
+    M = sys.M + H0.T @ (np.asarray(rad.A_inf) - np.asarray(water.A_inf)) @ H0
+    t = dt * np.arange(n_steps + 1)
+    comps = sea.components(water_depth=spec.water_depth, g=spec.g)
+    f = excitation_time_series(spec.database(), comps, t, ramp_duration=ramp) @ H0
+    free = _free_columns(sys.K)
+    x, qd, qdd, cond = lti_response(M, sys.C, sys.K, f, dt, save_every=save_every, H0=H0,
+                                    rad=rad, free=free)
+    ts = t[::save_every]
+    q = sys.q0[None] + x
+    eta = np.asarray(elevation(comps, ts, ramp_duration=ramp)).reshape(-1)
+    wall = _time.perf_counter() - start
+    settings = dict(level="linear", dt=dt, dt_units="s", duration=duration, n_steps=n_steps,
+                    save_every=int(save_every), ramp_s=ramp, sea=repr(sea),
+                    n_components=len(comps), free_positions=", ".join(
+                        model.coordinates[k] for k in free) or "none",
+                    mode_condition=cond, wall_time_s=wall)
+    return results.linear_time_series(model, sys.loads + (rad,), ts, q, qd, qdd, sys.q0, eta,
+                                      settings, source=spec.source)
