@@ -240,8 +240,8 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
     :func:`mfm.frequency_response` (q0 the linearisation point, default the equilibrium).
 
     Returns an xarray.Dataset with ``q``, ``qd``, ``qdd`` (time, coordinate), ``pto_power`` and
-    ``pto_displacement`` (time, pto) of each joint damper (c q̇², as :func:`mfm.spectral_response`;
-    hydraulic pistons' power is in :func:`mfm.frequency_response`), ``eta`` (time) and
+    ``pto_displacement`` (time, pto) of each joint damper (c q̇², as :func:`mfm.spectral_response`)
+    and each hydraulic piston (β ẇ², ẇ = g(q₀) q̇ to first order), ``eta`` (time) and
     ``equilibrium`` (coordinate); attributes: provenance, ``level = "linear"``, the state-space
     fit, ``free_positions``, ``mode_condition`` (‖V‖₁‖V⁻¹‖₁), the wall time.
     Raises ValueError on bad input, NotImplementedError for a load with frequency-dependent terms
@@ -297,4 +297,5 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
                         model.coordinates[k] for k in free) or "none",
                     mode_condition=cond, wall_time_s=wall)
     return results.linear_time_series(model, sys.loads + (rad,), ts, q, qd, qdd, sys.q0, eta,
-                                      settings, source=spec.source)
+                                      settings, source=spec.source,
+                                      dampers=results.linear_dampers(sys.loads, sys.kin0))

@@ -147,6 +147,21 @@ def add_ptos(ds, names, power, displacement, force=None, dim="time"):
     return ds
 
 
+def linear_dampers(loads, kin0) -> list:
+    """The loads' PTOs linearised at ``kin0`` (:meth:`mfm.loads.base.Load.linear_dampers`): the
+    hydraulic pistons the linear levels report beside the joint dampers."""
+    return [d for d in (ld.linear_dampers(kin0) for ld in loads) if d is not None]
+
+
+def add_linear_dampers(ds, dampers, q0, q, qd, dim="time"):
+    """Append each linearised PTO's power β (G q̇)² and displacement w₀ + G (q − q₀) (time, pto)."""
+    for d in dampers:
+        G = np.asarray(d.rows)
+        ds = add_ptos(ds, d.names, absorbed_power(np.asarray(d.damping), qd @ G.T),
+                      np.asarray(d.offset) + (q - q0) @ G.T, dim=dim)
+    return ds
+
+
 def _joint_dampers(ds, model, damping, q, qd, dim):
     damped, power = damper_power(np.asarray(damping), qd)
     if not damped:
@@ -213,9 +228,11 @@ def time_series(model, loads, integ, dt, t, q, qd, qdd, iters, rec, settings) ->
     return ds
 
 
-def linear_time_series(model, loads, t, q, qd, qdd, q0, eta, settings, source=None) -> xr.Dataset:
-    """The dataset of :func:`mfm.linear.linear_response`: q, q̇, q̈ (time, coordinate), the joint
-    dampers' power, ``eta`` and the ``equilibrium`` it is linearised about."""
+def linear_time_series(model, loads, t, q, qd, qdd, q0, eta, settings, source=None,
+                       dampers=()) -> xr.Dataset:
+    """The dataset of :func:`mfm.linear.linear_response`: q, q̇, q̈ (time, coordinate), the power
+    of the joint dampers and of the loads' linearised PTOs (``dampers``, :func:`linear_dampers`),
+    ``eta`` and the ``equilibrium`` it is linearised about."""
     ds = xr.Dataset(
         {"q": (("time", "coordinate"), q, _coordinate_attrs(model, 0)),
          "qd": (("time", "coordinate"), qd, _coordinate_attrs(model, 1)),
@@ -229,7 +246,8 @@ def linear_time_series(model, loads, t, q, qd, qdd, q0, eta, settings, source=No
                **provenance(model, loads, **settings)})
     if source is not None:
         ds.attrs["source"] = source
-    return _joint_dampers(ds, model, model.damping, q, qd, "time")
+    ds = _joint_dampers(ds, model, model.damping, q, qd, "time")
+    return add_linear_dampers(ds, dampers, q0, q, qd)
 
 
 def batch(model, models, loads, integ, t, q, qd, dts, settings, save_every, labels=None,

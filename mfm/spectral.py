@@ -8,7 +8,10 @@ wave amplitude, x(t) = Re[x̂ e^{−iωt}]):
 
     q(t) = q₀ + Re Σ_j a_j e^{iφ_j} x̂(ω_j, β_j) e^{−iω_j t}                 (the time series)
     σ_q² = Σ_j ½ a_j² |x̂(ω_j, β_j)|²                                       (its variance)
-    P̄ = Σ_j a_j² · ½ c ω_j² |x̂_pto(ω_j, β_j)|²                             (mean damper power)
+    P̄ = Σ_j a_j² · ½ c ω_j² |G x̂(ω_j, β_j)|²                              (mean damper power)
+
+(G the rows that give each PTO's rate from q̇: a joint damper's coordinate, a piston's stroke rate
+linearised at q₀.)
 
 — the same components and phases as :func:`mfm.simulate` excites the time domain with (the
 excitation is ``hydro.excitation.excitation_time_series`` of the same components), so the two can be
@@ -45,9 +48,10 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
     only. q0, loads, radiation, state_space_options: as :func:`mfm.frequency_response`.
 
     Returns an xarray.Dataset: ``q_rms`` (coordinate) the standard deviation about the equilibrium,
-    ``pto_power_mean`` (pto) the expected mean power of each joint damper (W), ``equilibrium``
-    (coordinate); with ``t`` also ``q``, ``qd`` (time, coordinate), ``pto_power`` (time, pto)
-    = c q̇² (W) and ``eta`` (time) the elevation at the origin (m). Attributes: provenance, the
+    ``pto_power_mean`` (pto) the expected mean power of each joint damper and hydraulic piston
+    (W; a piston's rate ẇ = G q̇ linearised at q₀, :meth:`~mfm.loads.base.Load.linear_dampers`),
+    ``equilibrium`` (coordinate); with ``t`` also ``q``, ``qd`` (time, coordinate), ``pto_power``
+    (time, pto) = c (G q̇)² (W) and ``eta`` (time) the elevation at the origin (m). Attributes: provenance, the
     sea, ``level = "spectral"``, ``n_components`` and the wall time of the synthesis.
     """
     # the harmonic sum of the time-domain excitation and elevation (hydro.waves), chunked over t
@@ -76,18 +80,24 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
     a = comps.complex_amplitude
     damped = [k for k in range(n) if float(model.damping[k]) > 0]
     c = np.asarray(model.damping, dtype=float)[damped]
+    # every PTO as a damping c on a rate G q̇: the joint dampers (G rows of the identity), then the
+    # loads' pistons linearised at q₀ (the time domain's pto order)
+    dampers = results.linear_dampers(sys.loads, sys.kin0)
+    G = np.concatenate([np.eye(n)[damped]] + [np.asarray(d.rows) for d in dampers])
+    c_all = np.concatenate([c] + [np.asarray(d.damping, dtype=float) for d in dampers])
     mean_power = np.sum(comps.amplitude[:, None] ** 2
-                        * results.mean_absorbed_power(c, comps.omega[:, None], x[:, damped]), axis=0)
+                        * results.mean_absorbed_power(c_all, comps.omega[:, None], x @ G.T), axis=0)
     q_rms = np.sqrt(np.sum(0.5 * comps.amplitude[:, None] ** 2 * np.abs(x) ** 2, axis=0))
     data = {
         "q_rms": (("coordinate",), q_rms, {"long_name": "standard deviation about the equilibrium",
                                            "units": "m or rad (per coordinate: coordinate_unit)"}),
         "pto_power_mean": (("pto",), mean_power, {"long_name": "expected mean power of each joint "
-                                                  "damper, Σ a² ½ c ω² |x|²", "units": "W"}),
+                                                  "damper and piston, Σ a² ½ c ω² |G x|²",
+                                                  "units": "W"}),
         "equilibrium": (("coordinate",), sys.q0, {"units": "m or rad"}),
     }
     coords = {**results._coordinate_coords(model),
-              "pto": [model.coordinates[k] for k in damped]}
+              "pto": [model.coordinates[k] for k in damped] + [p for d in dampers for p in d.names]}
     if t is not None:
         coef = a[:, None] * x
         # q and q̇ in one harmonic sum (the exponentials are most of the cost)
@@ -98,8 +108,9 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
                                            "units": "m or rad (per coordinate: coordinate_unit)"}),
             qd=(("time", "coordinate"), qd, {"long_name": "generalised velocities",
                                              "units": "m/s or rad/s"}),
-            pto_power=(("time", "pto"), results.absorbed_power(c, qd[:, damped]),
-                       {"long_name": "power absorbed by each joint damper, c q̇²", "units": "W"}),
+            pto_power=(("time", "pto"), results.absorbed_power(c_all, qd @ G.T),
+                       {"long_name": "power absorbed by each joint damper and piston, c (G q̇)²",
+                        "units": "W"}),
             eta=(("time",), np.asarray(elevation(comps, t)).reshape(-1),
                  {"long_name": "undisturbed wave elevation at the origin", "units": "m"}))
         coords["time"] = ("time", t, {"units": "s"})

@@ -10,7 +10,7 @@ frequency domain from one definition.
   :class:`CatenaryLines` (``[[catenary_lines]]``: quasi-static MoorPy lines, tabulated);
 - :class:`BodyWrench`, :class:`CoordinateForceSeries`: loads given directly (``loads=``).
 """
-from .base import Context, FrequencyTerms, Load, LoadOutput
+from .base import Context, FrequencyTerms, LinearDampers, Load, LoadOutput
 from .body_matrix import LinearBodyMatrix
 from .catenary import CatenaryLines
 from .generic import BodyWrench, CoordinateForceSeries
@@ -22,5 +22,5 @@ from .registry import TABLES, load_class
 from .wind import WindThrust
 
 __all__ = ["BodyPointOutputs", "BodyWrench", "CatenaryLines", "Context", "CoordinateForceSeries",
-           "FrequencyTerms", "HydraulicPTO", "JointLoad", "LinearBodyMatrix", "Load", "LoadOutput", "PointSprings",
-           "TABLES", "WindThrust", "load_class"]
+           "FrequencyTerms", "HydraulicPTO", "JointLoad", "LinearBodyMatrix", "LinearDampers", "Load",
+           "LoadOutput", "PointSprings", "TABLES", "WindThrust", "load_class"]

@@ -62,6 +62,16 @@ class FrequencyTerms(NamedTuple):
     force: Any = None
 
 
+class LinearDampers(NamedTuple):
+    """The power-absorbing dampers a load adds, linearised about q₀ (:meth:`Load.linear_dampers`):
+    ``names`` (P,), ``damping`` β (P,) (N s/m or N m s/rad), ``rows`` G (P, n_q) with the rate
+    ẇ = G q̇ to first order, ``offset`` w(q₀) (P,). Power β ẇ², displacement w(q₀) + G (q − q₀)."""
+    names: tuple
+    damping: Any
+    rows: Any
+    offset: Any
+
+
 class Load(eqx.Module):
     """Base class. Override :meth:`evaluate` (or, the older form, ``__call__(model, t, q, qd, z,
     kin, memory=(), qdd_guess=None)``); the rest has defaults for a load without states, memory,
@@ -154,6 +164,14 @@ class Load(eqx.Module):
         """Outputs of a frequency response from the complex coordinate amplitudes x (n_ω, n_q):
         name → (dims after "omega", array, attrs), plus "coords" (default: none)."""
         return {}
+
+    def linear_dampers(self, kin0) -> LinearDampers | None:
+        """The PTOs this load adds as seen by the linear levels (:func:`mfm.spectral_response`,
+        :func:`mfm.linear_response`), linearised at the kinematics ``kin0`` of q₀, so that every
+        level of the fidelity ladder reports the PTOs the time domain reports; None (default):
+        none. The damping itself must already be in :meth:`evaluate` (the linearisation takes it
+        from there); this only names it and says how its power is read from q̇."""
+        return None
 
     def provenance(self) -> dict:
         """Settings that made this load, for the result's attributes."""

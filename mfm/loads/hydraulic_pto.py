@@ -21,7 +21,7 @@ import numpy as np
 from ..parsing import body_ref, number, tables, vector
 from ..points import BodyPoints
 from ..tree import ConfigError
-from .base import Load, LoadOutput
+from .base import LinearDampers, Load, LoadOutput
 
 PTO_KEYS = {"name", "kind", "body", "point", "anchor_body", "anchor", "mu", "beta", "kappa", "notes"}
 
@@ -128,6 +128,13 @@ class HydraulicPTO(Load):
                                              "wave amplitude, (κ − ω²μ − iωβ) × stroke RAO",
                                              "units": "N/m"}),
                 "coords": {"hydraulic_pto": list(self.names)}}
+
+    def linear_dampers(self, kin0):
+        """The pistons to first order about q₀: ẇ = g(q₀) q̇, power β ẇ² (the β term of
+        :meth:`evaluate`; μ and κ absorb nothing)."""
+        w, _, g, _, _ = self._kinematics(kin0)
+        return LinearDampers(tuple(self.names), np.asarray(self.beta, dtype=float),
+                             np.asarray(g, dtype=float), np.asarray(w, dtype=float))
 
     # -- config
     @staticmethod
