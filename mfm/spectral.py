@@ -150,6 +150,33 @@ def _times(t, B):
     return arr
 
 
+def _synthesise(comps, xs, times, q0):
+    """q, q̇ (B, n_t, n_q) and η (B, n_t) at the origin of every case: Re Σ_j c_j e^{−iω_j t} with
+    c_j = a_j e^{iφ_j} (x̂_j, −iω_j x̂_j, 1) (the elevation of :func:`hydro.waves.elevation` at
+    x = y = 0). The phases e^{−iω_j t} are most of the cost: cases with the same time grid and
+    frequencies (a power matrix's seas of one T_p and one seed) share one harmonic sum."""
+    from hydro.waves import _harmonic_sum
+
+    B, n_t = times.shape
+    n = q0.shape[0]
+    q, qd, eta = np.empty((B, n_t, n)), np.empty((B, n_t, n)), np.empty((B, n_t))
+    groups: dict = {}
+    for i, cm in enumerate(comps):
+        groups.setdefault((times[i].tobytes(), cm.omega.tobytes()), []).append(i)
+    for members in groups.values():
+        omega = comps[members[0]].omega
+        cols = []
+        for i in members:
+            a = comps[i].complex_amplitude[:, None]
+            coef = a * xs[i]
+            cols += [coef, -1j * omega[:, None] * coef, a]
+        out = _harmonic_sum(omega, np.concatenate(cols, axis=1), times[members[0]])
+        for k, i in enumerate(members):
+            block = out[:, k * (2 * n + 1):(k + 1) * (2 * n + 1)]
+            q[i], qd[i], eta[i] = q0[None] + block[:, :n], block[:, n:2 * n], block[:, 2 * n]
+    return q, qd, eta
+
+
 def spectral_sweep(model: Model, seas, *, t=None, q0=None, loads=None,
                    radiation: str = "database", state_space_options: dict | None = None
                    ) -> xr.Dataset:
@@ -173,8 +200,6 @@ def spectral_sweep(model: Model, seas, *, t=None, q0=None, loads=None,
     step). Attributes: provenance, ``level = "spectral"``, the seas, ``n_frequencies_solved`` (the
     union), the wall times of the RAO solve and of the whole call.
     """
-    from hydro.waves import _harmonic_sum, elevation
-
     from .simulate import _sea_labels
 
     start = _time.perf_counter()
@@ -221,16 +246,7 @@ def spectral_sweep(model: Model, seas, *, t=None, q0=None, loads=None,
     coords = {"case": np.arange(B), **results._coordinate_coords(model),
               "pto": [model.coordinates[k] for k in damped]}
     if times is not None:
-        n_t = times.shape[1]
-        q, qd = np.empty((B, n_t, n)), np.empty((B, n_t, n))
-        eta = np.empty((B, n_t))
-        for i, (cm, x) in enumerate(zip(comps, xs)):
-            coef = cm.complex_amplitude[:, None] * x
-            # q and q̇ in one harmonic sum, as spectral_response
-            both = _harmonic_sum(cm.omega, np.concatenate([coef, -1j * cm.omega[:, None] * coef],
-                                                          1), times[i])
-            q[i], qd[i] = sys.q0[None] + both[:, :n], both[:, n:]
-            eta[i] = np.asarray(elevation(cm, times[i])).reshape(-1)
+        q, qd, eta = _synthesise(comps, xs, times, sys.q0)
         data.update(
             time=(("case", "step"), np.array(times), {"units": "s"}),
             q=(("case", "step", "coordinate"), q,
