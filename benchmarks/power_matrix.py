@@ -304,7 +304,8 @@ def main_spectral(a):
           f"state-space fit: max {np.abs(err_fit).max():.2e}. The expected mean power "
           f"Σ a² ½ c ω² |x̂|² against the 80-T_p window: max {np.abs(err_exp).max():.2e} (the "
           f"window's sampling of the record, not the model).")
-    over = [f"(H_s {HS[i]:g}, T_p {TP[j]:g}) {err[i, j]:+.2e}" for i, j in np.argwhere(np.abs(err) > 0.005)]
+    over = [f"(H_s {HS[i]:g}, T_p {TP[j]:g}) {err[i, j]:+.2e}"
+            for i, j in np.argwhere(np.abs(err) > 0.005)]
     print(f"- cells over 0.5 % (database radiation): {'; '.join(over) if over else 'none'}.\n")
     print("Relative error of the spectral level's mean power (database radiation) against the "
           "time domain, per cell:\n")
