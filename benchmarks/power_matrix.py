@@ -12,6 +12,18 @@ worker processes (its start timed apart). Wall times include the radiation fit a
 Peak memory: the child's maximum resident set (and each worker's). The results of every way are
 compared with the one-call batch (the acceptance: 1e-12) and the mean PTO power matrix over the
 last 80 T_p is printed.
+
+    python benchmarks/power_matrix.py --spectral [--td-file out/td_chunked.nc] [--pilot-tp 0.8 1.2 1.8]
+
+The same matrix through the spectral level (``mfm.sweep(m, seas, level="spectral", dt=, n_steps=,
+save_every=10)``: linearised once, RAOs solved once on the union of the seas' frequencies, the
+series synthesised on the time domain's saved grid), timed cold (a fresh process: load, linearise,
+RAOs, 120 cases) and warm (median of 3), and compared cell by cell with the time-domain matrix
+(``mfm.sweep`` in process, Verlet + exact state space; read from ``--td-file`` if it exists, else
+run once and written there): the mean power over the same last 80 T_p of the same samples. Then
+``mfm.reduce`` (tolerance 0.005, levels spectral, fast, full; its default 40-T_p pilot at T_p/200)
+at the largest H_s and the T_p of ``--pilot-tp``: is the linear level justified where the motions
+are largest?
 """
 import argparse
 import json
@@ -87,11 +99,73 @@ def child(what, n_steps, chunk_size, out):
     print("RESULT " + json.dumps(res), flush=True)
 
 
-def run(what, n_steps, chunk_size, tmp):
+def _timed(fn, repeats=3):
+    import statistics
+
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return out, statistics.median(times)
+
+
+def child_spectral(n_steps, out):
+    """The matrix through the spectral level in this fresh process: cold (load included), warm."""
+    warnings.simplefilter("ignore")
+    t0 = time.perf_counter()
+    import mfm
+
+    m = mfm.load(ROOT / "configs" / "m4_134.toml")
+    seas, dts, _ = cases()
+    res = {"what": "spectral", "load_s": time.perf_counter() - t0}
+    kw = dict(level="spectral", dt=dts, n_steps=n_steps, save_every=10)
+    ds = mfm.sweep(m, seas, **kw)
+    res["cold_s"] = time.perf_counter() - t0     # import, load, linearise, RAOs, 120 cases
+    res["cold_rao_solve_s"] = float(ds.attrs["rao_solve_s"])
+    res["n_frequencies_solved"] = int(ds.attrs["n_frequencies_solved"])
+    _, res["warm_s"] = _timed(lambda: mfm.sweep(m, seas, **kw))
+    stats, res["warm_stats_s"] = _timed(lambda: mfm.sweep(m, seas, level="spectral"))
+    res["warm_rao_solve_s"] = float(stats.attrs["rao_solve_s"])
+    res["maxrss_GB"] = _maxrss_gb()
+    # the same with the time domain's radiation (the state-space fit, fitted here once)
+    t1 = time.perf_counter()
+    fit = mfm.sweep(m, seas, radiation="state_space", **kw)
+    res["state_space_first_s"] = time.perf_counter() - t1
+    xr_ds = ds[["pto_power", "pto_power_mean", "time"]].copy()
+    xr_ds["pto_power_fit"] = fit.pto_power
+    xr_ds.to_netcdf(out)
+    print("RESULT " + json.dumps(res), flush=True)
+
+
+def child_reduce(tps, out):
+    """mfm.reduce at the largest H_s and the given T_p (tolerance 0.005)."""
+    warnings.simplefilter("ignore")
+    import hydro
+    import mfm
+
+    m = mfm.load(ROOT / "configs" / "m4_134.toml")
+    angles = [c for c in m.coordinates if c.endswith("angle")]
+    rows = []
+    for tp in tps:
+        sea = hydro.Jonswap(hs=float(HS[-1]), tp=float(tp), gamma=3.3, seed=1,
+                            omega_range=(1.0, 25.0))
+        t0 = time.perf_counter()
+        r = mfm.reduce(m, sea, tolerance=0.005, coordinates=angles,
+                       levels=("spectral", "fast", "full"), timing=False)
+        rows.append({"tp": float(tp), "level": r.level, "reason": r.reason,
+                     "wall_s": time.perf_counter() - t0,
+                     "errors": {lv: max(e.values()) for lv, e in r.errors.items()},
+                     "spectral": r.errors["spectral"]})
+        print(f"# reduce Tp {tp}: {rows[-1]}", file=sys.stderr, flush=True)
+    print("RESULT " + json.dumps(rows), flush=True)
+
+
+def run(what, n_steps, chunk_size, tmp, extra=()):
     out = os.path.join(tmp, f"{what}.nc")
     env = dict(os.environ, PYTHONPATH=str(ROOT), OPENBLAS_NUM_THREADS="1")
     cmd = [sys.executable, str(Path(__file__).resolve()), "--child", what, "--n-steps",
-           str(n_steps), "--chunk-size", str(chunk_size), "--out", out]
+           str(n_steps), "--chunk-size", str(chunk_size), "--out", out, *extra]
     p = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True)
     lines = [ln for ln in p.stdout.splitlines() if ln.startswith("RESULT ")]
     if p.returncode or not lines:
@@ -107,9 +181,18 @@ def main():
     ap.add_argument("--chunk-size", type=int, default=16)
     ap.add_argument("--workers", type=int, nargs="*", default=[1, 2])
     ap.add_argument("--skip-batch", action="store_true")
+    ap.add_argument("--spectral", action="store_true")
+    ap.add_argument("--td-file", default=str(ROOT / "out" / "td_chunked.nc"))
+    ap.add_argument("--pilot-tp", type=float, nargs="*", default=[0.8, 1.255, 1.8])
     a = ap.parse_args()
+    if a.child == "spectral":
+        return child_spectral(a.n_steps, a.out)
+    if a.child == "reduce":
+        return child_reduce(a.pilot_tp, a.out)
     if a.child:
         return child(a.child, a.n_steps, a.chunk_size, a.out)
+    if a.spectral:
+        return main_spectral(a)
     import xarray as xr
 
     ways = ([] if a.skip_batch else ["batch"]) + ["chunked"] + [f"cluster-{n}" for n in a.workers]
@@ -155,6 +238,92 @@ def main():
     Pm = P.reshape(len(HS), len(TP))
     for h, row in zip(HS, Pm):
         print(f"| {h:g} | " + " | ".join(f"{p:.3g}" for p in row) + " |")
+
+
+def _matrix(ds, var, n_steps):
+    """Mean total PTO power over the last 80 T_p of the saved samples (as the time domain's)."""
+    keep = n_steps // 10 // 5
+    return ds[var].sum("pto").isel(step=slice(keep, None)).mean("step").values.reshape(
+        len(HS), len(TP))
+
+
+def _table(M, fmt):
+    lines = ["| H_s \\ T_p | " + " | ".join(f"{t:g}" for t in TP) + " |",
+             "|---|" + "---|" * len(TP)]
+    lines += [f"| {h:g} | " + " | ".join(fmt(p) for p in row) + " |" for h, row in zip(HS, M)]
+    return "\n".join(lines)
+
+
+def main_spectral(a):
+    import xarray as xr
+
+    td_file = Path(a.td_file)
+    with tempfile.TemporaryDirectory() as tmp:
+        if td_file.exists():
+            td_run = None
+        else:
+            td_file.parent.mkdir(parents=True, exist_ok=True)
+            td_run, _ = run("chunked", a.n_steps, a.chunk_size, tmp)
+            os.replace(os.path.join(tmp, "chunked.nc"), td_file)
+        sp_run, sp_file = run("spectral", a.n_steps, a.chunk_size, tmp)
+        with xr.open_dataset(td_file) as f:
+            P_td = _matrix(f.load(), "pto_power", a.n_steps)
+        with xr.open_dataset(sp_file) as f:
+            sp = f.load()
+        P_sp = _matrix(sp, "pto_power", a.n_steps)
+        P_fit = _matrix(sp, "pto_power_fit", a.n_steps)
+        P_exp = sp.pto_power_mean.sum("pto").values.reshape(len(HS), len(TP))
+        pilot = run("reduce", a.n_steps, a.chunk_size, tmp,
+                    ["--pilot-tp", *map(str, a.pilot_tp)])[0] if a.pilot_tp else []
+    err = P_sp / P_td - 1
+    err_fit = P_fit / P_td - 1
+    err_exp = P_exp / P_td - 1
+    worst = np.unravel_index(np.argmax(np.abs(err)), err.shape)
+    print(f"**M4 134 power matrix through the spectral level** (`python benchmarks/power_matrix.py "
+          f"--spectral`, {time.strftime('%Y-%m-%d %H:%M')}; load average "
+          f"{os.getloadavg()[0]:.1f} at the end): {len(HS)} H_s × {len(TP)} T_p, "
+          f"`mfm.sweep(m, seas, level=\"spectral\", dt=T_p/200, n_steps={a.n_steps}, "
+          f"save_every=10)`, {sp_run['n_frequencies_solved']} frequencies solved once for all "
+          f"{len(HS) * len(TP)} cases.\n")
+    print(f"- one call cold (fresh process: import, load, linearise, RAOs, 120 cases with their "
+          f"series): {sp_run['cold_s']:.1f} s (of which load {sp_run['load_s']:.1f} s, RAO solve "
+          f"{sp_run['cold_rao_solve_s']:.2f} s); warm {sp_run['warm_s']:.2f} s (median of 3); "
+          f"statistics only warm {sp_run['warm_stats_s']:.2f} s; with the state-space fit "
+          f"(radiation=\"state_space\", fit included) {sp_run['state_space_first_s']:.1f} s; peak "
+          f"memory {sp_run['maxrss_GB']:.1f} GB.")
+    if td_run is not None:
+        print(f"- the time-domain matrix (`mfm.sweep` in process, Verlet + exact state space, "
+              f"20,000 steps per case) in this run: {td_run['wall_s']:.1f} s, peak "
+              f"{td_run['maxrss_GB']:.1f} GB.")
+    else:
+        print(f"- the time-domain matrix read from {td_file.name} (run earlier by this script).")
+    print(f"- mean power over the last 80 T_p of the same samples, spectral vs time domain: max "
+          f"|relative error| over the 120 cells {np.abs(err).max():.2e} (at H_s "
+          f"{HS[worst[0]]:g} m, T_p {TP[worst[1]]:g} s), median {np.median(np.abs(err)):.2e}; "
+          f"cells over 0.5 %: {int((np.abs(err) > 0.005).sum())}. With the time domain's "
+          f"state-space fit: max {np.abs(err_fit).max():.2e}. The expected mean power "
+          f"Σ a² ½ c ω² |x̂|² against the 80-T_p window: max {np.abs(err_exp).max():.2e} (the "
+          f"window's sampling of the record, not the model).")
+    over = [f"(H_s {HS[i]:g}, T_p {TP[j]:g}) {err[i, j]:+.2e}"
+            for i, j in np.argwhere(np.abs(err) > 0.005)]
+    print(f"- cells over 0.5 % (database radiation): {'; '.join(over) if over else 'none'}.\n")
+    print("Relative error of the spectral level's mean power (database radiation) against the "
+          "time domain, per cell:\n")
+    print(_table(err, lambda e: f"{e:+.1e}"))
+    print("\nThe same with the state-space fit in the spectral level:\n")
+    print(_table(err_fit, lambda e: f"{e:+.1e}"))
+    if pilot:
+        print(f"\n`mfm.reduce(m, sea, tolerance=0.005, coordinates=<the hinge angles>, "
+              f"levels=(\"spectral\", \"fast\", \"full\"), timing=False)` at H_s {HS[-1]:g} m "
+              "(40-T_p pilot at T_p/200 against RK4, radiation auto):\n")
+        print("| T_p | level chosen | spectral: largest error | fast: largest error | wall |")
+        print("|---|---|---|---|---|")
+        for r in pilot:
+            print(f"| {r['tp']:g} s | {r['level']} | {r['errors']['spectral']:.2e} | "
+                  f"{r['errors'].get('fast', float('nan')):.2e} | {r['wall_s']:.0f} s |")
+        for r in pilot:
+            print(f"\nT_p {r['tp']:g} s: {r['reason']}; spectral errors "
+                  + ", ".join(f"{k} {v:.2e}" for k, v in r["spectral"].items()))
 
 
 if __name__ == "__main__":

@@ -122,3 +122,161 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
                              convention="exp(-i omega t)", wall_time_s=wall),
         "source": model.hydro.source})
     return ds
+
+
+def _union_raos(model, sys, comps_list, options):
+    """The RAOs x̂ (n_j, n_q) of every sea's components from ONE linear solve per distinct heading
+    over the union of their (β, ω) pairs (seas of one seed share their frequencies: the M4 134
+    power matrix's 120 seas are 200 pairs, not 24,000). Returns (one array per sea, the number of
+    distinct pairs solved)."""
+    if not comps_list:
+        return [], 0
+    pairs = np.concatenate([np.stack([c.heading, c.omega], axis=1) for c in comps_list])
+    if pairs.size == 0:
+        return [np.zeros((0, model.n_coordinates), dtype=complex) for _ in comps_list], 0
+    union, inverse = np.unique(pairs, axis=0, return_inverse=True)
+    inverse = np.asarray(inverse).reshape(-1)
+    x = np.zeros((len(union), model.n_coordinates), dtype=complex)
+    for beta in np.unique(union[:, 0]):
+        sel = union[:, 0] == beta
+        x[sel] = _fd._amplitudes(model, sys, union[sel, 1], float(beta), options)
+    bounds = np.cumsum([0] + [len(c.omega) for c in comps_list])
+    return [x[inverse[bounds[i]:bounds[i + 1]]] for i in range(len(comps_list))], len(union)
+
+
+def _times(t, B):
+    """t as (B, n_t): one grid for every case (1-D) or one per case (2-D)."""
+    if t is None:
+        return None
+    try:
+        arr = np.asarray(t, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"t: {t!r}; give times in seconds, 1-D (every case) or 2-D "
+                         f"(case, time) with {B} rows") from None
+    if arr.ndim == 1:
+        arr = np.broadcast_to(arr, (B, arr.size))
+    if arr.ndim != 2 or arr.shape[0] != B or arr.shape[1] == 0 or not np.all(np.isfinite(arr)):
+        raise ValueError(f"t: shape {np.shape(t)}; give non-empty finite times (s), 1-D (every "
+                         f"case) or 2-D (case, time) with {B} rows")
+    return arr
+
+
+def _synthesise(comps, xs, times, q0):
+    """q, q̇ (B, n_t, n_q) and η (B, n_t) at the origin of every case: Re Σ_j c_j e^{−iω_j t} with
+    c_j = a_j e^{iφ_j} (x̂_j, −iω_j x̂_j, 1) (the elevation of :func:`hydro.waves.elevation` at
+    x = y = 0). The phases e^{−iω_j t} are most of the cost: cases with the same time grid and
+    frequencies (a power matrix's seas of one T_p and one seed) share one harmonic sum."""
+    from hydro.waves import _harmonic_sum
+
+    B, n_t = times.shape
+    n = q0.shape[0]
+    q, qd, eta = np.empty((B, n_t, n)), np.empty((B, n_t, n)), np.empty((B, n_t))
+    groups: dict = {}
+    for i, cm in enumerate(comps):
+        groups.setdefault((times[i].tobytes(), cm.omega.tobytes()), []).append(i)
+    for members in groups.values():
+        omega = comps[members[0]].omega
+        cols = []
+        for i in members:
+            a = comps[i].complex_amplitude[:, None]
+            coef = a * xs[i]
+            cols += [coef, -1j * omega[:, None] * coef, a]
+        out = _harmonic_sum(omega, np.concatenate(cols, axis=1), times[members[0]])
+        for k, i in enumerate(members):
+            block = out[:, k * (2 * n + 1):(k + 1) * (2 * n + 1)]
+            q[i], qd[i], eta[i] = q0[None] + block[:, :n], block[:, n:2 * n], block[:, 2 * n]
+    return q, qd, eta
+
+
+def spectral_sweep(model: Model, seas, *, t=None, q0=None, loads=None,
+                   radiation: str = "database", state_space_options: dict | None = None
+                   ) -> xr.Dataset:
+    """:func:`spectral_response` of many sea states in one call, with the model linearised once
+    and its RAOs solved once on the union of the seas' component frequencies and headings (module
+    docstring: per case i, σ_q² = Σ_j ½ a_ij² |x̂(ω_ij, β_ij)|², P̄ = Σ_j a_ij² ½ c ω_ij² |x̂_pto|²).
+    Its front door is ``mfm.sweep(model, seas, level="spectral")``; a power matrix of a model
+    linear over its sea states needs no time stepping.
+
+    model: a Model with hydrodynamics (one: the linearisation is shared by every case).
+    seas: a sequence of sea states of :mod:`hydro.waves` (or one).
+    t: None (the statistics only), times (s) 1-D for every case or 2-D (case, time): the time
+    series too, the same synthesis as :func:`spectral_response` (memory B × n_t × n_q).
+    q0, loads, radiation, state_space_options: as :func:`mfm.frequency_response`.
+
+    Returns an xarray.Dataset over ``case`` with the sea labels of :func:`mfm.simulate_batch`
+    (``sea_hs``, ``sea_tp``, ``sea_gamma``, ``sea_heading``, …): ``q_rms`` (case, coordinate),
+    ``pto_power_mean`` (case, pto) the expected mean power of each joint damper (W),
+    ``n_components`` (case), ``equilibrium`` (coordinate); with ``t`` also ``time`` (case, step),
+    ``q``, ``qd`` (case, step, coordinate), ``pto_power`` (case, step, pto) and ``eta`` (case,
+    step). Attributes: provenance, ``level = "spectral"``, the seas, ``n_frequencies_solved`` (the
+    union), the wall times of the RAO solve and of the whole call.
+    """
+    from .simulate import _sea_labels
+
+    start = _time.perf_counter()
+    if model.hydro is None:
+        raise ValueError(f"model {model.name!r} has no hydrodynamics: the spectral level needs a "
+                         "config with a [hydro] table")
+    seas = list(seas) if isinstance(seas, (list, tuple)) else [seas]
+    if not seas:
+        raise ValueError("seas: an empty sequence; give at least one sea state of hydro.waves")
+    for i, sea in enumerate(seas):
+        try:
+            _check_sea(sea)
+        except ValueError as e:
+            raise ValueError(f"seas[{i}]: {e}") from None
+    B = len(seas)
+    times = _times(t, B)
+    comps = [s.components(water_depth=model.hydro.water_depth, g=model.hydro.g) for s in seas]
+    options = {"radiation": radiation, "state_space_options": state_space_options}
+    sys = _fd.linear_system(model, q0, loads=loads)
+    solve_start = _time.perf_counter()
+    xs, n_union = _union_raos(model, sys, comps, options)
+    solve_s = _time.perf_counter() - solve_start
+    n = model.n_coordinates
+    damped = [k for k in range(n) if float(model.damping[k]) > 0]
+    c = np.asarray(model.damping, dtype=float)[damped]
+    q_rms = np.empty((B, n))
+    power = np.empty((B, len(damped)))
+    for i, (cm, x) in enumerate(zip(comps, xs)):
+        a2 = cm.amplitude[:, None] ** 2
+        power[i] = np.sum(a2 * results.mean_absorbed_power(c, cm.omega[:, None], x[:, damped]),
+                          axis=0)
+        q_rms[i] = np.sqrt(np.sum(0.5 * a2 * np.abs(x) ** 2, axis=0))
+    data = {
+        "q_rms": (("case", "coordinate"), q_rms,
+                  {"long_name": "standard deviation about the equilibrium",
+                   "units": "m or rad (per coordinate: coordinate_unit)"}),
+        "pto_power_mean": (("case", "pto"), power,
+                           {"long_name": "expected mean power of each joint damper, "
+                            "Σ a² ½ c ω² |x|²", "units": "W"}),
+        "n_components": (("case",), np.array([len(cm.omega) for cm in comps]),
+                         {"long_name": "wave components of the case's sea"}),
+        "equilibrium": (("coordinate",), sys.q0, {"units": "m or rad"}),
+    }
+    coords = {"case": np.arange(B), **results._coordinate_coords(model),
+              "pto": [model.coordinates[k] for k in damped]}
+    if times is not None:
+        q, qd, eta = _synthesise(comps, xs, times, sys.q0)
+        data.update(
+            time=(("case", "step"), np.array(times), {"units": "s"}),
+            q=(("case", "step", "coordinate"), q,
+               {"long_name": "generalised coordinates",
+                "units": "m or rad (per coordinate: coordinate_unit)"}),
+            qd=(("case", "step", "coordinate"), qd,
+                {"long_name": "generalised velocities", "units": "m/s or rad/s"}),
+            pto_power=(("case", "step", "pto"), results.absorbed_power(c, qd[:, :, damped]),
+                       {"long_name": "power absorbed by each joint damper, c q̇²", "units": "W"}),
+            eta=(("case", "step"), eta,
+                 {"long_name": "undisturbed wave elevation at the origin", "units": "m"}))
+    ds = xr.Dataset(data, coords=coords)
+    for name, (values, attrs) in _sea_labels(seas).items():
+        ds = ds.assign_coords({name: ("case", np.asarray(values), attrs)})
+    ds.attrs = {
+        "title": f"mfm spectral response of {model.name} in {B} sea states",
+        **results.provenance(model, sys.loads, level="spectral", seas=repr(seas),
+                             n_frequencies_solved=n_union, radiation=radiation,
+                             convention="exp(-i omega t)", rao_solve_s=solve_s,
+                             wall_time_s=_time.perf_counter() - start),
+        "source": model.hydro.source}
+    return ds

@@ -14,6 +14,10 @@ Every chunk has the same number of cases (the last one padded by repeating its l
 padding dropped after), so a worker compiles one shape once and reuses it for all its chunks; the
 model is sent to each worker once (``scatter``) and kept there under a hash of its pickled bytes,
 so later sweeps of the same model on the same cluster (a resume) do not compile again.
+
+``level="spectral"`` skips all of that for a model linear over its sea states: the cases are the
+linear frequency-domain response of :func:`mfm.spectral.spectral_sweep` (one linearisation, one RAO
+solve on the union of the seas' frequencies), in one call.
 """
 from __future__ import annotations
 
@@ -171,10 +175,10 @@ def _open_client(client, n_workers):
                      "'tcp://10.0.0.1:8786', or a distributed.Client")
 
 
-def sweep(model, seas, *, dt, n_steps: int, chunk_size: int = 16, client=None,
-          n_workers: int | None = None, ramp=0.0, parameters: dict | None = None,
+def sweep(model, seas, *, dt=None, n_steps: int | None = None, chunk_size: int = 16,
+          client=None, n_workers: int | None = None, ramp=0.0, parameters: dict | None = None,
           vary_loads=None, resume: xr.Dataset | None = None, progress: bool | dict = True,
-          **options) -> xr.Dataset:
+          level: str | None = None, **options) -> xr.Dataset:
     """Run many cases of one topology in chunks of :func:`mfm.simulate_batch` and gather them into
     one dataset, the same as one ``simulate_batch`` over every case (to round-off: the vmapped
     width differs) with bounded memory, here or on a Dask cluster.
@@ -199,6 +203,17 @@ def sweep(model, seas, *, dt, n_steps: int, chunk_size: int = 16, client=None,
         same cases (number, chunk size, sea labels, parameters, integrator, radiation, steps); dt
         may differ (e.g. smaller for the chunks that went non-finite).
     progress: True (default), False, or a dict of tqdm options: a bar over the chunks.
+    level: None (default: the time domain, as ``options`` say) or ``"spectral"``: the linear
+        frequency-domain level of the fidelity ladder (:func:`mfm.spectral.spectral_sweep`), for a
+        model that is linear over the sea states (:func:`mfm.reduce` measures it): linearised
+        once, RAOs solved once on the union of the seas' frequencies, every case's statistics
+        ``pto_power_mean`` and ``q_rms`` (case, …) in one call, no time stepping. With ``dt`` and
+        ``n_steps`` it also synthesises the time series on the time domain's saved grid
+        (t0 + k save_every dt, k = 0 … n_steps/save_every), steady state from t0 (``ramp`` does
+        not apply: there is no start-up). It takes one model, the options ``q0``, ``loads``,
+        ``radiation`` ("database", default, or "state_space": the time domain's fit),
+        ``state_space_options``, ``save_every``, ``t0`` and ``parameters``; the chunks and the
+        cluster do not apply.
     options: ``simulate_batch``'s other options (integrator, radiation, state_space_options,
         memory, save_every, t0, q0, qd0, loads, outputs), the same for every case. The fast path
         for long sea states is ``integrator="verlet", radiation="state_space_exact"``.
@@ -212,6 +227,13 @@ def sweep(model, seas, *, dt, n_steps: int, chunk_size: int = 16, client=None,
     ``ds.set_index(case=["sea_hs", "sea_tp"]).unstack("case")``.
     Raises :class:`SweepError` when every chunk failed.
     """
+    if level is not None:
+        return _spectral_sweep(model, seas, level, dt, n_steps, parameters, options,
+                               dict(client=client, n_workers=n_workers, vary_loads=vary_loads,
+                                    resume=resume))
+    if dt is None or n_steps is None:
+        raise ValueError(f"dt, n_steps: {dt!r}, {n_steps!r}; the time domain needs both (the "
+                         "time step in s and the number of steps); level='spectral' needs neither")
     bad = sorted(set(options) - set(BATCH_OPTIONS))
     if bad:
         raise TypeError(f"sweep: unknown options {bad}; accepted: {list(BATCH_OPTIONS)} and "
@@ -288,6 +310,68 @@ def sweep(model, seas, *, dt, n_steps: int, chunk_size: int = 16, client=None,
                         sweep_chunks_run=", ".join(map(str, todo)), sweep_scheduler=scheduler,
                         sweep_workers=int(workers),
                         sweep_wall_s=round(time.perf_counter() - t_start, 3)))
+
+
+# the options the spectral level takes, and its defaults (the rest are the time stepping's)
+SPECTRAL_OPTIONS = {"q0": None, "loads": None, "radiation": "database",
+                    "state_space_options": None, "save_every": 1, "t0": 0.0}
+
+
+def _spectral_sweep(model, seas, level, dt, n_steps, parameters, options, unused):
+    """``sweep(..., level="spectral")``: :func:`mfm.spectral.spectral_sweep` over the cases, on the
+    time domain's saved grid when dt and n_steps are given, labelled as a sweep."""
+    from .spectral import spectral_sweep
+
+    if level != "spectral":
+        raise ValueError(f"level: {level!r}; accepted: None (the time domain, as the options "
+                         "say) or 'spectral' (the linear frequency-domain level)")
+    given = {k: v for k, v in unused.items() if v is not None}
+    bad = sorted(set(options) - set(SPECTRAL_OPTIONS)) + sorted(given)
+    if bad:
+        raise ValueError(f"level='spectral': {bad} do not apply (no time stepping, one call); "
+                         f"it takes the options {sorted(SPECTRAL_OPTIONS)}, dt, n_steps, ramp "
+                         "(not applied: steady state) and parameters")
+    if isinstance(model, (list, tuple)):
+        raise ValueError(f"model: {len(model)} models; level='spectral' linearises one model for "
+                         "every sea (run one sweep per model, or the time domain)")
+    opts = {**SPECTRAL_OPTIONS, **options}
+    seas_l = list(seas) if isinstance(seas, (list, tuple)) else [seas]
+    B = len(seas_l)
+    t = None
+    if (dt is None) != (n_steps is None):
+        raise ValueError(f"dt, n_steps: {dt!r}, {n_steps!r}; give both (the time series on the "
+                         "time domain's grid) or neither (the statistics only)")
+    if dt is not None:
+        every = opts["save_every"]
+        if isinstance(n_steps, bool) or not isinstance(n_steps, numbers.Integral) or n_steps < 1 \
+                or isinstance(every, bool) or not isinstance(every, numbers.Integral) \
+                or every < 1 or n_steps % every:
+            raise ValueError(f"n_steps: {n_steps!r} must be a whole number ≥ 1 and a multiple of "
+                             f"save_every={every!r}")
+        try:
+            dts = np.atleast_1d(np.asarray(dt, dtype=float))
+        except (TypeError, ValueError):
+            dts = None
+        if dts is None or dts.ndim != 1 or dts.size not in (1, B) \
+                or not np.all(np.isfinite(dts) & (dts > 0)):
+            raise ValueError(f"dt: {dt!r}; give one positive time step in s, or one per case "
+                             f"({B})")
+        t0 = _simulate._number(opts["t0"], "t0")
+        k = np.arange(int(n_steps) // int(every) + 1)
+        t = t0 + np.broadcast_to(dts, (B,))[:, None] * int(every) * k[None]
+    params = _parameter_labels(parameters, B)
+    start = time.perf_counter()
+    ds = spectral_sweep(model, seas_l, t=t, q0=opts["q0"], loads=opts["loads"],
+                        radiation=opts["radiation"],
+                        state_space_options=opts["state_space_options"])
+    for name, (values, attrs) in params.items():
+        ds = ds.assign_coords({name: ("case", values, attrs)})
+    if t is not None:
+        ds["dt"] = ("case", np.broadcast_to(dts, (B,)).copy(), {"units": "s"})
+        ds.attrs.update(save_every=int(opts["save_every"]), n_steps=int(n_steps), t0=float(t0))
+    ds.attrs.update(sweep_scheduler="in-process, one call (spectral level)",
+                    sweep_wall_s=round(time.perf_counter() - start, 3))
+    return ds
 
 
 def _run_on_cluster(c, models, chunks, todo, seas_l, dts, ramps, args, bar):
