@@ -50,13 +50,11 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
     Returns an xarray.Dataset: ``q_rms`` (coordinate) the standard deviation about the equilibrium,
     ``pto_power_mean`` (pto) the expected mean power of each joint damper and hydraulic piston
     (W; a piston's rate ẇ = G q̇ linearised at q₀, :meth:`~mfm.loads.base.Load.linear_dampers`),
-    ``equilibrium`` (coordinate); with ``t`` also ``q``, ``qd`` (time, coordinate), ``pto_power``
-    (time, pto) = c (G q̇)² (W) and ``eta`` (time) the elevation at the origin (m). Attributes: provenance, the
-    sea, ``level = "spectral"``, ``n_components`` and the wall time of the synthesis.
+    ``equilibrium`` (coordinate), the sea's labels (``sea_hs``, ``sea_tp``, …, scalars); with ``t``
+    also ``q``, ``qd`` (time, coordinate), ``pto_power`` (time, pto) = c (G q̇)² (W) and ``eta``
+    (time) the elevation at the origin (m). Attributes: provenance, the sea, ``level =
+    "spectral"``, ``n_components`` and the wall time. The one-sea case of :func:`spectral_sweep`.
     """
-    # the harmonic sum of the time-domain excitation and elevation (hydro.waves), chunked over t
-    from hydro.waves import _harmonic_sum, elevation
-
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: spectral_response needs a "
                          "config with a [hydro] table")
@@ -68,59 +66,17 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
             raise ValueError(f"t: {t!r}; give a 1-D array of times in seconds") from None
         if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)):
             raise ValueError(f"t: shape {t.shape}; give a non-empty 1-D array of finite times (s)")
-    start = _time.perf_counter()
-    comps = sea.components(water_depth=model.hydro.water_depth, g=model.hydro.g)
-    options = {"radiation": radiation, "state_space_options": state_space_options}
-    sys = _fd.linear_system(model, q0, loads=loads)
-    n = model.n_coordinates
-    x = np.zeros((len(comps), n), dtype=complex)
-    for beta in np.unique(comps.heading):
-        sel = comps.heading == beta
-        x[sel] = _fd._amplitudes(model, sys, comps.omega[sel], float(beta), options)
-    a = comps.complex_amplitude
-    damped = [k for k in range(n) if float(model.damping[k]) > 0]
-    c = np.asarray(model.damping, dtype=float)[damped]
-    # every PTO as a damping c on a rate G q̇: the joint dampers (G rows of the identity), then the
-    # loads' pistons linearised at q₀ (the time domain's pto order)
-    dampers = results.linear_dampers(sys.loads, sys.kin0)
-    G = np.concatenate([np.eye(n)[damped]] + [np.asarray(d.rows) for d in dampers])
-    c_all = np.concatenate([c] + [np.asarray(d.damping, dtype=float) for d in dampers])
-    mean_power = np.sum(comps.amplitude[:, None] ** 2
-                        * results.mean_absorbed_power(c_all, comps.omega[:, None], x @ G.T), axis=0)
-    q_rms = np.sqrt(np.sum(0.5 * comps.amplitude[:, None] ** 2 * np.abs(x) ** 2, axis=0))
-    data = {
-        "q_rms": (("coordinate",), q_rms, {"long_name": "standard deviation about the equilibrium",
-                                           "units": "m or rad (per coordinate: coordinate_unit)"}),
-        "pto_power_mean": (("pto",), mean_power, {"long_name": "expected mean power of each joint "
-                                                  "damper and piston, Σ a² ½ c ω² |G x|²",
-                                                  "units": "W"}),
-        "equilibrium": (("coordinate",), sys.q0, {"units": "m or rad"}),
-    }
-    coords = {**results._coordinate_coords(model),
-              "pto": [model.coordinates[k] for k in damped] + [p for d in dampers for p in d.names]}
+    # one sea is the one-case sweep (one place for the synthesis), relabelled over time
+    ds = spectral_sweep(model, [sea], t=t, q0=q0, loads=loads, radiation=radiation,
+                        state_space_options=state_space_options).isel(case=0, drop=True)
+    attrs = {**ds.attrs, "title": f"mfm spectral response of {model.name}", "sea": repr(sea),
+             "n_components": int(ds.n_components)}
+    attrs.pop("seas", None)
+    ds = ds.drop_vars("n_components")
     if t is not None:
-        coef = a[:, None] * x
-        # q and q̇ in one harmonic sum (the exponentials are most of the cost)
-        both = _harmonic_sum(comps.omega, np.concatenate([coef, -1j * comps.omega[:, None] * coef], 1), t)
-        q, qd = sys.q0[None] + both[:, :n], both[:, n:]
-        data.update(
-            q=(("time", "coordinate"), q, {"long_name": "generalised coordinates",
-                                           "units": "m or rad (per coordinate: coordinate_unit)"}),
-            qd=(("time", "coordinate"), qd, {"long_name": "generalised velocities",
-                                             "units": "m/s or rad/s"}),
-            pto_power=(("time", "pto"), results.absorbed_power(c_all, qd @ G.T),
-                       {"long_name": "power absorbed by each joint damper and piston, c (G q̇)²",
-                        "units": "W"}),
-            eta=(("time",), np.asarray(elevation(comps, t)).reshape(-1),
-                 {"long_name": "undisturbed wave elevation at the origin", "units": "m"}))
-        coords["time"] = ("time", t, {"units": "s"})
-    wall = _time.perf_counter() - start
-    ds = xr.Dataset(data, coords=coords, attrs={
-        "title": f"mfm spectral response of {model.name}",
-        **results.provenance(model, sys.loads, level="spectral", sea=repr(sea),
-                             n_components=len(comps), radiation=radiation,
-                             convention="exp(-i omega t)", wall_time_s=wall),
-        "source": model.hydro.source})
+        ds = ds.drop_vars("time").rename_dims(step="time").assign_coords(
+            time=("time", t, {"units": "s"}))
+    ds.attrs = attrs
     return ds
 
 
@@ -205,7 +161,8 @@ def spectral_sweep(model: Model, seas, *, t=None, q0=None, loads=None,
 
     Returns an xarray.Dataset over ``case`` with the sea labels of :func:`mfm.simulate_batch`
     (``sea_hs``, ``sea_tp``, ``sea_gamma``, ``sea_heading``, …): ``q_rms`` (case, coordinate),
-    ``pto_power_mean`` (case, pto) the expected mean power of each joint damper (W),
+    ``pto_power_mean`` (case, pto) the expected mean power of each joint damper and hydraulic
+    piston (W; as :func:`spectral_response`),
     ``n_components`` (case), ``equilibrium`` (coordinate); with ``t`` also ``time`` (case, step),
     ``q``, ``qd`` (case, step, coordinate), ``pto_power`` (case, step, pto) and ``eta`` (case,
     step). Attributes: provenance, ``level = "spectral"``, the seas, ``n_frequencies_solved`` (the
@@ -235,27 +192,31 @@ def spectral_sweep(model: Model, seas, *, t=None, q0=None, loads=None,
     solve_s = _time.perf_counter() - solve_start
     n = model.n_coordinates
     damped = [k for k in range(n) if float(model.damping[k]) > 0]
-    c = np.asarray(model.damping, dtype=float)[damped]
+    # every PTO as a damping c on a rate G q̇: the joint dampers (rows of the identity), then the
+    # loads' pistons linearised at q₀ (the time domain's pto order)
+    dampers = results.linear_dampers(sys.loads, sys.kin0)
+    G = np.concatenate([np.eye(n)[damped]] + [np.asarray(d.rows) for d in dampers])
+    c = np.concatenate([np.asarray(model.damping, dtype=float)[damped]]
+                       + [np.asarray(d.damping, dtype=float) for d in dampers])
     q_rms = np.empty((B, n))
-    power = np.empty((B, len(damped)))
+    power = np.empty((B, len(c)))
     for i, (cm, x) in enumerate(zip(comps, xs)):
         a2 = cm.amplitude[:, None] ** 2
-        power[i] = np.sum(a2 * results.mean_absorbed_power(c, cm.omega[:, None], x[:, damped]),
-                          axis=0)
+        power[i] = np.sum(a2 * results.mean_absorbed_power(c, cm.omega[:, None], x @ G.T), axis=0)
         q_rms[i] = np.sqrt(np.sum(0.5 * a2 * np.abs(x) ** 2, axis=0))
     data = {
         "q_rms": (("case", "coordinate"), q_rms,
                   {"long_name": "standard deviation about the equilibrium",
                    "units": "m or rad (per coordinate: coordinate_unit)"}),
         "pto_power_mean": (("case", "pto"), power,
-                           {"long_name": "expected mean power of each joint damper, "
-                            "Σ a² ½ c ω² |x|²", "units": "W"}),
+                           {"long_name": "expected mean power of each joint damper and piston, "
+                            "Σ a² ½ c ω² |G x|²", "units": "W"}),
         "n_components": (("case",), np.array([len(cm.omega) for cm in comps]),
                          {"long_name": "wave components of the case's sea"}),
         "equilibrium": (("coordinate",), sys.q0, {"units": "m or rad"}),
     }
     coords = {"case": np.arange(B), **results._coordinate_coords(model),
-              "pto": [model.coordinates[k] for k in damped]}
+              "pto": [model.coordinates[k] for k in damped] + [p for d in dampers for p in d.names]}
     if times is not None:
         q, qd, eta = _synthesise(comps, xs, times, sys.q0)
         data.update(
@@ -265,8 +226,9 @@ def spectral_sweep(model: Model, seas, *, t=None, q0=None, loads=None,
                 "units": "m or rad (per coordinate: coordinate_unit)"}),
             qd=(("case", "step", "coordinate"), qd,
                 {"long_name": "generalised velocities", "units": "m/s or rad/s"}),
-            pto_power=(("case", "step", "pto"), results.absorbed_power(c, qd[:, :, damped]),
-                       {"long_name": "power absorbed by each joint damper, c q̇²", "units": "W"}),
+            pto_power=(("case", "step", "pto"), results.absorbed_power(c, qd @ G.T),
+                       {"long_name": "power absorbed by each joint damper and piston, c (G q̇)²",
+                        "units": "W"}),
             eta=(("case", "step"), eta,
                  {"long_name": "undisturbed wave elevation at the origin", "units": "m"}))
     ds = xr.Dataset(data, coords=coords)
