@@ -75,6 +75,32 @@ class HydroSpec:
         self.added_mass_inf_option = added_mass_inf
         self._cache = {}
 
+    def replace(self, *, body_coupling: bool | None = None, moving=None) -> "HydroSpec":
+        """A copy with other options (the same database, bodies and drag; its own caches, so its
+        fits and kernels are made anew): ``body_coupling`` (True, False; None keeps this one's),
+        ``moving`` (indices of the hydro dofs radiation is modelled on; None keeps this one's)."""
+        import copy
+
+        if body_coupling is not None and not isinstance(body_coupling, bool):
+            raise ValueError(f"body_coupling: {body_coupling!r}; accepted: True, False or None "
+                             "(keep the spec's)")
+        new = copy.copy(self)
+        new._cache = {}
+        if body_coupling is not None:
+            nb = len(self.db_names)
+            new.body_coupling = body_coupling
+            new.mask = (np.ones((6 * nb, 6 * nb)) if body_coupling
+                        else np.kron(np.eye(nb), np.ones((6, 6))))
+            A_inf = np.asarray(self.db["added_mass_inf"].values, dtype=float)
+            new.A_inf_db = 0.5 * (A_inf + A_inf.T) * new.mask
+        if moving is not None:
+            idx = tuple(int(k) for k in moving)
+            if not idx or any(not 0 <= k < len(self.dofs) for k in idx) or len(set(idx)) != len(idx):
+                raise ValueError(f"moving: {moving!r}; give distinct indices in [0, {len(self.dofs)})"
+                                 " of the hydro dofs")
+            new.moving = tuple(sorted(idx))
+        return new
+
     def fingerprint(self) -> str:
         """sha256 of everything the spec holds: the database's every array and attribute (hashed
         once: the dataset is not modified in place) and each of the spec's own attributes, hashed
