@@ -78,12 +78,26 @@ class HydroSpec:
     def replace(self, *, body_coupling: bool | None = None, moving=None) -> "HydroSpec":
         """A copy with other options (the same database, bodies and drag; its own caches, so its
         fits and kernels are made anew): ``body_coupling`` (True, False; None keeps this one's),
-        ``moving`` (indices of the hydro dofs radiation is modelled on; None keeps this one's)."""
+        ``moving`` (indices of the hydro dofs radiation is modelled on; None keeps this one's).
+        The copy is kept in this spec's cache: asked again, the same object answers, with the
+        fits and kernels it has made."""
         import copy
 
         if body_coupling is not None and not isinstance(body_coupling, bool):
             raise ValueError(f"body_coupling: {body_coupling!r}; accepted: True, False or None "
                              "(keep the spec's)")
+        if moving is not None:
+            try:
+                moving = tuple(sorted(int(k) for k in moving))
+            except (TypeError, ValueError):
+                raise ValueError(f"moving: {moving!r}; give indices of the hydro dofs") from None
+            if not moving or moving[0] < 0 or moving[-1] >= len(self.dofs) \
+                    or len(set(moving)) != len(moving):
+                raise ValueError(f"moving: {moving!r}; give distinct indices in "
+                                 f"[0, {len(self.dofs)}) of the hydro dofs")
+        key = ("replace", body_coupling, moving)
+        if key in self._cache:
+            return self._cache[key]
         new = copy.copy(self)
         new._cache = {}
         if body_coupling is not None:
@@ -94,11 +108,8 @@ class HydroSpec:
             A_inf = np.asarray(self.db["added_mass_inf"].values, dtype=float)
             new.A_inf_db = 0.5 * (A_inf + A_inf.T) * new.mask
         if moving is not None:
-            idx = tuple(int(k) for k in moving)
-            if not idx or any(not 0 <= k < len(self.dofs) for k in idx) or len(set(idx)) != len(idx):
-                raise ValueError(f"moving: {moving!r}; give distinct indices in [0, {len(self.dofs)})"
-                                 " of the hydro dofs")
-            new.moving = tuple(sorted(idx))
+            new.moving = moving
+        self._cache[key] = new
         return new
 
     def fingerprint(self) -> str:
