@@ -2,8 +2,8 @@
 Stansby & Li hybrid semi-sub in head seas, each option's warm wall time and its error on the
 scene's outputs against the full model with default options, at the levels where it applies.
 
-    PYTHONPATH=. python tools/fidelity_options.py m4_134       # ≈ 15 min on 2 shared cores
-    PYTHONPATH=. python tools/fidelity_options.py stansby_li   # ≈ 15 min
+    PYTHONPATH=. python tools/fidelity_options.py m4_134       # 25 min on 2 shared cores (load 4–6)
+    PYTHONPATH=. python tools/fidelity_options.py stansby_li   # 20 min
     PYTHONPATH=. python tools/fidelity_options.py table        # the markdown tables from the JSON
 
 Each system's rows go to notebooks/figures/fidelity_options/<system>.json as they finish (a rerun
