@@ -75,6 +75,43 @@ class HydroSpec:
         self.added_mass_inf_option = added_mass_inf
         self._cache = {}
 
+    def replace(self, *, body_coupling: bool | None = None, moving=None) -> "HydroSpec":
+        """A copy with other options (the same database, bodies and drag; its own caches, so its
+        fits and kernels are made anew): ``body_coupling`` (True, False; None keeps this one's),
+        ``moving`` (indices of the hydro dofs radiation is modelled on; None keeps this one's).
+        The copy is kept in this spec's cache: asked again, the same object answers, with the
+        fits and kernels it has made."""
+        import copy
+
+        if body_coupling is not None and not isinstance(body_coupling, bool):
+            raise ValueError(f"body_coupling: {body_coupling!r}; accepted: True, False or None "
+                             "(keep the spec's)")
+        if moving is not None:
+            try:
+                moving = tuple(sorted(int(k) for k in moving))
+            except (TypeError, ValueError):
+                raise ValueError(f"moving: {moving!r}; give indices of the hydro dofs") from None
+            if not moving or moving[0] < 0 or moving[-1] >= len(self.dofs) \
+                    or len(set(moving)) != len(moving):
+                raise ValueError(f"moving: {moving!r}; give distinct indices in "
+                                 f"[0, {len(self.dofs)}) of the hydro dofs")
+        key = ("replace", body_coupling, moving)
+        if key in self._cache:
+            return self._cache[key]
+        new = copy.copy(self)
+        new._cache = {}
+        if body_coupling is not None:
+            nb = len(self.db_names)
+            new.body_coupling = body_coupling
+            new.mask = (np.ones((6 * nb, 6 * nb)) if body_coupling
+                        else np.kron(np.eye(nb), np.ones((6, 6))))
+            A_inf = np.asarray(self.db["added_mass_inf"].values, dtype=float)
+            new.A_inf_db = 0.5 * (A_inf + A_inf.T) * new.mask
+        if moving is not None:
+            new.moving = moving
+        self._cache[key] = new
+        return new
+
     def fingerprint(self) -> str:
         """sha256 of everything the spec holds: the database's every array and attribute (hashed
         once: the dataset is not modified in place) and each of the spec's own attributes, hashed

@@ -14,6 +14,13 @@ The levels, cheapest first:
 - ``"full"``: the full nonlinear model with RK4 and the engine's default radiation
   (``radiation="auto"``), the reference.
 
+Within a level, ``options`` of :func:`reduce` pilots run-time simplifications of the model the
+same way (:data:`OPTIONS`): ``"body_coupling"``, the model without the hydrodynamic interaction
+between its bodies (the cross-body blocks of A∞, A(ω), B(ω) and K dropped, as
+``mfm.load(path, body_coupling=False)``), at the chosen level; it is taken when the scene's outputs
+stay within the tolerance of the full model with the model as given. What the options buy and cost
+on M4 134 and the Stansby & Li semi-sub: docs/fidelity.md.
+
 Whether a level holds is measured, not guessed: :func:`reduce` runs the full model and each cheaper
 level on a pilot window of the scene (the same sea, the same components and phases, so the time
 series agree sample by sample where the model is linear) and compares the scene's outputs — the
@@ -37,6 +44,19 @@ LEVELS = ("spectral", "linear", "fast", "full")
 # the run options each time-domain level gives mfm.simulate
 LEVEL_OPTIONS = {"fast": {"integrator": "verlet", "radiation": "state_space_exact"},
                  "full": {"integrator": "rk4", "radiation": "auto"}}
+# the within-level options reduce can pilot: name -> the HydroSpec options of the variant
+OPTIONS = {"body_coupling": {"body_coupling": False}}
+
+
+def variant_model(model: Model, variant: dict) -> Model:
+    """``model`` with the hydro options of ``variant`` (values of :data:`OPTIONS`, merged; e.g.
+    ``{"body_coupling": False}``) by :meth:`hydro.prepare.HydroSpec.replace`; the model itself
+    when ``variant`` is empty."""
+    if not variant:
+        return model
+    import dataclasses
+
+    return dataclasses.replace(model, hydro=model.hydro.replace(**variant))
 
 
 def _sea_period(sea, period):
@@ -58,6 +78,10 @@ class Reduction:
     for it (empty for "spectral" and "linear"). errors: {level: {output: relative error against
     "full"}} on the pilot. wall_s: {level: s} the warm wall time of each level on the pilot.
     reason: why this level, in words. tolerance, dt, pilot: the settings of the measurement.
+    variant: the hydro options of the within-level variant taken (``{"body_coupling": False}``;
+    empty when none was asked for or none held); :meth:`run` applies it (:func:`variant_model`).
+    variant_errors, variant_wall_s: {option: {output: error}} and {option: s} of each option
+    piloted at the chosen level, against the same full model.
     """
     level: str
     options: dict
@@ -67,12 +91,16 @@ class Reduction:
     tolerance: float
     dt: float
     pilot: tuple = field(default=())
+    variant: dict = field(default_factory=dict)
+    variant_errors: dict = field(default_factory=dict)
+    variant_wall_s: dict = field(default_factory=dict)
 
     def run(self, model: Model, sea, *, duration: float, ramp: float | None = None):
         """Run the scene at the chosen level: a dataset with ``time``, ``q``, ``qd`` and
         ``pto_power`` whichever the level (spectral: synthesised on the same time grid; no ramp,
         its response is the steady state; linear: from rest at the equilibrium, with the ramp)."""
         duration = _positive(duration, "duration")
+        model = variant_model(model, self.variant)
         if self.level == "spectral":
             from .spectral import spectral_response
             t = self.dt * np.arange(int(round(duration / self.dt)) + 1)
@@ -112,7 +140,8 @@ def _errors(measured, reference):
 
 def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period=None,
            pilot_periods: float = 40.0, settle_periods: float = 15.0,
-           steps_per_period: int = 200, levels=LEVELS, timing: bool = True) -> Reduction:
+           steps_per_period: int = 200, levels=LEVELS, timing: bool = True,
+           options=()) -> Reduction:
     """The cheapest level of the fidelity ladder (module docstring) whose mean PTO powers and
     coordinate standard deviations stay within ``tolerance`` of the full model on a pilot run of
     the scene.
@@ -129,6 +158,12 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
     timing: run each level a second time for its warm wall time (compiled, fitted: what a long
     run or a sweep pays per run), reported in ``wall_s`` and the reason; False runs each once and
     reports no times.
+    options: names of :data:`OPTIONS` to pilot at the chosen level, each on its own: an option is
+    taken when its outputs stay within ``tolerance`` of the full model (the errors are those of
+    the level and the option together; with ``timing``, also only when it is faster than the
+    level without it); the variant taken is ``reduction.variant``, each option's errors and time
+    in ``variant_errors`` and ``variant_wall_s``, why in the reason. ``"body_coupling"`` needs a
+    model whose bodies are coupled (more than one hydro body, ``body_coupling`` on).
 
     Returns a :class:`Reduction`; ``reduction.run(model, sea, duration=...)`` runs the scene at the
     chosen level. Refuses a cheaper level (returns "full", saying why) when none is within the
@@ -148,6 +183,17 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
     if bad:
         raise ValueError(f"coordinates: {bad} are not coordinates of {model.name!r}; accepted: "
                          f"{names}")
+    if isinstance(options, str):
+        options = (options,)
+    options = tuple(options)
+    bad = [o for o in options if o not in OPTIONS]
+    if bad or len(set(options)) != len(options):
+        raise ValueError(f"options: {options!r}; accepted: distinct names of {tuple(OPTIONS)}")
+    if "body_coupling" in options and (not model.hydro.body_coupling
+                                       or len(model.hydro.db_names) < 2):
+        raise ValueError(f"options: 'body_coupling': model {model.name!r} has no coupling between "
+                         f"hydro bodies to drop ({len(model.hydro.db_names)} hydro bodies, "
+                         f"body_coupling={model.hydro.body_coupling})")
     T = _positive(_sea_period(sea, period), "period")
     pilot_periods = _positive(pilot_periods, "pilot_periods")
     settle_periods = _positive(settle_periods, "settle_periods")
@@ -161,9 +207,10 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
     duration, ramp = pilot_periods * T, 5.0 * T
     window = slice(settle_periods * T, None)
 
-    def timed(level):
+    def timed(level, variant=None):
         fn = lambda: Reduction(level, LEVEL_OPTIONS.get(level, {}), {}, {}, "", tolerance, dt,  # noqa: E731
-                               (duration, ramp)).run(model, sea, duration=duration)
+                               (duration, ramp), dict(variant or {})).run(model, sea,
+                                                                          duration=duration)
         ds = fn()
         if not timing:
             return ds, None
@@ -192,7 +239,24 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
         if refused:
             reason += "; refused: " + ", ".join(f"{lv} {worst[lv]:.3g} > {tolerance:g}"
                                                 for lv in refused)
+    variant, v_errors, v_wall, notes = {}, {}, {}, []
+    for name in options:
+        ds, v_wall[name] = timed(level, OPTIONS[name])
+        v_errors[name] = _errors(_measures(ds, window, coordinates), reference)
+        worst_v = max(v_errors[name].values(), default=0.0)
+        text = f"{name} off at {level}: largest error {worst_v:.3g}"
+        if timing:
+            text += f", {v_wall[name]:.3g} s against {wall[level]:.3g} s"
+        if worst_v > tolerance:
+            notes.append(f"{text} > {tolerance:g}: refused")
+        elif timing and v_wall[name] >= wall[level]:
+            notes.append(f"{text}: within {tolerance:g} but no faster: refused")
+        else:
+            variant.update(OPTIONS[name])
+            notes.append(f"{text} ≤ {tolerance:g}: taken")
+    if notes:
+        reason += "; options: " + "; ".join(notes)
     if not timing:
-        wall = {}
+        wall, v_wall = {}, {}
     return Reduction(level, LEVEL_OPTIONS.get(level, {}), errors, wall, reason, tolerance, dt,
-                     (duration, ramp))
+                     (duration, ramp), variant, v_errors, v_wall)
