@@ -23,8 +23,10 @@ The grid (each distinct integrator, number of steps and radiation structure is a
   10T) and the full T_K (from the decay of K), and the state space integrated by RK4
   (``state_space``) at two or three orders and the default (``order="auto"``);
 - ``fidelity``: the levels of :mod:`mfm.fidelity` at dt = T/200: spectral (no time stepping;
-  statistics only, and the series on the run's grid), fast (verlet, ``state_space_exact``), full
-  (rk4, ``radiation="auto"``).
+  statistics only, and the series on the run's grid), linear (:func:`mfm.linear_response`: the
+  linearised model with the state-space fit, its modes stepped exactly), fast (verlet,
+  ``state_space_exact``), full (rk4, ``radiation="auto"``). A level that refuses a system (an
+  error naming why) is recorded as ``"refused"`` with the message.
 
 The reference: RK4 at dt = T/800 with the state space integrated by RK4 (``state_space``, the
 default fit). RK4 is the highest-order integrator; with the state space its radiation is
@@ -223,6 +225,48 @@ def spectral_case(model, sea, cfg, t, time_it=True):
     return rec, (np.asarray(ds.time), np.asarray(ds.q), np.asarray(ds.qd))
 
 
+def linear_case(model, sea, cfg, *, n_per_T, time_it=True):
+    """The linear level (:func:`mfm.linear_response`) at dt = T/n_per_T over the run's duration,
+    ramp and samples (every T/25), timed as :func:`run_case`: ``warm_s`` the median of warm calls
+    (linearisation, excitation series and the compiled modal scan; the modes of A are cached per
+    model and dt, as the state-space fit is, so they are outside it) and ``modes_s`` a warm call
+    with that cache emptied (what a new dt or model adds: the eigendecomposition). A load the
+    level cannot realise (NotImplementedError) or ill-conditioned modes (ValueError) give
+    ``status = "refused"`` and the ``reason``."""
+    import mfm
+
+    lin = importlib.import_module("mfm.linear")
+    T = cfg["T"]
+    kw = dict(duration=cfg["periods"] * T, dt=T / n_per_T, ramp=5 * T,
+              save_every=n_per_T // SAVE_PER_PERIOD)
+    rec = dict(integrator="linear", n_per_T=n_per_T, radiation="state_space", option=None,
+               radiation_used="state_space", dt=kw["dt"], n_steps=int(round(kw["duration"] / kw["dt"])))
+    start = time.perf_counter()
+    try:
+        ds = mfm.linear_response(model, sea, **kw)
+    except (NotImplementedError, ValueError) as err:
+        rec.update(status="refused", reason=f"{type(err).__name__}: {err}",
+                   first_s=time.perf_counter() - start)
+        return rec, None
+    rec.update(first_s=time.perf_counter() - start, status="ok",
+               mode_condition=float(ds.attrs.get("mode_condition", math.nan)))
+    if time_it:
+        times = []
+        while True:
+            s = time.perf_counter()
+            mfm.linear_response(model, sea, **kw)
+            times.append(time.perf_counter() - s)
+            if len(times) >= (3 if times[0] < 2 else 2 if times[0] < 5 else 1):
+                break
+        lin._MODES_CACHE.clear()
+        s = time.perf_counter()
+        mfm.linear_response(model, sea, **kw)
+        rec.update(warm_s=statistics.median(times), repeats=len(times),
+                   modes_s=time.perf_counter() - s,
+                   compile_s=max(rec["first_s"] - statistics.median(times), 0.0))
+    return rec, (np.asarray(ds.time), np.asarray(ds.q), np.asarray(ds.qd))
+
+
 def measures(model, cfg, series):
     """The settled part's coordinate standard deviations, mean damper power and the series."""
     t, q, qd = series
@@ -251,6 +295,8 @@ def plan(cfg, system=None):
     out = [("reference", dict(REFERENCE)),
            ("fidelity", dict(integrator="spectral", n_per_T=None, radiation="database",
                              option=None, level="spectral")),
+           ("fidelity", dict(integrator="linear", n_per_T=FIDELITY_AT, radiation="state_space",
+                             option=None, level="linear")),
            ("fidelity", dict(integrator="verlet", n_per_T=FIDELITY_AT,
                              radiation="state_space_exact", option=None, level="fast")),
            ("fidelity", dict(integrator="rk4", n_per_T=FIDELITY_AT, radiation="auto",
@@ -293,7 +339,7 @@ def study(system, *, path=None, slices=None, cases=None, reference=None, time_it
     data["mfm_version"] = getattr(mfm, "__version__", "")
     cache = {}
 
-    def series_of(case):
+    def series_of(case, time_it=time_it):
         if case["radiation"] == "auto":    # the strategy auto takes: the same run as that case's
             case = dict(case, radiation=_sim().choose_radiation(
                 model, dt=cfg["T"] / case["n_per_T"], n_steps=cfg["periods"] * case["n_per_T"],
@@ -303,14 +349,24 @@ def study(system, *, path=None, slices=None, cases=None, reference=None, time_it
             if case["integrator"] == "spectral":
                 t = cache[_key(reference)][1][0]
                 cache[k] = spectral_case(model, sea, cfg, t, time_it=time_it)
+            elif case["integrator"] == "linear":
+                cache[k] = linear_case(model, sea, cfg, n_per_T=case["n_per_T"], time_it=time_it)
             else:
                 cache[k] = run_case(model, sea, cfg, time_it=time_it, **{
                     n: case[n] for n in ("integrator", "n_per_T", "radiation", "option")})
         return cache[k]
 
-    ref_rec, ref_series = series_of(reference)
+    # a resumed study keeps its reference's timing and checks the rerun gives the stored numbers
+    stored = data.get("reference")
+    ref_rec, ref_series = series_of(reference, time_it=time_it and stored is None)
     ref = measures(model, cfg, ref_series)
-    data["reference"] = dict(ref_rec, std=ref["std"].tolist(), power=ref["power"])
+    if stored is None:
+        data["reference"] = dict(ref_rec, std=ref["std"].tolist(), power=ref["power"])
+    elif not (np.allclose(ref["std"], stored["std"], rtol=1e-9, atol=0)
+              and math.isclose(ref["power"], stored["power"], rel_tol=1e-9)):
+        raise RuntimeError(f"{system}: the reference rerun differs from the stored one (std "
+                           f"{ref['std'].tolist()} against {stored['std']}, power {ref['power']} "
+                           f"against {stored['power']}): delete {path} to start afresh")
     conv = None
     for sl, case in (plan(cfg, system) if cases is None else cases):
         if sl == "reference" or (slices is not None and sl not in slices):
@@ -347,13 +403,16 @@ def study(system, *, path=None, slices=None, cases=None, reference=None, time_it
 
 METRICS = (("std", "coordinate std (θ_rms)"), ("power", "mean PTO power"),
            ("series", "time series (relative L2)"))
-COLOURS = dict(rk4="C0", beeman="C1", semi_implicit="C2", newmark="C3", verlet="C4", spectral="k")
+COLOURS = dict(rk4="C0", beeman="C1", semi_implicit="C2", newmark="C3", verlet="C4", spectral="k",
+               linear="C8")
 
 
 def label(row):
     """A case in words: 'rk4 T/100 state_space_exact', 'rk4 T/100 conv 3T', 'spectral'."""
     if row["integrator"] == "spectral":
         return "spectral (linear FD)"
+    if row["integrator"] == "linear":
+        return f"linear T/{row['n_per_T']} (modal exact, ss)"
     rad = {"state_space_exact": "ss-exact", "state_space": "ss", "convolution": "conv",
            "auto": "auto"}[row["radiation"]]
     opt = row.get("option")
@@ -387,7 +446,7 @@ def figure(data, path=None, *, show_labels=True):
     import matplotlib.pyplot as plt
     from matplotlib.ticker import NullFormatter
 
-    rows = [r for r in data["cases"] if r["slice"] != "reference_check"]
+    rows = [r for r in data["cases"] if r["slice"] != "reference_check" and r["status"] != "refused"]
     fig, axes = plt.subplots(1, 3, figsize=(17, 6.2))
     markers = dict(integrators="o", radiation="s", fidelity="D")
     for ax, (metric, title) in zip(axes, METRICS):
@@ -431,6 +490,8 @@ def figure(data, path=None, *, show_labels=True):
     from matplotlib.lines import Line2D
     handles = [Line2D([], [], color=COLOURS[i], marker="o", ls="-", label=i) for i in INTEGRATORS]
     handles += [Line2D([], [], color="k", marker="D", ls="none", label="spectral level"),
+                Line2D([], [], color=COLOURS["linear"], marker="D", ls="none",
+                       label="linear level (T/200)"),
                 Line2D([], [], color="0.4", marker="o", ls="none",
                        label="integrators × dt (ss-exact)"),
                 Line2D([], [], color="0.4", marker="s", ls="none", label="radiation: state space"),
@@ -439,7 +500,7 @@ def figure(data, path=None, *, show_labels=True):
                 Line2D([], [], color="0.4", marker="D", ls="none", label="fidelity levels (T/200)"),
                 Line2D([], [], color="crimson", marker="o", mfc="none", ms=10, ls="-",
                        label="Pareto front")]
-    fig.legend(handles=handles, fontsize=8, loc="lower center", ncol=6)
+    fig.legend(handles=handles, fontsize=8, loc="lower center", ncol=7)
     s = data["settings"]
     fig.suptitle(f"{data['system']}: {SEA_TEXT.get(data['system'], data['sea'])}; {s['periods']} "
                  f"periods, compared after {s['settle']} T; reference "
@@ -455,6 +516,9 @@ def table(data):
     lines = ["| case | slice | warm s | compile s | std err | power err | series err |",
              "|---|---|---|---|---|---|---|"]
     for r in data["cases"]:
+        if r["status"] == "refused":
+            lines.append(f"| {label(r)} | {r['slice']} | — | — | refused: {r['reason']} | | |")
+            continue
         if r["status"] != "ok":
             lines.append(f"| {label(r)} | {r['slice']} | — | — | non-finite at "
                          f"{r['stopped_at_s']:.3g} s | | |")
