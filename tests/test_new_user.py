@@ -10,6 +10,7 @@ import shutil
 import subprocess
 import sys
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -424,13 +425,24 @@ def test_rm3_spar_surge_drift_said_by_info_and_the_run_summary(tmp_path, capsys)
     assert info.startswith("  no restoring in spar.surge (at q0): nothing pulls it back")
     nc = tmp_path / "rm3.nc"
     # in waves, without a ramp: the excitation at t = 0 does not count as restoring
-    assert main(["simulate", str(CONFIGS / "rm3.toml"), "--duration", "2", "--dt", "0.1",
-                 "--wave", "regular", "--height", "1", "--period", "8", "--ramp", "0",
-                 "--no-plot", "--out", str(nc)]) == 0
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        assert main(["simulate", str(CONFIGS / "rm3.toml"), "--duration", "2", "--dt", "0.1",
+                     "--wave", "regular", "--height", "1", "--period", "8", "--ramp", "0",
+                     "--no-plot", "--out", str(nc)]) == 0
+    assert not [w for w in rec if "have no restoring" in str(w.message)]   # RK4: no drift warning
     summary, = [ln for ln in capsys.readouterr().out.splitlines() if "restoring" in ln]
     assert summary == info
     with xr.open_dataset(nc) as ds:
         assert ds.attrs["no_restoring"] == "spar.surge"
+    # Verlet drifts such a coordinate without bound (docs/stability.md §3): said before the run,
+    # naming it
+    import hydro
+    import mfm
+
+    with pytest.warns(mfm.AccuracyWarning, match=r"\['spar.surge'\] have no restoring.*verlet"):
+        mfm.simulate(mfm.load(CONFIGS / "rm3.toml"), hydro.Regular(height=1.0, period=8.0),
+                     duration=0.2, dt=0.1, integrator="verlet", radiation="state_space_exact")
 
 
 def test_plot_result_files(tmp_path, capsys):
