@@ -119,7 +119,18 @@ class HydroSpec:
         import hashlib
 
         def add(h, *items):
+            # containers item by item, so an array inside an attribute dict or a tuple is hashed by
+            # its bytes (its repr elides the middle of a large array)
             for x in items:
+                if isinstance(x, dict):
+                    h.update(f"dict{len(x)}".encode())
+                    for k in sorted(x, key=repr):
+                        add(h, k, x[k])
+                    continue
+                if isinstance(x, (list, tuple)):
+                    h.update(f"{type(x).__name__}{len(x)}".encode())
+                    add(h, *x)
+                    continue
                 a = np.asarray(x) if not isinstance(x, (str, bytes)) else None
                 if a is not None and a.dtype.kind in "fciub":
                     h.update(f"{a.dtype.str}{a.shape}".encode())
@@ -131,9 +142,9 @@ class HydroSpec:
             h = hashlib.sha256()
             for name in sorted(map(str, self.db.variables)):
                 v = self.db.variables[name]
-                add(h, name, v.dims, v.values, sorted(v.attrs.items()))
+                add(h, name, v.dims, v.values, dict(v.attrs))
             # when a WAMIT file set was read is provenance, not data
-            add(h, sorted((k, v) for k, v in self.db.attrs.items() if k != "date_read"))
+            add(h, {k: v for k, v in self.db.attrs.items() if k != "date_read"})
             self._cache["db_fingerprint"] = h.hexdigest()
         h = hashlib.sha256(self._cache["db_fingerprint"].encode())
         for k in sorted(vars(self)):

@@ -91,3 +91,12 @@ def test_the_same_config_loaded_twice_compiles_once():
     salt.db = spec.db.assign_attrs(rho=1025.0)
     salt._cache = {}
     assert salt != spec
+    # an array attribute is hashed by its bytes, not its repr (which elides a large array's middle)
+    big = np.zeros(5000)
+    other_big = big.copy()
+    other_big[2500] = 1.0
+    assert repr(big) == repr(other_big)
+    a, b = copy.copy(spec), copy.copy(spec)
+    a.db, b.db = spec.db.assign_attrs(table=big), spec.db.assign_attrs(table=other_big)
+    a._cache, b._cache = {}, {}
+    assert a != b
