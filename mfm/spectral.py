@@ -50,9 +50,8 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
     Returns an xarray.Dataset: ``q_rms`` (coordinate) the standard deviation about the equilibrium,
     ``pto_power_mean`` (pto) the expected mean power of each joint damper and hydraulic piston
     (W; a piston's rate ẇ = G q̇ linearised at q₀, :meth:`~mfm.loads.base.Load.linear_dampers`),
-    ``equilibrium`` (coordinate), the sea's labels (``sea_hs``, ``sea_tp``, …, scalars); with ``t``
-    also ``q``, ``qd`` (time, coordinate), ``pto_power`` (time, pto) = c (G q̇)² (W) and ``eta``
-    (time) the elevation at the origin (m). Attributes: provenance, the sea, ``level =
+    ``equilibrium`` (coordinate); with ``t`` also ``q``, ``qd`` (time, coordinate), ``pto_power``
+    (time, pto) = c (G q̇)² (W) and ``eta`` (time) the elevation at the origin (m). Attributes: provenance, the sea, ``level =
     "spectral"``, ``n_components`` and the wall time. The one-sea case of :func:`spectral_sweep`.
     """
     if model.hydro is None:
