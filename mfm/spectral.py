@@ -51,8 +51,9 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
     ``pto_power_mean`` (pto) the expected mean power of each joint damper and hydraulic piston
     (W; a piston's rate ẇ = G q̇ linearised at q₀, :meth:`~mfm.loads.base.Load.linear_dampers`),
     ``equilibrium`` (coordinate); with ``t`` also ``q``, ``qd`` (time, coordinate), ``pto_power``
-    (time, pto) = c (G q̇)² (W) and ``eta`` (time) the elevation at the origin (m). Attributes: provenance, the sea, ``level =
-    "spectral"``, ``n_components`` and the wall time. The one-sea case of :func:`spectral_sweep`.
+    (time, pto) = c (G q̇)² (W) and ``eta`` (time) the elevation at the origin (m). Attributes:
+    provenance, the sea, ``level = "spectral"``, ``n_components`` and the wall time. The one-sea
+    case of :func:`spectral_sweep`.
     """
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: spectral_response needs a "
