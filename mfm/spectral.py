@@ -149,14 +149,14 @@ def spectral_sweep(model: Model, seas, *, t=None, q0=None, loads=None,
                    ) -> xr.Dataset:
     """:func:`spectral_response` of many sea states in one call, with the model linearised once
     and its RAOs solved once on the union of the seas' component frequencies and headings (module
-    docstring: per case i, σ_q² = Σ_j ½ a_ij² |x̂(ω_ij, β_ij)|², P̄ = Σ_j a_ij² ½ c ω_ij² |x̂_pto|²).
+    docstring: per case i, σ_q² = Σ_j ½ a_ij² |x̂(ω_ij, β_ij)|², P̄ = Σ_j a_ij² ½ c ω_ij² |G x̂|²).
     Its front door is ``mfm.sweep(model, seas, level="spectral")``; a power matrix of a model
     linear over its sea states needs no time stepping.
 
     model: a Model with hydrodynamics (one: the linearisation is shared by every case).
     seas: a sequence of sea states of :mod:`hydro.waves` (or one).
     t: None (the statistics only), times (s) 1-D for every case or 2-D (case, time): the time
-    series too, the same synthesis as :func:`spectral_response` (memory B × n_t × n_q).
+    series too (memory B × n_t × n_q).
     q0, loads, radiation, state_space_options: as :func:`mfm.frequency_response`.
 
     Returns an xarray.Dataset over ``case`` with the sea labels of :func:`mfm.simulate_batch`

@@ -17,6 +17,7 @@ import xarray as xr
 import hydro
 import mfm
 from hydro import statespace as S
+from hydro.waves import elevation
 from mfm import wec
 from mfm.fidelity import reduce, variant_model
 from mfm.spectral import spectral_response
@@ -311,6 +312,10 @@ def test_spectral_sweep_equals_per_sea_spectral_response(m111):
         t = 2.0 + 4 * dts[i] * np.arange(11)
         np.testing.assert_allclose(ds.time.values[i], t, rtol=1e-15)
         one = spectral_response(m111, sea, t=t)
+        # the elevation is folded into the synthesis' harmonic sum: against hydro.waves' own
+        comps = sea.components(water_depth=m111.hydro.water_depth, g=m111.hydro.g)
+        np.testing.assert_allclose(ds.eta.values[i], np.asarray(elevation(comps, t)).reshape(-1),
+                                   rtol=0, atol=1e-12 * np.abs(ds.eta.values[i]).max())
         for v in ("q_rms", "pto_power_mean", "q", "qd", "pto_power", "eta"):
             ref = one[v].values
             np.testing.assert_allclose(ds[v].values[i], ref, rtol=0,
