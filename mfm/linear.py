@@ -78,13 +78,10 @@ def lti_matrices(M, C, K, H0=None, rad=None, free=()):
     if nx:
         pr, pi = np.asarray(rad.p[:, 0]), np.asarray(rad.p[:, 1])
         zr, zi = slice(ns + n, ns + n + nx), slice(ns + n + nx, N)
-        Cr, Ci = np.asarray(rad.C[..., 0]), np.asarray(rad.C[..., 1])
-        out = np.zeros((H0.shape[0], nx)), np.zeros((H0.shape[0], nx))
-        out[0][np.asarray(rad.outputs)] = Cr
-        out[1][np.asarray(rad.outputs)] = Ci
-        # F_rad = −(Cr zr − Ci zi) on the output dofs; M ẍ gets H₀ᵀ F_rad
-        A[vs, zr] = -Minv @ H0.T @ out[0]
-        A[vs, zi] = Minv @ H0.T @ out[1]
+        out = np.zeros((H0.shape[0], 2 * nx))
+        out[np.asarray(rad.outputs)] = np.asarray(rad.C)
+        # F_rad = −C [zr; zi] on the output dofs; M ẍ gets H₀ᵀ F_rad
+        A[vs, ns + n:] = -Minv @ H0.T @ out
         A[zr, zr] = np.diag(pr)
         A[zr, zi] = -np.diag(pi)
         A[zi, zr] = np.diag(pi)

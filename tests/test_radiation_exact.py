@@ -14,7 +14,7 @@ RES = np.array([[1.5 - 0.4j, 0.7 + 0.2j], [-0.3 + 0.1j, 2.0 - 1.0j]])   # (n_out
 
 def modal(dt, offsets=(0.0, 0.5, 1.0)):
     ss = StateSpace(p=jnp.asarray(np.stack([POLES.real, POLES.imag], 1)),
-                    C=jnp.asarray(np.stack([RES.real, RES.imag], -1)), A_inf=jnp.zeros((2, 2)),
+                    C=jnp.asarray(np.concatenate([RES.real, -RES.imag], 1)), A_inf=jnp.zeros((2, 2)),
                     inputs=(0, 0), outputs=(0, 1))
     return ExactStateSpace.from_state_space(ss, dt, offsets)
 

@@ -127,10 +127,13 @@ class Convolution(NoRadiation):
 
 
 class StateSpace(NoRadiation):
-    """The modal state space: ``p`` (n_x, 2) complex poles as (re, im), ``C`` (n_out, n_x, 2)
-    output residues (conjugate pairs folded, × 2), ``inputs`` the input dof of each state,
-    ``outputs`` the output dofs, ``A_inf`` the fit's corrected A∞; ``options`` the fit options
-    (static, so the frequency domain refits nothing: the fit is cached on the HydroSpec)."""
+    """The modal state space: ``p`` (n_x, 2) complex poles as (re, im); ``C`` (n_out, 2 n_x) the
+    real output map [Re R, −Im R] of the output residues R (conjugate pairs folded, × 2), so that
+    the force on the output dofs is −C [Re z; Im z] with one matrix–vector product (one contiguous
+    matrix: slices of a trailing (re, im) axis cost a copy of R at every evaluation); ``inputs``
+    the input dof of each state, ``outputs`` the output dofs, ``A_inf`` the fit's corrected A∞;
+    ``options`` the fit options (static, so the frequency domain refits nothing: the fit is cached
+    on the HydroSpec)."""
     p: jnp.ndarray
     C: jnp.ndarray
     A_inf: jnp.ndarray
@@ -150,8 +153,7 @@ class StateSpace(NoRadiation):
         pr, pi = self.p[:, 0], self.p[:, 1]
         u = v[np.asarray(self.inputs)]
         zd = jnp.concatenate([pr * zr - pi * zi + u, pr * zi + pi * zr])
-        F = self.C[..., 0] @ zr - self.C[..., 1] @ zi
-        return -jnp.zeros_like(v).at[np.asarray(self.outputs)].set(F), zd
+        return -jnp.zeros_like(v).at[np.asarray(self.outputs)].set(self.C @ z), zd
 
     def added_mass_inf(self, spec):
         return np.asarray(self.A_inf)
@@ -187,7 +189,7 @@ class StateSpace(NoRadiation):
         report = tuple((k, v) for k, v in (getattr(ss, "report", None) or {}).items()
                        if isinstance(v, (int, float, str)))
         return cls(p=jnp.asarray(np.stack([P.real, P.imag], 1).reshape(-1, 2)),
-                   C=jnp.asarray(np.stack([C.real, C.imag], -1).reshape(len(outs), len(P), 2)),
+                   C=jnp.asarray(np.concatenate([C.real, -C.imag], 1).reshape(len(outs), 2 * len(P))),
                    A_inf=jnp.asarray(np.asarray(ss.added_mass_inf) * spec.mask),
                    inputs=tuple(ins), outputs=tuple(outs),
                    options=tuple(sorted(options.items())), report=report)
@@ -223,8 +225,8 @@ class ExactStateSpace(StateSpace):
     states are the load's memory, not the integrator's: stable at any dt (|e^{ph}| < 1 for every
     stable pole), so a one-evaluation integrator (``verlet``) can carry lightly damped radiation
     modes; the radiation's own error is that of the hold, O(dt²) (as the convolution's).
-    ``E``, ``G``, ``H`` (S + 1, n_x, 2): e^{ph}, hφ₁, hφ₂ as (re, im) for each stage offset and
-    the full step (last row). Memory: (tₙ, Re zₙ, Im zₙ, uₙ)."""
+    ``E``, ``G``, ``H`` (S + 1, 2, n_x): e^{ph}, hφ₁, hφ₂ as (re, im) rows for each stage offset
+    and the full step (last). Memory: (tₙ, Re zₙ, Im zₙ, uₙ)."""
     E: jnp.ndarray = None
     G: jnp.ndarray = None
     H: jnp.ndarray = None
@@ -244,8 +246,8 @@ class ExactStateSpace(StateSpace):
         _, zr, zi, u_n = memory
         E, G, H = self.E[r], self.G[r], self.H[r]
         du = u - u_n
-        return (E[:, 0] * zr - E[:, 1] * zi + G[:, 0] * u_n + H[:, 0] * du,
-                E[:, 0] * zi + E[:, 1] * zr + G[:, 1] * u_n + H[:, 1] * du)
+        return (E[0] * zr - E[1] * zi + G[0] * u_n + H[0] * du,
+                E[0] * zi + E[1] * zr + G[1] * u_n + H[1] * du)
 
     def update_memory(self, v, t, memory):
         u = v[np.asarray(self.inputs)]
@@ -256,7 +258,7 @@ class ExactStateSpace(StateSpace):
         offs = jnp.asarray(self.stage_offsets)
         r = jnp.argmin(jnp.abs((t - memory[0]) / self.dt - offs))
         zr, zi = self._advance(r, memory, v[np.asarray(self.inputs)])
-        F = self.C[..., 0] @ zr - self.C[..., 1] @ zi
+        F = self.C @ jnp.concatenate([zr, zi])
         return -jnp.zeros_like(v).at[np.asarray(self.outputs)].set(F), None
 
     def provenance(self):
@@ -273,7 +275,7 @@ class ExactStateSpace(StateSpace):
         p = np.asarray(ss.p[:, 0]) + 1j * np.asarray(ss.p[:, 1])
         h = float(dt) * np.asarray(tuple(stage_offsets) + (1.0,))[:, None]
         e, phi1, phi2 = phi_functions(p[None, :] * h, 2)
-        split = lambda a: jnp.asarray(np.stack([a.real, a.imag], -1))  # noqa: E731
+        split = lambda a: jnp.asarray(np.stack([a.real, a.imag], 1))  # noqa: E731
         return cls(p=ss.p, C=ss.C, A_inf=ss.A_inf, inputs=ss.inputs, outputs=ss.outputs,
                    options=ss.options, report=ss.report, E=split(e), G=split(h * phi1),
                    H=split(h * phi2), dt=jnp.asarray(dt, jnp.float64),
