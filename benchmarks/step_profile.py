@@ -1,0 +1,168 @@
+"""What one time step costs, kernel by kernel: the compiled step's kernels counted by the source
+line that made them, beside the warm time per step (not a test).
+
+    python benchmarks/step_profile.py [--config configs/m4_134.toml] [--integrator verlet]
+                                      [--radiation state_space_exact] [--steps 20000] [--top 25]
+                                      [--mechanics-only]
+
+XLA on a CPU runs each compiled step as a sequence of kernels (fusions, dots, solver calls,
+copies), each with a fixed cost of a fraction of a microsecond besides its flops. For a model of
+a few coordinates the step's flops are a few µs (benchmarks/RESULTS.md, "One step of the fast
+path"), so the count of kernels, not the flops, sets the floor: this script shows where they come
+from. It compiles the rollout of ``mfm.rollout`` (the M4 134 sea state of benchmarks/speed.py by
+default), takes the body of its time loop from the optimised HLO, and attributes each kernel to
+the innermost ``mfm`` source line in its metadata (jax records the Python stack of every
+operation). Then it times warm rollouts: the median of ``--repeats`` calls after the compiling
+one.
+"""
+import argparse
+import collections
+import re
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+# HLO operations that are not kernels (no code runs for them)
+FREE = {"get-tuple-element", "constant", "bitcast", "tuple", "parameter"}
+
+
+def _section(txt, name):
+    """The lines of one metadata table of an HLO module's text (FileNames, FunctionNames, …)."""
+    parts = txt.split("\n" + name + "\n")
+    return parts[1].split("\n\n")[0].split("\n") if len(parts) > 1 else []
+
+
+def _frames(txt):
+    """stack frame id -> [(file, function, line), …] innermost first, from the module's tables."""
+    files = {int(x.split()[0]): x.split('"')[1] for x in _section(txt, "FileNames") if '"' in x}
+    funcs = {int(x.split()[0]): x.split('"')[1] for x in _section(txt, "FunctionNames") if '"' in x}
+    locs = {}
+    for x in _section(txt, "FileLocations"):
+        m = re.match(r"(\d+) \{file_name_id=(\d+) function_name_id=(\d+) line=(\d+)", x)
+        if m:
+            locs[int(m.group(1))] = (files[int(m.group(2))], funcs[int(m.group(3))], int(m.group(4)))
+    frames = {}
+    for x in _section(txt, "StackFrames"):
+        m = re.match(r"(\d+) \{file_location_id=(\d+) parent_frame_id=(\d+)", x)
+        if m:
+            frames[int(m.group(1))] = (int(m.group(2)), int(m.group(3)))
+
+    def chain(fid):
+        out = []
+        while fid in frames and len(out) < 64:
+            loc, parent = frames[fid]
+            out.append(locs.get(loc, ("?", "?", 0)))
+            if parent == fid:
+                break
+            fid = parent
+        return out
+    return chain
+
+
+def _computations(txt):
+    comps, cur = {}, None
+    for line in txt.split("\n"):
+        m = re.match(r"^(ENTRY )?%(\S+) .*\{$", line)
+        if m:
+            cur = m.group(2)
+            comps[cur] = []
+            continue
+        if line.startswith("}"):
+            cur = None
+        elif cur:
+            comps[cur].append(line)
+    return comps
+
+
+def step_kernels(hlo_text, n_steps):
+    """The kernels of the time loop's body (the while loop of ``n_steps`` trips): a Counter of
+    "file:function:line" (the innermost frame in mfm/ or hydro/) -> kernels, and one of op kinds."""
+    comps = _computations(hlo_text)
+    chain = _frames(hlo_text)
+    body = None
+    for lines in comps.values():
+        for line in lines:
+            if " while(" in line and f'"known_trip_count":{{"n":"{n_steps}"}}' in line:
+                body = re.search(r"body=%([^,\s]+)", line).group(1)
+    if body is None:
+        raise RuntimeError(f"no while loop of {n_steps} trips in the compiled rollout")
+    where, kinds = collections.Counter(), collections.Counter()
+    for line in comps[body]:
+        op = re.search(r"= \S+ ([a-z][\w-]*)\(", line)
+        if not op or op.group(1) in FREE:
+            continue
+        kinds[op.group(1)] += 1
+        sf = re.search(r"stack_frame_id=(\d+)", line)
+        ours = [f for f in (chain(int(sf.group(1))) if sf else [])
+                if "/mfm/" in f[0] or "/hydro/" in f[0]]
+        key = (f"{Path(ours[0][0]).parent.name}/{Path(ours[0][0]).name}:{ours[0][1]}:{ours[0][2]}"
+               if ours else f"(no mfm frame) {op.group(1)}")
+        where[key] += 1
+    return where, kinds
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--config", default=str(ROOT / "configs" / "m4_134.toml"))
+    ap.add_argument("--integrator", default="verlet")
+    ap.add_argument("--radiation", default="state_space_exact")
+    ap.add_argument("--steps", type=int, default=20_000)
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--top", type=int, default=25)
+    ap.add_argument("--mechanics-only", action="store_true",
+                    help="the tree alone: no water, no other loads of the config")
+    a = ap.parse_args()
+
+    import jax.numpy as jnp
+
+    import hydro
+    import mfm
+    from mfm import integrators
+    from mfm.simulate import _rollout_jit, model_loads
+
+    tp = 1.2
+    dt = tp / 200
+    m = mfm.load(a.config)
+    sea = hydro.Jonswap(hs=0.04, tp=tp, gamma=3.3, seed=1, omega_range=(1.0, 25.0))
+    loads = model_loads(m, sea, dt=dt, duration=a.steps * dt, ramp=5 * tp, radiation=a.radiation,
+                        integrator=a.integrator)
+    if a.mechanics_only:
+        loads = ()
+    q0 = jnp.zeros(m.n_coordinates)
+    z0 = jnp.concatenate([ld.initial_state(m) for ld in loads]) if loads else jnp.zeros(0)
+    t0 = time.perf_counter()
+    compiled = _rollout_jit.lower(m, loads, q0, q0, z0, jnp.asarray(0.0), jnp.asarray(dt),
+                                  n_steps=a.steps, integrator=integrators.get(a.integrator),
+                                  save_every=a.steps, record=False).compile()
+    t_compile = time.perf_counter() - t0
+    where, kinds = step_kernels(compiled.as_text(), a.steps)
+
+    def run():
+        return mfm.rollout(m, q0, q0, dt=dt, n_steps=a.steps, integrator=a.integrator, loads=loads,
+                           save_every=a.steps)[1].block_until_ready()
+    run()
+    ts = []
+    for _ in range(a.repeats):
+        t0 = time.perf_counter()
+        run()
+        ts.append(time.perf_counter() - t0)
+    warm = float(np.median(ts))
+    n = sum(kinds.values())
+    what = "mechanics only" if a.mechanics_only else a.radiation
+    print(f"{Path(a.config).name}, {a.integrator} / {what}, {a.steps} steps: compile "
+          f"{t_compile:.1f} s, warm {warm:.3f} s = {warm / a.steps * 1e6:.1f} µs/step; "
+          f"{n} kernels per step ({warm / a.steps * 1e6 / n:.2f} µs per kernel on average)")
+    print("kinds: " + ", ".join(f"{k} {v}" for k, v in kinds.most_common()))
+    by_file = collections.Counter()
+    for k, v in where.items():
+        by_file[k.split(":")[0]] += v
+    print("by file: " + ", ".join(f"{k} {v}" for k, v in by_file.most_common()))
+    print(f"\n| kernels | source line (innermost mfm frame) |\n|---|---|")
+    for k, v in where.most_common(a.top):
+        print(f"| {v} | {k} |")
+
+
+if __name__ == "__main__":
+    main()
