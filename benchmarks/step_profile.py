@@ -3,7 +3,7 @@ line that made them, beside the warm time per step (not a test).
 
     python benchmarks/step_profile.py [--config configs/m4_134.toml] [--integrator verlet]
                                       [--radiation state_space_exact] [--steps 20000] [--top 25]
-                                      [--mechanics-only]
+                                      [--mechanics-only] [--without-welded]
 
 XLA on a CPU runs each compiled step as a sequence of kernels (fusions, dots, solver calls,
 copies), each with a fixed cost of a fraction of a microsecond besides its flops. For a model of
@@ -14,6 +14,11 @@ default), takes the body of its time loop from the optimised HLO, and attributes
 the innermost ``mfm`` source line in its metadata (jax records the Python stack of every
 operation). Then it times warm rollouts: the median of ``--repeats`` calls after the compiling
 one.
+
+``--without-welded`` (with ``--mechanics-only``) is a cost probe, not the same physics: it profiles
+the config's tree with every body on a fixed joint left out (their children hung from the
+left-out body's parent at the same joint points; masses not merged), i.e. what a step would cost
+if welded bodies were lumped into their parent before compiling.
 """
 import argparse
 import collections
@@ -103,6 +108,46 @@ def step_kernels(hlo_text, n_steps):
     return where, kinds
 
 
+def _without_welded(config):
+    """The config's tree (no hydro, no loads) without its bodies on fixed joints: each one's
+    children hang from its parent at their own joint points (a cost probe, masses not merged)."""
+    import tempfile
+    import tomllib
+
+    import mfm
+
+    with open(config, "rb") as f:
+        cfg = tomllib.load(f)
+    bodies = {b["name"]: b for b in cfg["bodies"]}
+    welded = {n for n, b in bodies.items() if b.get("joint", {}).get("type") == "fixed"}
+
+    def keeper(name):
+        while name in welded:
+            name = bodies[name].get("parent")
+        return name
+
+    def value(v):
+        return "[" + ", ".join(map(value, v)) + "]" if isinstance(v, list) else (
+            f'"{v}"' if isinstance(v, str) else repr(v).lower() if isinstance(v, bool) else repr(v))
+
+    lines = [f'[model]\nname = "{cfg["model"]["name"]} without welded bodies"\n'
+             f'gravity = {cfg["model"].get("gravity", 9.81)}\n']
+    for name, b in bodies.items():
+        if name in welded:
+            continue
+        keep = {k: v for k, v in b.items() if k not in ("joint", "geometry", "hydro", "notes")}
+        if keep.get("parent") is not None:
+            keep["parent"] = keeper(keep["parent"])
+        lines.append("[[bodies]]")
+        lines += [f"{k} = {value(v)}" for k, v in keep.items() if v is not None]
+        lines += ["[bodies.joint]"] + [f"{k} = {value(v)}" for k, v in b.get("joint", {}).items()]
+        lines.append("")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "without_welded.toml"
+        path.write_text("\n".join(lines))
+        return mfm.load(path)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--config", default=str(ROOT / "configs" / "m4_134.toml"))
@@ -113,6 +158,9 @@ def main():
     ap.add_argument("--top", type=int, default=25)
     ap.add_argument("--mechanics-only", action="store_true",
                     help="the tree alone: no water, no other loads of the config")
+    ap.add_argument("--without-welded", action="store_true",
+                    help="with --mechanics-only: the tree without its fixed-joint bodies (a cost "
+                         "probe of lumping them, not the same physics)")
     a = ap.parse_args()
 
     import jax.numpy as jnp
@@ -124,9 +172,11 @@ def main():
 
     tp = 1.2
     dt = tp / 200
-    m = mfm.load(a.config)
+    if a.without_welded and not a.mechanics_only:
+        ap.error("--without-welded needs --mechanics-only (the hydro data belong to every body)")
+    m = _without_welded(a.config) if a.without_welded else mfm.load(a.config)
     sea = hydro.Jonswap(hs=0.04, tp=tp, gamma=3.3, seed=1, omega_range=(1.0, 25.0))
-    loads = model_loads(m, sea, dt=dt, duration=a.steps * dt, ramp=5 * tp, radiation=a.radiation,
+    loads = () if a.without_welded else model_loads(m, sea, dt=dt, duration=a.steps * dt, ramp=5 * tp, radiation=a.radiation,
                         integrator=a.integrator)
     if a.mechanics_only:
         loads = ()
@@ -151,6 +201,7 @@ def main():
     warm = float(np.median(ts))
     n = sum(kinds.values())
     what = "mechanics only" if a.mechanics_only else a.radiation
+    what += ", welded bodies left out" if a.without_welded else ""
     print(f"{Path(a.config).name}, {a.integrator} / {what}, {a.steps} steps: compile "
           f"{t_compile:.1f} s, warm {warm:.3f} s = {warm / a.steps * 1e6:.1f} µs/step; "
           f"{n} kernels per step ({warm / a.steps * 1e6 / n:.2f} µs per kernel on average)")
@@ -159,7 +210,7 @@ def main():
     for k, v in where.items():
         by_file[k.split(":")[0]] += v
     print("by file: " + ", ".join(f"{k} {v}" for k, v in by_file.most_common()))
-    print(f"\n| kernels | source line (innermost mfm frame) |\n|---|---|")
+    print("\n| kernels | source line (innermost mfm frame) |\n|---|---|")
     for k, v in where.most_common(a.top):
         print(f"| {v} | {k} |")
 
