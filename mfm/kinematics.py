@@ -121,6 +121,13 @@ def kinematics(model: Model, q, qd=None) -> Kinematics:
         p = model.parents[i]
         f = world if p < 0 else frames[p]
         com_p = z3 if p < 0 else model.com[p]
+        if not model.motions[i]:
+            # a welded body: with no motion between them the two placements are one,
+            # (j − c_p) + (c − j) = c − c_p (each placement is linear in its offset); the joint
+            # frame's pose alone is kept for the outputs, so the walk carries one placement
+            joints.append(f._replace(o=f.o + _mv(f.R, model.joint_point[i] - com_p)))
+            frames.append(_offset(f, model.com[i] - com_p))
+            continue
         f = _offset(f, model.joint_point[i] - com_p)
         for k, (kind, qi) in enumerate(model.motions[i]):
             step = _rotate if kind == "R" else _translate
