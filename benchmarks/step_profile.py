@@ -26,7 +26,7 @@ import re
 import time
 from pathlib import Path
 
-import numpy as np
+from speed import _timed   # the median of warm calls after the compiling one (this folder)
 
 ROOT = Path(__file__).resolve().parents[1]
 # HLO operations that are not kernels (no code runs for them)
@@ -176,10 +176,9 @@ def main():
         ap.error("--without-welded needs --mechanics-only (the hydro data belong to every body)")
     m = _without_welded(a.config) if a.without_welded else mfm.load(a.config)
     sea = hydro.Jonswap(hs=0.04, tp=tp, gamma=3.3, seed=1, omega_range=(1.0, 25.0))
-    loads = () if a.without_welded else model_loads(m, sea, dt=dt, duration=a.steps * dt, ramp=5 * tp, radiation=a.radiation,
-                        integrator=a.integrator)
-    if a.mechanics_only:
-        loads = ()
+    loads = () if a.mechanics_only else model_loads(
+        m, sea, dt=dt, duration=a.steps * dt, ramp=5 * tp, radiation=a.radiation,
+        integrator=a.integrator)
     q0 = jnp.zeros(m.n_coordinates)
     z0 = jnp.concatenate([ld.initial_state(m) for ld in loads]) if loads else jnp.zeros(0)
     t0 = time.perf_counter()
@@ -192,13 +191,7 @@ def main():
     def run():
         return mfm.rollout(m, q0, q0, dt=dt, n_steps=a.steps, integrator=a.integrator, loads=loads,
                            save_every=a.steps)[1].block_until_ready()
-    run()
-    ts = []
-    for _ in range(a.repeats):
-        t0 = time.perf_counter()
-        run()
-        ts.append(time.perf_counter() - t0)
-    warm = float(np.median(ts))
+    _, _, warm = _timed(run, a.repeats)
     n = sum(kinds.values())
     what = "mechanics only" if a.mechanics_only else a.radiation
     what += ", welded bodies left out" if a.without_welded else ""

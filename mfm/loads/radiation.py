@@ -189,7 +189,7 @@ class StateSpace(NoRadiation):
         report = tuple((k, v) for k, v in (getattr(ss, "report", None) or {}).items()
                        if isinstance(v, (int, float, str)))
         return cls(p=jnp.asarray(np.stack([P.real, P.imag], 1).reshape(-1, 2)),
-                   C=jnp.asarray(np.concatenate([C.real, -C.imag], 1).reshape(len(outs), 2 * len(P))),
+                   C=jnp.asarray(np.concatenate([C.real, -C.imag], 1)),
                    A_inf=jnp.asarray(np.asarray(ss.added_mass_inf) * spec.mask),
                    inputs=tuple(ins), outputs=tuple(outs),
                    options=tuple(sorted(options.items())), report=report)
