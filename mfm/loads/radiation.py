@@ -225,12 +225,18 @@ class ExactStateSpace(StateSpace):
     states are the load's memory, not the integrator's: stable at any dt (|e^{ph}| < 1 for every
     stable pole), so a one-evaluation integrator (``verlet``) can carry lightly damped radiation
     modes; the radiation's own error is that of the hold, O(dt²) (as the convolution's).
-    ``E``, ``G``, ``H`` (S + 1, 2, n_x): e^{ph}, hφ₁, hφ₂ as (re, im) rows for each stage offset
-    and the full step (last). Memory: (tₙ, Re zₙ, Im zₙ, uₙ)."""
+    ``E``, ``G``, ``H`` (S + 1, 2, n_b, n_p): e^{ph}, hφ₁, hφ₂ as (re, im) rows for each stage
+    offset and the full step (last), with the states in blocks (:func:`_blocks`): block b holds
+    the n_p states driven by the input dof ``block_inputs[b]`` (padded with states that stay zero),
+    so each input is read once and broadcast along its block instead of gathered per state.
+    ``C_blocks`` (n_out, 2 n_b n_p): the output map in that layout. Memory: (tₙ, Re zₙ, Im zₙ,
+    uₙ), z (n_b, n_p), u (n_b,)."""
     E: jnp.ndarray = None
     G: jnp.ndarray = None
     H: jnp.ndarray = None
+    C_blocks: jnp.ndarray = None
     dt: jnp.ndarray = None
+    block_inputs: tuple[int, ...] = eqx.field(static=True, default=())
     stage_offsets: tuple[float, ...] = eqx.field(static=True, default=(0.0,))
     name: ClassVar[str] = "state_space_exact"
 
@@ -239,26 +245,27 @@ class ExactStateSpace(StateSpace):
         return 0
 
     def init_memory(self, v, t0):
-        n = len(self.inputs)
-        return (jnp.asarray(t0, jnp.float64), jnp.zeros(n), jnp.zeros(n), v[np.asarray(self.inputs)])
+        shape = self.E.shape[2:]
+        return (jnp.asarray(t0, jnp.float64), jnp.zeros(shape), jnp.zeros(shape),
+                v[np.asarray(self.block_inputs)])
 
     def _advance(self, r, memory, u):
         _, zr, zi, u_n = memory
         E, G, H = self.E[r], self.G[r], self.H[r]
-        du = u - u_n
-        return (E[0] * zr - E[1] * zi + G[0] * u_n + H[0] * du,
-                E[0] * zi + E[1] * zr + G[1] * u_n + H[1] * du)
+        du, un = (u - u_n)[:, None], u_n[:, None]
+        return (E[0] * zr - E[1] * zi + G[0] * un + H[0] * du,
+                E[0] * zi + E[1] * zr + G[1] * un + H[1] * du)
 
     def update_memory(self, v, t, memory):
-        u = v[np.asarray(self.inputs)]
+        u = v[np.asarray(self.block_inputs)]
         zr, zi = self._advance(-1, memory, u)
         return (t, zr, zi, u)
 
     def force(self, t, v, z, memory):
         offs = jnp.asarray(self.stage_offsets)
         r = jnp.argmin(jnp.abs((t - memory[0]) / self.dt - offs))
-        zr, zi = self._advance(r, memory, v[np.asarray(self.inputs)])
-        F = self.C @ jnp.concatenate([zr, zi])
+        zr, zi = self._advance(r, memory, v[np.asarray(self.block_inputs)])
+        F = self.C_blocks @ jnp.concatenate([zr.reshape(-1), zi.reshape(-1)])
         return -jnp.zeros_like(v).at[np.asarray(self.outputs)].set(F), None
 
     def provenance(self):
@@ -275,11 +282,41 @@ class ExactStateSpace(StateSpace):
         p = np.asarray(ss.p[:, 0]) + 1j * np.asarray(ss.p[:, 1])
         h = float(dt) * np.asarray(tuple(stage_offsets) + (1.0,))[:, None]
         e, phi1, phi2 = phi_functions(p[None, :] * h, 2)
-        split = lambda a: jnp.asarray(np.stack([a.real, a.imag], 1))  # noqa: E731
+        slot, block_inputs, n_p = _blocks(ss.inputs)
+        n_b = len(block_inputs)
+
+        def split(a):
+            # (S + 1, n_x) complex -> (S + 1, 2, n_b, n_p); padded states get E = G = H = 0
+            out = np.zeros((a.shape[0], 2, n_b * n_p))
+            out[:, 0, slot], out[:, 1, slot] = a.real, a.imag
+            return jnp.asarray(out.reshape(a.shape[0], 2, n_b, n_p))
+
+        n_x = len(ss.inputs)
+        C = np.asarray(ss.C)
+        Cb = np.zeros((C.shape[0], 2 * n_b * n_p))
+        Cb[:, slot], Cb[:, n_b * n_p + slot] = C[:, :n_x], C[:, n_x:]
         return cls(p=ss.p, C=ss.C, A_inf=ss.A_inf, inputs=ss.inputs, outputs=ss.outputs,
                    options=ss.options, report=ss.report, E=split(e), G=split(h * phi1),
-                   H=split(h * phi2), dt=jnp.asarray(dt, jnp.float64),
-                   stage_offsets=tuple(float(c) for c in stage_offsets))
+                   H=split(h * phi2), C_blocks=jnp.asarray(Cb), dt=jnp.asarray(dt, jnp.float64),
+                   block_inputs=block_inputs, stage_offsets=tuple(float(c) for c in stage_offsets))
+
+
+def _blocks(inputs):
+    """The block layout of states driven by the input dofs ``inputs`` (n_x,): runs of consecutive
+    states with one input (the modal form makes one run per input and pole set) become blocks of
+    n_p = the longest run, padded; where padding would more than double the states (runs of
+    very different lengths), every state is its own block (n_p = 1). Returns the slot of each state
+    in the flattened (n_b, n_p) layout, the input of each block and n_p."""
+    inputs = np.asarray(inputs, dtype=int)
+    if inputs.size == 0:
+        return np.zeros(0, int), (), 1
+    starts = np.flatnonzero(np.r_[True, inputs[1:] != inputs[:-1]])
+    lengths = np.diff(np.r_[starts, inputs.size])
+    n_p = int(lengths.max())
+    if len(starts) * n_p > 2 * inputs.size:
+        return np.arange(inputs.size), tuple(int(j) for j in inputs), 1
+    slot = np.concatenate([b * n_p + np.arange(n) for b, n in enumerate(lengths)])
+    return slot, tuple(int(inputs[s]) for s in starts), n_p
 
 
 def strategy(spec, name, *, dt=None, memory=None, state_space_options=None, stage_offsets=(0.0, 0.5, 1.0),
