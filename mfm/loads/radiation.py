@@ -225,18 +225,33 @@ class ExactStateSpace(StateSpace):
     states are the load's memory, not the integrator's: stable at any dt (|e^{ph}| < 1 for every
     stable pole), so a one-evaluation integrator (``verlet``) can carry lightly damped radiation
     modes; the radiation's own error is that of the hold, O(dt²) (as the convolution's).
-    ``E``, ``G``, ``H`` (S + 1, 2, n_b, n_p): e^{ph}, hφ₁, hφ₂ as (re, im) rows for each stage
-    offset and the full step (last), with the states in blocks (:func:`_blocks`): block b holds
-    the n_p states driven by the input dof ``block_inputs[b]`` (padded with states that stay zero),
-    so each input is read once and broadcast along its block instead of gathered per state.
-    ``C_blocks`` (n_out, 2 n_b n_p): the output map in that layout. Memory: (tₙ, Re zₙ, Im zₙ,
-    uₙ), z (n_b, n_p), u (n_b,)."""
+
+    The force F = −Re(R z) is linear in (zₙ, uₙ, u_c), so a stage reads
+
+        F_c = −(Yₙ[c] + (R G_c) uₙ + (R H_c)(u_c − uₙ)),   Yₙ[c] = Re(R e^{p c dt} zₙ),
+
+    with Yₙ computed once per step where zₙ is (:meth:`update_memory`), one product of the states
+    with ``CE`` for the stages after the step's start, and none for a stage at its start (c = 0:
+    Yₙ₊₁[0] = Re(R zₙ₊₁) follows from the stage at its end, c = 1, by the same linearity). The
+    stages themselves cost (n_out × n_in) products, not a pass over the states.
+
+    ``E``, ``G``, ``H`` (2, n_b, n_p): e^{p dt}, dt φ₁, dt φ₂ of the full step as (re, im), with the
+    states in blocks (:func:`_blocks`): block b holds the n_p states driven by the input dof
+    ``block_inputs[b]`` (padded with states that stay zero), so each input is read once and
+    broadcast along its block instead of gathered per state. ``CE`` (n_c, n_out, 2 n_b n_p): the
+    output maps Re(R e^{p c dt} ·) of the stage offsets c ∈ ``matvec_stages`` on [Re z; Im z];
+    ``CG``, ``CH`` (S + 1, n_out, n_b): Re(R hφ₁), Re(R hφ₂) summed over each block, per stage
+    offset and the full step (last). Memory: (tₙ, Re zₙ, Im zₙ, uₙ, Yₙ), z (n_b, n_p), u (n_b,),
+    Y (S, n_out)."""
     E: jnp.ndarray = None
     G: jnp.ndarray = None
     H: jnp.ndarray = None
-    C_blocks: jnp.ndarray = None
+    CE: jnp.ndarray = None
+    CG: jnp.ndarray = None
+    CH: jnp.ndarray = None
     dt: jnp.ndarray = None
     block_inputs: tuple[int, ...] = eqx.field(static=True, default=())
+    matvec_stages: tuple[int, ...] = eqx.field(static=True, default=())
     stage_offsets: tuple[float, ...] = eqx.field(static=True, default=(0.0,))
     name: ClassVar[str] = "state_space_exact"
 
@@ -245,27 +260,39 @@ class ExactStateSpace(StateSpace):
         return 0
 
     def init_memory(self, v, t0):
-        shape = self.E.shape[2:]
+        shape = self.E.shape[1:]
         return (jnp.asarray(t0, jnp.float64), jnp.zeros(shape), jnp.zeros(shape),
-                v[np.asarray(self.block_inputs)])
-
-    def _advance(self, r, memory, u):
-        _, zr, zi, u_n = memory
-        E, G, H = self.E[r], self.G[r], self.H[r]
-        du, un = (u - u_n)[:, None], u_n[:, None]
-        return (E[0] * zr - E[1] * zi + G[0] * un + H[0] * du,
-                E[0] * zi + E[1] * zr + G[1] * un + H[1] * du)
+                v[np.asarray(self.block_inputs)], jnp.zeros((len(self.stage_offsets), self.CG.shape[1])))
 
     def update_memory(self, v, t, memory):
+        _, zr, zi, u_n, Y = memory
         u = v[np.asarray(self.block_inputs)]
-        zr, zi = self._advance(-1, memory, u)
-        return (t, zr, zi, u)
+        E, G, H = self.E, self.G, self.H
+        du, un = (u - u_n)[:, None], u_n[:, None]
+        zr, zi = (E[0] * zr - E[1] * zi + G[0] * un + H[0] * du,
+                  E[0] * zi + E[1] * zr + G[1] * un + H[1] * du)
+        rows = [None] * len(self.stage_offsets)
+        if self.matvec_stages:
+            Yc = self.CE @ jnp.concatenate([zr.reshape(-1), zi.reshape(-1)])
+            for k, s in enumerate(self.matvec_stages):
+                rows[s] = Yc[k]
+        for s, c in enumerate(self.stage_offsets):
+            if rows[s] is None:
+                # c = 0: Re(R zₙ₊₁) = the full step's stage output of zₙ and the inputs
+                rows[s] = Y[self._end] + jnp.sum(self.CG[-1] * u_n + self.CH[-1] * (u - u_n), axis=1)
+        return (t, zr, zi, u, jnp.stack(rows))
+
+    @property
+    def _end(self):
+        return self.stage_offsets.index(1.0)
 
     def force(self, t, v, z, memory):
+        t_n, _, _, u_n, Y = memory
         offs = jnp.asarray(self.stage_offsets)
-        r = jnp.argmin(jnp.abs((t - memory[0]) / self.dt - offs))
-        zr, zi = self._advance(r, memory, v[np.asarray(self.block_inputs)])
-        F = self.C_blocks @ jnp.concatenate([zr.reshape(-1), zi.reshape(-1)])
+        r = jnp.argmin(jnp.abs((t - t_n) / self.dt - offs))
+        u = v[np.asarray(self.block_inputs)]
+        # (n_out × n_in) products as one fused multiply–reduce: tiny dots are slow on XLA CPU
+        F = Y[r] + jnp.sum(self.CG[r] * u_n + self.CH[r] * (u - u_n), axis=1)
         return -jnp.zeros_like(v).at[np.asarray(self.outputs)].set(F), None
 
     def provenance(self):
@@ -279,26 +306,39 @@ class ExactStateSpace(StateSpace):
     @classmethod
     def from_state_space(cls, ss: StateSpace, dt, stage_offsets):
         """The exact update of ``ss``'s states for steps of ``dt`` and stages at ``stage_offsets``."""
+        offsets = tuple(float(c) for c in stage_offsets)
         p = np.asarray(ss.p[:, 0]) + 1j * np.asarray(ss.p[:, 1])
-        h = float(dt) * np.asarray(tuple(stage_offsets) + (1.0,))[:, None]
+        h = float(dt) * np.asarray(offsets + (1.0,))[:, None]
         e, phi1, phi2 = phi_functions(p[None, :] * h, 2)
         slot, block_inputs, n_p = _blocks(ss.inputs)
-        n_b = len(block_inputs)
+        n_b, n_x = len(block_inputs), len(ss.inputs)
+        C = np.asarray(ss.C)
+        Rc = C[:, :n_x] - 1j * C[:, n_x:]                 # the complex residues R: F = −Re(R z)
+
+        def blocks(a):
+            # (..., n_x) -> (..., n_b, n_p); padded states get zeros (they stay zero)
+            out = np.zeros(a.shape[:-1] + (n_b * n_p,), dtype=a.dtype)
+            out[..., slot] = a
+            return out.reshape(a.shape[:-1] + (n_b, n_p))
 
         def split(a):
-            # (S + 1, n_x) complex -> (S + 1, 2, n_b, n_p); padded states get E = G = H = 0
-            out = np.zeros((a.shape[0], 2, n_b * n_p))
-            out[:, 0, slot], out[:, 1, slot] = a.real, a.imag
-            return jnp.asarray(out.reshape(a.shape[0], 2, n_b, n_p))
+            return jnp.asarray(np.stack([blocks(a.real), blocks(a.imag)]))
 
-        n_x = len(ss.inputs)
-        C = np.asarray(ss.C)
-        Cb = np.zeros((C.shape[0], 2 * n_b * n_p))
-        Cb[:, slot], Cb[:, n_b * n_p + slot] = C[:, :n_x], C[:, n_x:]
+        def per_block(a):
+            # Re(R a) summed over each block's states: (S + 1, n_out, n_b)
+            return jnp.asarray(blocks((Rc[None] * a[:, None, :]).real).sum(-1))
+
+        # stages after the step's start need a product with the states; one at the start does not
+        # where a stage at the end gives it (see the class docstring)
+        matvec = tuple(s for s, c in enumerate(offsets) if c != 0.0 or 1.0 not in offsets)
+        RE = Rc[None] * e[list(matvec)][:, None, :]       # (n_c, n_out, n_x)
+        CE = np.concatenate([blocks(RE.real), -blocks(RE.imag)], axis=-1)
+        CE = CE.reshape(len(matvec), C.shape[0], 2 * n_b * n_p)
         return cls(p=ss.p, C=ss.C, A_inf=ss.A_inf, inputs=ss.inputs, outputs=ss.outputs,
-                   options=ss.options, report=ss.report, E=split(e), G=split(h * phi1),
-                   H=split(h * phi2), C_blocks=jnp.asarray(Cb), dt=jnp.asarray(dt, jnp.float64),
-                   block_inputs=block_inputs, stage_offsets=tuple(float(c) for c in stage_offsets))
+                   options=ss.options, report=ss.report, E=split(e[-1]), G=split(h[-1] * phi1[-1]),
+                   H=split(h[-1] * phi2[-1]), CE=jnp.asarray(CE), CG=per_block(h * phi1),
+                   CH=per_block(h * phi2), dt=jnp.asarray(dt, jnp.float64),
+                   block_inputs=block_inputs, matvec_stages=matvec, stage_offsets=offsets)
 
 
 def _blocks(inputs):

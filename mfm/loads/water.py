@@ -151,7 +151,8 @@ class Water(Load):
         body = self.geometry.to_body_wrench(F, kin, model.n_bodies) + self._buoyancy_wrench(kin, model.n_bodies)
         # A∞ H on the moved dofs only: the rows of H the joints cannot move are zero
         mv = np.asarray(self.spec.moving) if self.spec is not None else slice(None)
-        mass = None if rhs else H[mv].T @ (self.A_inf[mv][:, mv] @ H[mv])
+        Hm = H[mv]
+        mass = None if rhs else (Hm.T @ self.A_inf[mv][:, mv]) @ Hm
         return LoadOutput(body=body, zd=zd, mass=mass)
 
     def reaction_loads(self, ctx, out):
