@@ -95,12 +95,14 @@ def evaluate(model: Model, q, qd, tau=None, body_loads=None, extra_mass=None,
     if tau is not None:
         Q = Q + tau
     MB = _apply_mass(model, B)                                    # M B, (n, 6, n_q)
-    Mstar = jnp.einsum("nai,naj->ij", B, MB)
+    # the products with B as multiply–reduces (se3.rotate says why)
+    Mstar = jnp.sum(B[:, :, :, None] * MB[:, :, None, :], axis=(0, 1))
     if extra_mass is not None:
         Mstar = Mstar + extra_mass
-    rhs = jnp.einsum("nai,na->i", B, F - _apply_mass(model, bias) - gyroscopic(model, X)) + Q
+    G = F - _apply_mass(model, bias) - gyroscopic(model, X)
+    rhs = jnp.sum(B * G[:, :, None], axis=(0, 1)) + Q
     qdd = spd_solve(Mstar, rhs)
-    Xdot = jnp.einsum("nai,i->na", B, qdd) + bias
+    Xdot = jnp.sum(B * qdd, axis=2) + bias
     return Evaluation(qdd=qdd, kin=kin, X=X, Xdot=Xdot, F=F, Q=Q)
 
 
@@ -113,19 +115,21 @@ def spd_solve(A, b):
     """x = A⁻¹ b for a symmetric positive-definite A (n, n), b (n,).
 
     For n ≤ 12 by Gauss–Jordan elimination without pivoting, unrolled: the k-th step takes row k
-    over its pivot and removes column k from the others, [A | b] ← [A | b] − a_k (r_k / a_kk) with
-    row k then replaced by r_k / a_kk. No pivoting is needed: every pivot of an SPD matrix is
-    positive (it is a ratio of leading principal minors) and the elimination is backward stable
-    for SPD matrices. Measured 0.7 µs against 1.8 µs for Cholesky at n = 7 (XLA CPU, one core).
-    Larger n: Cholesky. A matrix that is not positive definite gives non-finite values either way.
+    over its pivot and removes column k from the others, [A | b] ← [A | b] − (a_k − e_k) r_k / a_kk
+    (a_k the k-th column, r_k the k-th row, so that row k becomes r_k / a_kk). No pivoting is
+    needed: every pivot of an SPD matrix is positive (a ratio of leading principal minors) and the
+    elimination is backward stable for SPD matrices. Measured 0.7 µs against 1.8 µs for Cholesky
+    at n = 7 (XLA CPU, one core). Larger n: Cholesky. A singular matrix gives non-finite values
+    either way (a zero pivot); M* + HᵀA∞H is never indefinite.
     """
     n = A.shape[0]
     if n > _UNROLLED_SOLVE:
         return jax.scipy.linalg.cho_solve(jax.scipy.linalg.cho_factor(A), b)
     Ab = jnp.concatenate([A, b[:, None]], axis=1)
+    eye = jnp.eye(n)
     for k in range(n):
-        row = Ab[k] / Ab[k, k]
-        Ab = (Ab - Ab[:, k:k + 1] * row[None, :]).at[k].set(row)
+        # one fused update: [A | b] − (a_k − e_k) ⊗ r_k / a_kk (row k becomes r_k / a_kk)
+        Ab = Ab - (Ab[:, k:k + 1] - eye[:, k:k + 1]) * (Ab[k] / Ab[k, k])[None, :]
     return Ab[:, n]
 
 

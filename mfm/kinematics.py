@@ -44,10 +44,7 @@ class Kinematics(NamedTuple):
     bias: jnp.ndarray | None = None
 
 
-def _mv(R, v):
-    """R v for stacks of 3×3 R (..., 3, 3) and v (..., 3), as a fused multiply–reduce (tiny dots
-    are slow on XLA CPU)."""
-    return jnp.sum(R * v[..., None, :], axis=-1)
+_mv = se3.rotate
 
 
 def _mm(A, B):

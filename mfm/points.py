@@ -26,13 +26,13 @@ class BodyPoints(eqx.Module):
     def _frames(self, kin):
         idx = np.asarray(self.body_index)
         R = kin.E[idx, :3, :3]
-        rho = jnp.einsum("kab,kb->ka", R, self.d_ref)
+        rho = se3.rotate(R, self.d_ref)
         return idx, R, rho
 
     def h_matrix(self, kin):
         """H (6K, n_q): ξ̇ = H q̇; and the rotation matrices (K, 3, 3), lever arms ρ (K, 3)."""
         idx, R, rho = self._frames(kin)
-        w_cols = jnp.einsum("kab,kbq->kaq", R, kin.B[idx, 3:])     # inertial ω Jacobian
+        w_cols = jnp.sum(R[:, :, :, None] * kin.B[idx, 3:][:, None], axis=2)   # inertial ω Jacobian
         lin = kin.B[idx, :3] - jnp.cross(rho[:, :, None], w_cols, axis=1)   # v + ω × ρ
         H = jnp.concatenate([lin, w_cols], axis=1)
         return H.reshape(-1, H.shape[-1]), R, rho
@@ -46,8 +46,8 @@ class BodyPoints(eqx.Module):
     def velocity_and_bias(self, kin):
         """ξ̇ (6K,) and Ḣ q̇ (6K,) from the tree walk's velocities and velocity-product terms."""
         idx, R, rho = self._frames(kin)
-        w = jnp.einsum("kab,kb->ka", R, kin.X[idx, 3:])
-        beta = jnp.einsum("kab,kb->ka", R, kin.bias[idx, 3:])     # d/dt(R ω_b) = R ω̇_b
+        w = se3.rotate(R, kin.X[idx, 3:])
+        beta = se3.rotate(R, kin.bias[idx, 3:])     # d/dt(R ω_b) = R ω̇_b
         v = jnp.concatenate([kin.X[idx, :3] + jnp.cross(w, rho), w], axis=1)
         a = jnp.concatenate([kin.bias[idx, :3] + jnp.cross(beta, rho)
                              + jnp.cross(w, jnp.cross(w, rho)), beta], axis=1)
@@ -61,7 +61,7 @@ class BodyPoints(eqx.Module):
         rho = rho if point_offset is None else point_offset
         F = F.reshape(-1, 6)
         f, m = F[:, :3], F[:, 3:]
-        mb = jnp.einsum("kba,kb->ka", R, m + jnp.cross(rho, f))
+        mb = se3.rotate_t(R, m + jnp.cross(rho, f))
         return jnp.zeros((n_bodies, 6)).at[idx].add(jnp.concatenate([f, mb], axis=1))
 
     @classmethod

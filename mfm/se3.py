@@ -18,6 +18,21 @@ import jax.numpy as jnp
 _SMALL_ANGLE = 1e-4
 
 
+def rotate(R, v):
+    """R v for stacks of 3×3 R (..., 3, 3) and vectors v (..., 3), written as a multiply–reduce.
+
+    The small products of the time step (3×3 rotations, B-matrix rows of a few coordinates) are
+    written this way rather than as einsum/matmul: XLA on a CPU turns those into library dot calls
+    of about a microsecond each whatever their size, while a multiply–reduce fuses with its
+    neighbours (benchmarks/RESULTS.md, "Where the M4 134 step's time goes")."""
+    return jnp.sum(R * v[..., None, :], axis=-1)
+
+
+def rotate_t(R, v):
+    """Rᵀ v for stacks (..., 3, 3) and (..., 3), as :func:`rotate`."""
+    return jnp.sum(R * v[..., :, None], axis=-2)
+
+
 def hat(w):
     """Skew matrix ``ŵ`` of a 3-vector, so that ``ŵ u = w × u``. Shape (3,) → (3, 3)."""
     w = jnp.asarray(w)

@@ -40,6 +40,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .. import se3
 from ..points import BodyPoints
 from .base import FrequencyTerms, Load, LoadOutput
 from .radiation import NoRadiation, grid_subdivisions, strategy
@@ -128,7 +129,7 @@ class Water(Load):
     def _buoyancy(self, kin):
         """ρgV ẑ at each centre of buoyancy: as loads at r_k (6K,) and the CoB lever (K, 3)."""
         R = kin.E[np.asarray(self.geometry.body_index), :3, :3]
-        lever = jnp.einsum("kab,kb->ka", R, self.d_cob)
+        lever = se3.rotate(R, self.d_cob)
         f = jnp.zeros_like(lever).at[:, 2].set(self.buoyancy)
         return f, lever
 
