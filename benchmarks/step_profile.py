@@ -3,7 +3,7 @@ line that made them, beside the warm time per step (not a test).
 
     python benchmarks/step_profile.py [--config configs/m4_134.toml] [--integrator verlet]
                                       [--radiation state_space_exact] [--steps 20000] [--top 25]
-                                      [--mechanics-only] [--without-welded]
+                                      [--mechanics-only] [--without-welded] [--trace K]
 
 XLA on a CPU runs each compiled step as a sequence of kernels (fusions, dots, solver calls,
 copies), each with a fixed cost of a fraction of a microsecond besides its flops. For a model of
@@ -13,7 +13,9 @@ from. It compiles the rollout of ``mfm.rollout`` (the M4 134 sea state of benchm
 default), takes the body of its time loop from the optimised HLO, and attributes each kernel to
 the innermost ``mfm`` source line in its metadata (jax records the Python stack of every
 operation). Then it times warm rollouts: the median of ``--repeats`` calls after the compiling
-one.
+one. ``--trace K`` ranks the kernels by time as well as by count: a short rollout runs under
+jax's profiler, and the K kernels that take the most beyond the median kernel are listed (this is
+how the library dots of a microsecond each were found among kernels of a fraction of that).
 
 ``--without-welded`` (with ``--mechanics-only``) is a cost probe, not the same physics: it profiles
 the config's tree with every body on a fixed joint left out (their children hung from the
@@ -93,19 +95,46 @@ def step_kernels(hlo_text, n_steps):
                 body = re.search(r"body=%([^,\s]+)", line).group(1)
     if body is None:
         raise RuntimeError(f"no while loop of {n_steps} trips in the compiled rollout")
-    where, kinds = collections.Counter(), collections.Counter()
+    where, kinds, named = collections.Counter(), collections.Counter(), {}
     for line in comps[body]:
-        op = re.search(r"= \S+ ([a-z][\w-]*)\(", line)
-        if not op or op.group(1) in FREE:
+        op = re.search(r"%(\S+) = (\S+) ([a-z][\w-]*)\(", line)
+        if not op or op.group(3) in FREE:
             continue
-        kinds[op.group(1)] += 1
+        kinds[op.group(3)] += 1
         sf = re.search(r"stack_frame_id=(\d+)", line)
         ours = [f for f in (chain(int(sf.group(1))) if sf else [])
                 if "/mfm/" in f[0] or "/hydro/" in f[0]]
         key = (f"{Path(ours[0][0]).parent.name}/{Path(ours[0][0]).name}:{ours[0][1]}:{ours[0][2]}"
-               if ours else f"(no mfm frame) {op.group(1)}")
+               if ours else f"(no mfm frame) {op.group(3)}")
         where[key] += 1
-    return where, kinds
+        named[op.group(1)] = (op.group(3), op.group(2).split("{")[0], key)
+    return where, kinds, named
+
+
+def traced_kernels(run, n_steps):
+    """Each kernel's traced time per step, from one ``run()`` under ``jax.profiler.trace``: a dict
+    kernel name -> µs per step. The trace adds a fixed overhead to every kernel, so these rank
+    the kernels (and show which cost more than their share); their sum is not the step's time.
+    Kernels running concurrently on XLA's two threads are each counted whole."""
+    import glob
+    import tempfile
+
+    import jax
+    from jax.profiler import ProfileData
+
+    with tempfile.TemporaryDirectory() as d:
+        with jax.profiler.trace(d):
+            run()
+        pd = ProfileData.from_file(glob.glob(d + "/**/*.xplane.pb", recursive=True)[0])
+        total = collections.Counter()
+        for plane in pd.planes:
+            for line in plane.lines:
+                if "XLAEigen" not in line.name:      # the threads that run the kernels
+                    continue
+                for ev in line.events:
+                    if not ev.name.startswith("ThunkExecutor"):
+                        total[ev.name] += ev.duration_ns
+    return {k: v / 1e3 / n_steps for k, v in total.items()}
 
 
 def _without_welded(config):
@@ -158,6 +187,9 @@ def main():
     ap.add_argument("--top", type=int, default=25)
     ap.add_argument("--mechanics-only", action="store_true",
                     help="the tree alone: no water, no other loads of the config")
+    ap.add_argument("--trace", type=int, default=0, metavar="K",
+                    help="also trace a rollout of 1,000 steps with jax's profiler and list the K "
+                         "kernels that take the most time beyond the median kernel's")
     ap.add_argument("--without-welded", action="store_true",
                     help="with --mechanics-only: the tree without its fixed-joint bodies (a cost "
                          "probe of lumping them, not the same physics)")
@@ -186,7 +218,7 @@ def main():
                                   n_steps=a.steps, integrator=integrators.get(a.integrator),
                                   save_every=a.steps, record=False).compile()
     t_compile = time.perf_counter() - t0
-    where, kinds = step_kernels(compiled.as_text(), a.steps)
+    where, kinds, _ = step_kernels(compiled.as_text(), a.steps)
 
     def run():
         return mfm.rollout(m, q0, q0, dt=dt, n_steps=a.steps, integrator=a.integrator, loads=loads,
@@ -206,6 +238,25 @@ def main():
     print("\n| kernels | source line (innermost mfm frame) |\n|---|---|")
     for k, v in where.most_common(a.top):
         print(f"| {v} | {k} |")
+    if a.trace:
+        n_tr = 1000
+        text = _rollout_jit.lower(m, loads, q0, q0, z0, jnp.asarray(0.0), jnp.asarray(dt),
+                                  n_steps=n_tr, integrator=integrators.get(a.integrator),
+                                  save_every=n_tr, record=False).compile().as_text()
+        _, _, named = step_kernels(text, n_tr)
+
+        def run_short():
+            return mfm.rollout(m, q0, q0, dt=dt, n_steps=n_tr, integrator=a.integrator,
+                               loads=loads, save_every=n_tr)[1].block_until_ready()
+        run_short()
+        per = {k: v for k, v in traced_kernels(run_short, n_tr).items() if k in named}
+        base = sorted(per.values())[len(per) // 2]
+        print(f"\ntraced ({n_tr} steps; every kernel carries the trace's overhead, the median "
+              f"kernel {base:.2f} µs/step): the kernels that take the most beyond the median\n"
+              "| µs/step beyond the median | kernel | kind, shape | source line |\n|---|---|---|---|")
+        for k in sorted(per, key=per.get, reverse=True)[:a.trace]:
+            kind, shape, key = named[k]
+            print(f"| {per[k] - base:.2f} | {k} | {kind} {shape} | {key} |")
 
 
 if __name__ == "__main__":
