@@ -332,8 +332,8 @@ class ExactStateSpace(StateSpace):
         # where a stage at the end gives it (see the class docstring)
         matvec = tuple(s for s, c in enumerate(offsets) if c != 0.0 or 1.0 not in offsets)
         RE = Rc[None] * e[list(matvec)][:, None, :]       # (n_c, n_out, n_x)
-        CE = np.concatenate([blocks(RE.real), -blocks(RE.imag)], axis=-1)
-        CE = CE.reshape(len(matvec), C.shape[0], 2 * n_b * n_p)
+        flat = (len(matvec), C.shape[0], n_b * n_p)          # columns in the order of [Re z; Im z]
+        CE = np.concatenate([blocks(RE.real).reshape(flat), -blocks(RE.imag).reshape(flat)], axis=-1)
         return cls(p=ss.p, C=ss.C, A_inf=ss.A_inf, inputs=ss.inputs, outputs=ss.outputs,
                    options=ss.options, report=ss.report, E=split(e[-1]), G=split(h[-1] * phi1[-1]),
                    H=split(h[-1] * phi2[-1]), CE=jnp.asarray(CE), CG=per_block(h * phi1),
