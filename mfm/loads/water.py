@@ -153,7 +153,9 @@ class Water(Load):
         # A∞ H on the moved dofs only: the rows of H the joints cannot move are zero
         mv = np.asarray(self.spec.moving) if self.spec is not None else slice(None)
         Hm = H[mv]
-        mass = None if rhs else (Hm.T @ self.A_inf[mv][:, mv]) @ Hm
+        # HᵀA∞H as multiply–reduces (se3.rotate says why)
+        AH = jnp.sum(self.A_inf[mv][:, mv][:, :, None] * Hm[None, :, :], axis=1)
+        mass = None if rhs else jnp.sum(Hm[:, :, None] * AH[:, None, :], axis=0)
         return LoadOutput(body=body, zd=zd, mass=mass)
 
     def reaction_loads(self, ctx, out):
