@@ -95,13 +95,9 @@ def evaluate(model: Model, q, qd, tau=None, body_loads=None, extra_mass=None,
     if tau is not None:
         Q = Q + tau
     MB = _apply_mass(model, B)                                    # M B, (n, 6, n_q)
-    # the products with B as multiply–reduces (se3.rotate says why), but for M* only while its
-    # (n, 6, n_q, n_q) product is small: wider, XLA makes it one slow library fusion (Wu & Yuan's
-    # 16 bodies, 18 coordinates: 55 µs/step traced, against a dot's few)
-    if B.size * B.shape[-1] <= _REDUCE_MASS_MATRIX:
-        Mstar = jnp.sum(B[:, :, :, None] * MB[:, :, None, :], axis=(0, 1))
-    else:
-        Mstar = jnp.einsum("nai,naj->ij", B, MB)
+    # the products with B as multiply–reduces (se3.rotate says why); M* only while small
+    n_q = B.shape[-1]
+    Mstar = se3.matmul_small(B.reshape(-1, n_q).T, MB.reshape(-1, n_q))
     if extra_mass is not None:
         Mstar = Mstar + extra_mass
     G = F - _apply_mass(model, bias) - gyroscopic(model, X)
@@ -110,9 +106,6 @@ def evaluate(model: Model, q, qd, tau=None, body_loads=None, extra_mass=None,
     Xdot = jnp.sum(B * qdd, axis=2) + bias
     return Evaluation(qdd=qdd, kin=kin, X=X, Xdot=Xdot, F=F, Q=Q)
 
-
-# M* by a multiply–reduce up to this many products (M4 134: 8 · 6 · 7² = 2,352), by a dot above
-_REDUCE_MASS_MATRIX = 8192
 
 # up to this size the solve is unrolled elimination (n fused kernels); above it, a Cholesky
 # factorisation and two triangular solves (three library calls of ~1 µs each on XLA CPU whatever n)

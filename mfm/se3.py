@@ -33,6 +33,20 @@ def rotate_t(R, v):
     return jnp.sum(R * v[..., :, None], axis=-2)
 
 
+# products X Y (m, k) × (k, p) up to this many multiplications are written as a multiply–reduce,
+# wider ones as a dot: XLA makes a wide multiply–reduce one slow library fusion (Wu & Yuan's BᵀMB,
+# 96 × 18 × 18: 55 µs/step traced, against a dot's few)
+_REDUCE_LIMIT = 8192
+
+
+def matmul_small(X, Y):
+    """X Y for 2-D X (m, k), Y (k, p): a multiply–reduce while m k p ≤ 8,192 (see :func:`rotate`
+    for why), a dot above."""
+    if X.shape[0] * X.shape[1] * Y.shape[1] <= _REDUCE_LIMIT:
+        return jnp.sum(X[:, :, None] * Y[None, :, :], axis=1)
+    return X @ Y
+
+
 def hat(w):
     """Skew matrix ``ŵ`` of a 3-vector, so that ``ŵ u = w × u``. Shape (3,) → (3, 3)."""
     w = jnp.asarray(w)

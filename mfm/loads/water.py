@@ -152,16 +152,8 @@ class Water(Load):
         body = self.geometry.to_body_wrench(F, kin, model.n_bodies) + self._buoyancy_wrench(kin, model.n_bodies)
         # A∞ H on the moved dofs only: the rows of H the joints cannot move are zero
         mv = np.asarray(self.spec.moving) if self.spec is not None else slice(None)
-        Hm, Am = H[mv], self.A_inf[mv][:, mv]
-        if rhs:
-            mass = None
-        elif Am.size * Hm.shape[1] <= 8192:
-            # HᵀA∞H as multiply–reduces while small (se3.rotate says why; M4 134: 24² · 7); wider
-            # ones become slow library fusions (as M* does, mfm.dynamics), so dots there
-            AH = jnp.sum(Am[:, :, None] * Hm[None, :, :], axis=1)
-            mass = jnp.sum(Hm[:, :, None] * AH[:, None, :], axis=0)
-        else:
-            mass = (Hm.T @ Am) @ Hm
+        Hm = H[mv]
+        mass = None if rhs else se3.matmul_small(Hm.T, se3.matmul_small(self.A_inf[mv][:, mv], Hm))
         return LoadOutput(body=body, zd=zd, mass=mass)
 
     def reaction_loads(self, ctx, out):
