@@ -96,8 +96,7 @@ def evaluate(model: Model, q, qd, tau=None, body_loads=None, extra_mass=None,
         Q = Q + tau
     MB = _apply_mass(model, B)                                    # M B, (n, 6, n_q)
     # the products with B as multiply–reduces (se3.rotate says why); M* only while small
-    n_q = B.shape[-1]
-    Mstar = se3.matmul_small(B.reshape(-1, n_q).T, MB.reshape(-1, n_q))
+    Mstar = se3.matmul_small(B, MB, transpose_x=True)
     if extra_mass is not None:
         Mstar = Mstar + extra_mass
     G = F - _apply_mass(model, bias) - gyroscopic(model, X)

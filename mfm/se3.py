@@ -39,11 +39,21 @@ def rotate_t(R, v):
 _REDUCE_LIMIT = 8192
 
 
-def matmul_small(X, Y):
-    """X Y for 2-D X (m, k), Y (k, p): a multiply–reduce while m k p ≤ 8,192 (see :func:`rotate`
-    for why), a dot above."""
-    if X.shape[0] * X.shape[1] * Y.shape[1] <= _REDUCE_LIMIT:
+def matmul_small(X, Y, *, transpose_x=False):
+    """X Y for 2-D X (m, k), Y (k, p); with ``transpose_x``, Xᵀ Y for X (..., m), Y (..., p),
+    summed over all leading axes. A multiply–reduce while m k p ≤ 8,192 (see :func:`rotate` for
+    why), a dot above. Xᵀ Y is reduced over X's leading axes directly: a transposed or reshaped
+    operand costs XLA extra copy kernels."""
+    if transpose_x:
+        m, k = X.shape[-1], X.size // X.shape[-1]
+    else:
+        m, k = X.shape
+    if m * k * Y.shape[-1] <= _REDUCE_LIMIT:
+        if transpose_x:
+            return jnp.sum(X[..., :, None] * Y[..., None, :], axis=tuple(range(X.ndim - 1)))
         return jnp.sum(X[:, :, None] * Y[None, :, :], axis=1)
+    if transpose_x:
+        return X.reshape(k, m).T @ Y.reshape(k, -1)
     return X @ Y
 
 

@@ -153,7 +153,7 @@ class Water(Load):
         # A∞ H on the moved dofs only: the rows of H the joints cannot move are zero
         mv = np.asarray(self.spec.moving) if self.spec is not None else slice(None)
         Hm = H[mv]
-        mass = None if rhs else se3.matmul_small(Hm.T, se3.matmul_small(self.A_inf[mv][:, mv], Hm))
+        mass = None if rhs else se3.matmul_small(Hm, se3.matmul_small(self.A_inf[mv][:, mv], Hm), transpose_x=True)
         return LoadOutput(body=body, zd=zd, mass=mass)
 
     def reaction_loads(self, ctx, out):
