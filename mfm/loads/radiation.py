@@ -44,7 +44,16 @@ class NoRadiation(eqx.Module):
         return memory
 
     def force(self, t, v, z, memory):
-        return jnp.zeros_like(v), None
+        """The force on every hydro dof (6K,) and the derivative of the strategy's states."""
+        rows, F, zd = self.force_rows(t, v, z, memory)
+        return (jnp.zeros_like(v) if rows is None
+                else jnp.zeros_like(v).at[np.asarray(rows)].set(F)), zd
+
+    def force_rows(self, t, v, z, memory):
+        """(rows, F, ż): the force F on the hydro dofs ``rows`` (static) the strategy acts on; it
+        is zero on the others (rows None: no force). The water's time step takes this form, so
+        that it works on the moved dofs only."""
+        return None, None, None
 
     def added_mass_inf(self, spec):
         return spec.added_mass_inf()
@@ -61,7 +70,7 @@ class DatabaseRadiation(NoRadiation):
     """The database's A(ω), B(ω) (frequency domain only)."""
     name: ClassVar[str] = "database"
 
-    def force(self, t, v, z, memory):  # pragma: no cover - refused when the water is built
+    def force_rows(self, t, v, z, memory):  # pragma: no cover - refused when the water is built
         raise ValueError("radiation='database' exists in the frequency domain only")
 
     def coefficients(self, spec, omega):
@@ -91,14 +100,13 @@ class Convolution(NoRadiation):
     def update_memory(self, v, t, memory):
         return (t, jnp.concatenate([v[np.asarray(self.dofs)][None], memory[1][:-1]], axis=0))
 
-    def force(self, t, v, z, memory):
+    def force_rows(self, t, v, z, memory):
         t_n, hist = memory
         # the stage of the step: the nearest of the offsets the integrator declared
         offs = jnp.asarray(self.stage_offsets)
         r = jnp.argmin(jnp.abs((t - t_n) / self.dt - offs))
-        idx = np.asarray(self.dofs)
-        F = self.W_current[r] @ v[idx] + jnp.einsum("jab,jb->a", self.W_lag[r], hist)
-        return -jnp.zeros_like(v).at[idx].set(F), None
+        F = self.W_current[r] @ v[np.asarray(self.dofs)] + jnp.einsum("jab,jb->a", self.W_lag[r], hist)
+        return self.dofs, -F, None
 
     def coefficients(self, spec, omega):
         from hydro.radiation import added_mass_from_irf, damping_from_irf
@@ -147,13 +155,13 @@ class StateSpace(NoRadiation):
     def n_states(self):
         return 2 * len(self.inputs)
 
-    def force(self, t, v, z, memory):
+    def force_rows(self, t, v, z, memory):
         n = len(self.inputs)
         zr, zi = z[:n], z[n:]
         pr, pi = self.p[:, 0], self.p[:, 1]
         u = v[np.asarray(self.inputs)]
         zd = jnp.concatenate([pr * zr - pi * zi + u, pr * zi + pi * zr])
-        return -jnp.zeros_like(v).at[np.asarray(self.outputs)].set(self.C @ z), zd
+        return self.outputs, -(self.C @ z), zd
 
     def added_mass_inf(self, spec):
         return np.asarray(self.A_inf)
@@ -286,14 +294,14 @@ class ExactStateSpace(StateSpace):
     def _end(self):
         return self.stage_offsets.index(1.0)
 
-    def force(self, t, v, z, memory):
+    def force_rows(self, t, v, z, memory):
         t_n, _, _, u_n, Y = memory
         offs = jnp.asarray(self.stage_offsets)
         r = jnp.argmin(jnp.abs((t - t_n) / self.dt - offs))
         u = v[np.asarray(self.block_inputs)]
         # (n_out × n_in) products as one fused multiply–reduce: tiny dots are slow on XLA CPU
         F = Y[r] + jnp.sum(self.CG[r] * u_n + self.CH[r] * (u - u_n), axis=1)
-        return -jnp.zeros_like(v).at[np.asarray(self.outputs)].set(F), None
+        return self.outputs, -F, None
 
     def provenance(self):
         return {**super().provenance(), "radiation": self.name,

@@ -138,32 +138,69 @@ class Water(Load):
         F = jnp.concatenate([f, jnp.zeros_like(f)], axis=1).reshape(-1)
         return self.geometry.to_body_wrench(F, kin, n_bodies, point_offset=lever)
 
-    def evaluate(self, ctx):
-        model, kin = ctx.model, ctx.kin
-        comps, zd, _, _ = self._forces(ctx.t, kin, ctx.z, ctx.memory)
-        F = sum(comps.values())
-        H, _, _ = self.geometry.h_matrix(kin)
-        rhs = self.added_mass == "rhs" and ctx.qdd_guess is not None
-        if rhs:
+    @property
+    def _moved(self) -> np.ndarray:
+        """Indices of the moved hydro dofs (static): the rows of H that are not structurally 0."""
+        if self.spec is None:
+            return np.arange(self.A_inf.shape[0])
+        return np.asarray(self.spec.moving)
+
+    def _moved_load(self, ctx, H):
+        """The hydro load on the moved dofs, F[m] (n_m,), with ``H`` = H[m] (n_m, n_q) (the
+        Cummins terms of the module docstring; buoyancy as a load at r_k, moment (CoB − r_k) × f;
+        with ``added_mass="rhs"`` −A∞ H q̈ of the iterate) and the radiation's ż. Its virtual
+        power is the whole load's: the rows of H outside m are 0 at every q (:func:`moving_dofs`),
+        so Hᵀ F = H[m]ᵀ F[m], and ξ̇, Ḣq̇ are 0 there too."""
+        g, kin, mv = self.geometry, ctx.kin, self._moved
+        xi = g.xi(kin)
+        v, hbias = g.velocity_and_bias(kin)
+        rows, Fr, zd = self.rad.force_rows(ctx.t, v, ctx.z, ctx.memory)
+        Am = self.A_inf[mv][:, mv]
+        F = (self._series(self.exc_values, ctx.t)[mv] - self.C_wp[mv] @ xi
+             - Am @ hbias[mv])
+        if rows is not None:
+            if tuple(rows) == tuple(mv):
+                F = F + Fr
+            else:   # a strategy on other dofs: only its moved rows do work
+                F = F + jnp.zeros_like(v).at[np.asarray(rows)].set(Fr)[mv]
+        # quadratic drag on the translational dofs (k = body, a = axis)
+        k, a = mv // 6, mv % 6
+        tr = np.flatnonzero(a < 3)
+        if tr.size:
+            vt = v[mv[tr]]
+            F = F.at[tr].add(-self.drag[k[tr], a[tr]] * jnp.abs(vt) * vt)
+        f, lever = self._buoyancy(kin)
+        rho = g._frames(kin)[2]
+        buoy = jnp.concatenate([f, jnp.cross(lever - rho, f)], axis=1).reshape(-1)
+        F = F + buoy[mv]
+        if self.added_mass == "rhs" and ctx.qdd_guess is not None:
             # seed 001 §5: −A∞ ξ̈ on the right-hand side with the corrector's acceleration iterate.
             # Without an iterate (start of a run, linearisation) the iteration's converged value
             # is used instead: A∞ on the left.
-            F = F - self.A_inf @ (H @ ctx.qdd_guess)
-        body = self.geometry.to_body_wrench(F, kin, model.n_bodies) + self._buoyancy_wrench(kin, model.n_bodies)
-        # A∞ H on the moved dofs only: the rows of H the joints cannot move are zero
-        mv = np.asarray(self.spec.moving) if self.spec is not None else slice(None)
-        Hm = H[mv]
-        mass = None if rhs else se3.matmul_small(Hm, se3.matmul_small(self.A_inf[mv][:, mv], Hm), transpose_x=True)
-        return LoadOutput(body=body, zd=zd, mass=mass)
+            F = F - Am @ (H @ ctx.qdd_guess)
+        return F, zd
+
+    def evaluate(self, ctx):
+        # generalised loads Hᵀ F on the moved dofs directly: no body wrenches in the time step
+        # (they are made for the joint reactions only, :meth:`reaction_loads`)
+        mv = self._moved
+        H = self.geometry.h_matrix(ctx.kin)[0][mv]
+        F, zd = self._moved_load(ctx, H)
+        tau = jnp.sum(H * F[:, None], axis=0)
+        rhs = self.added_mass == "rhs" and ctx.qdd_guess is not None
+        mass = None if rhs else se3.matmul_small(H, se3.matmul_small(self.A_inf[mv][:, mv], H),
+                                                 transpose_x=True)
+        return LoadOutput(tau=tau, zd=zd, mass=mass)
 
     def reaction_loads(self, ctx, out):
-        # out.body holds −A∞ Ḣq̇; add −A∞ H q̈ so that the bodies feel the whole −A∞ ξ̈ (with
-        # added_mass="rhs" out.body already holds −A∞ H q̈ of the recorded iterate)
-        if self.added_mass == "rhs" and out.mass is None:
-            return out.body
-        H, _, _ = self.geometry.h_matrix(ctx.kin)
-        return out.body + self.geometry.to_body_wrench(-(self.A_inf @ (H @ ctx.qdd)), ctx.kin,
-                                                       ctx.model.n_bodies)
+        # the whole −A∞ ξ̈ on the bodies: −A∞ Ḣq̇ and −A∞ H q̈ (with added_mass="rhs" the load
+        # already holds −A∞ H q̈ of the recorded iterate)
+        kin, n = ctx.kin, ctx.model.n_bodies
+        comps, _, _, _ = self._forces(ctx.t, kin, ctx.z, ctx.memory)
+        H, _, _ = self.geometry.h_matrix(kin)
+        qdd = ctx.qdd_guess if out.mass is None else ctx.qdd
+        F = sum(comps.values()) - self.A_inf @ (H @ qdd)
+        return self.geometry.to_body_wrench(F, kin, n) + self._buoyancy_wrench(kin, n)
 
     def diagnostics(self, ctx, out):
         kin = ctx.kin
