@@ -5,7 +5,9 @@ Importing mfm switches jax to float64: every physical quantity here is float64.
 Data flows one way: config (TOML) → float tree → :class:`Model` → :func:`simulate` →
 :class:`xarray.Dataset` → plots.
 """
-import jax
+from . import _xla  # noqa: I001  (first: XLA options must be set before jax starts its backend)
+from ._xla import PerformanceWarning  # noqa: E402
+import jax  # noqa: E402
 
 jax.config.update("jax_enable_x64", True)
 
@@ -27,7 +29,7 @@ from .fidelity import reduce  # noqa: E402
 from .tree import ConfigError  # noqa: E402
 from .sweep import SweepError, sweep  # noqa: E402
 
-__all__ = ["AccuracyWarning", "amplification_matrix", "fidelity", "floquet", "largest_stable_dt",
+__all__ = ["AccuracyWarning", "PerformanceWarning", "amplification_matrix", "fidelity", "floquet", "largest_stable_dt",
            "reduce", "spectral_response", "linear", "linear_response", "stability", "ConfigError", "Model", "SimulationError", "b_matrix", "b_matrix_dot", "body_poses",
            "compile_tree", "config", "coriolis_matrix", "energies", "equilibrium", "evaluate",
            "forward_dynamics", "frequency_response", "natural_frequencies", "water",

@@ -60,6 +60,8 @@ def provenance(model, loads=(), **settings) -> dict:
     settings (database, sea state, ramp, radiation, fit report), the run's settings, versions."""
     import jax
 
+    from . import _xla
+
     out = {"model": model.name, "config": getattr(model, "source", "") or "none",
            "config_sha256": getattr(model, "source_sha256", "") or "none"}
     if model.hydro is not None:
@@ -69,6 +71,9 @@ def provenance(model, loads=(), **settings) -> dict:
     out.update(settings)
     out.update({"mfm_version": version(), "git_commit": git_commit() or "none",
                 "jax_version": jax.__version__, "numpy_version": np.__version__,
+                # whether XLA compiled the time loop as one function (mfm._xla: speed only)
+                "xla_time_loop": (f"whole (loops reading up to {_xla.LOOP_THRESHOLD} bytes)"
+                                  if _xla.LOOPS_COMPILED_WHOLE else "kernel by kernel"),
                 "xarray_version": xr.__version__,
                 "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
                 "conventions": CONVENTIONS})

@@ -163,12 +163,12 @@ class Water(Load):
                 F = F + Fr
             else:   # a strategy on other dofs: only its moved rows do work
                 F = F + jnp.zeros_like(v).at[np.asarray(rows)].set(Fr)[mv]
-        # quadratic drag on the translational dofs (k = body, a = axis)
+        # quadratic drag on the translational dofs (k = body, a = axis); dense, as a scatter
+        # would keep XLA from compiling the time loop as one function (mfm.simulate)
         k, a = mv // 6, mv % 6
-        tr = np.flatnonzero(a < 3)
-        if tr.size:
-            vt = v[mv[tr]]
-            F = F.at[tr].add(-self.drag[k[tr], a[tr]] * jnp.abs(vt) * vt)
+        c = self.drag[k, np.minimum(a, 2)] * (a < 3)
+        vm = v[mv]
+        F = F - c * jnp.abs(vm) * vm
         f, lever = self._buoyancy(kin)
         rho = g._frames(kin)[2]
         buoy = jnp.concatenate([f, jnp.cross(lever - rho, f)], axis=1).reshape(-1)

@@ -1,0 +1,77 @@
+"""XLA settings mfm needs before jax starts its CPU backend (imported first by ``mfm/__init__``).
+
+**Time loops compiled as one function.** XLA on a CPU runs a compiled program as a sequence of
+kernels, and pays about a quarter of a microsecond to dispatch each (benchmarks/RESULTS.md, "Where
+the M4 134 step's time goes"). A time step of M4 134 is ~140 such kernels of a few hundred flops
+each, so dispatch, not arithmetic, set its cost. XLA can instead compile a while loop whose
+iteration touches few bytes as one native function (its ``small_while_loop_hoisting`` pass, keyed
+by the backend option ``xla_cpu_small_while_loop_byte_threshold``, default 1 kB). mfm raises that
+threshold to :data:`LOOP_BYTES` so that the time loops of its rollouts qualify (M4 134 with exact
+radiation reads ~0.5 MB per step): M4 134's step 33 → 17 µs, its mechanics alone 16.5 → 4.3 µs
+(``python benchmarks/step_profile.py``). The numbers are the same to round-off (the same HLO, one
+emitter instead of another). Loops that read more than that per iteration (a convolution's
+history, big batches) keep the kernel-by-kernel runtime, whose library matrix products are faster
+for large operands.
+
+XLA reads ``XLA_FLAGS`` once, when jax starts its backend: mfm adds the option there at import,
+unless ``XLA_FLAGS`` already names it (yours wins; ``=1024`` restores XLA's default). If jax's
+backend is already running when mfm is imported (jax used before ``import mfm``), the option cannot
+take effect any more: :data:`LOOPS_COMPILED_WHOLE` is then False, a :class:`PerformanceWarning`
+says so, and results record it (``xla_time_loop`` in their provenance).
+"""
+from __future__ import annotations
+
+import os
+import re
+import warnings
+
+OPTION = "xla_cpu_small_while_loop_byte_threshold"
+# bytes one loop iteration may read and still be compiled whole: above M4 134's ~0.5 MB with room
+# for larger trees, below the tens of MB where library matrix products pay (convolution histories,
+# batches of many cases)
+LOOP_BYTES = 16 * 2**20
+
+
+class PerformanceWarning(UserWarning):
+    """A setting that makes mfm slower than it could be, without changing its results."""
+
+
+def _backend_running() -> bool:
+    try:
+        from jax._src import xla_bridge
+        return bool(xla_bridge.backends_are_initialized())
+    except Exception:   # a jax without this private helper: assume not started
+        return False
+
+
+def with_loop_option(flags: str, threshold: int = LOOP_BYTES) -> str:
+    """XLA_FLAGS ``flags`` with the option added (into an existing ``--xla_backend_extra_options``,
+    which holds all extra options comma-separated); unchanged if it already names the option."""
+    if OPTION in flags:
+        return flags
+    m = re.search(r"--xla_backend_extra_options=(\S*)", flags)
+    if m:
+        value = f"{m.group(1)},{OPTION}={threshold}" if m.group(1) else f"{OPTION}={threshold}"
+        return flags[:m.start()] + f"--xla_backend_extra_options={value}" + flags[m.end():]
+    return f"{flags} --xla_backend_extra_options={OPTION}={threshold}".strip()
+
+
+def _set_flags() -> tuple[bool, str]:
+    """Add the option to XLA_FLAGS if absent; (whether it is in effect, the threshold in bytes)."""
+    flags = os.environ.get("XLA_FLAGS", "")
+    given = re.search(OPTION + r"=(\d+)", flags)
+    if given:
+        return int(given.group(1)) > 1024, given.group(1)
+    if _backend_running():
+        warnings.warn(
+            "mfm was imported after jax started its backend, so XLA cannot compile mfm's time loops "
+            f"as one function any more ({OPTION}; see mfm._xla): rollouts of small models run up "
+            "to ~2x slower, with the same results. Import mfm before using jax, or set XLA_FLAGS="
+            f"'--xla_backend_extra_options={OPTION}={LOOP_BYTES}' before starting Python.",
+            PerformanceWarning, stacklevel=3)
+        return False, "1024"
+    os.environ["XLA_FLAGS"] = with_loop_option(flags)
+    return True, str(LOOP_BYTES)
+
+
+LOOPS_COMPILED_WHOLE, LOOP_THRESHOLD = _set_flags()
