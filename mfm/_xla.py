@@ -26,6 +26,7 @@ import re
 import warnings
 
 OPTION = "xla_cpu_small_while_loop_byte_threshold"
+YNN_OPTION = "xla_cpu_experimental_ynn_fusion_type"
 # bytes one loop iteration may read and still be compiled whole: above M4 134's ~0.5 MB with room
 # for larger trees, below the tens of MB where library matrix products pay (convolution histories,
 # batches of many cases)
@@ -56,6 +57,16 @@ def with_loop_option(flags: str, threshold: int = LOOP_BYTES) -> str:
     return f"{flags} --xla_backend_extra_options={OPTION}={threshold}".strip()
 
 
+def without_library_fusions(flags: str) -> str:
+    """XLA_FLAGS ``flags`` with XLA's experimental YNNPACK fusions off (unless they name the
+    option): XLA may rewrite a small multiply–reduce of a time step into one (Stansby & Li's HᵀA∞H,
+    Wu & Yuan's radiation output), and the whole-loop compilation refuses library fusions, so one
+    such product would send the whole loop back to kernel-by-kernel dispatch."""
+    if YNN_OPTION in flags:
+        return flags
+    return f"{flags} --{YNN_OPTION}=".strip()
+
+
 def _set_flags() -> tuple[bool, str]:
     """Add the option to XLA_FLAGS if absent; (whether it is in effect, the threshold in bytes)."""
     flags = os.environ.get("XLA_FLAGS", "")
@@ -70,7 +81,7 @@ def _set_flags() -> tuple[bool, str]:
             f"'--xla_backend_extra_options={OPTION}={LOOP_BYTES}' before starting Python.",
             PerformanceWarning, stacklevel=3)
         return False, "1024"
-    os.environ["XLA_FLAGS"] = with_loop_option(flags)
+    os.environ["XLA_FLAGS"] = without_library_fusions(with_loop_option(flags))
     return True, str(LOOP_BYTES)
 
 

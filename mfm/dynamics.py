@@ -15,7 +15,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from . import se3
+from . import _xla, se3
 from .kinematics import Kinematics, kinematics
 from .model import Model
 
@@ -107,19 +107,21 @@ def evaluate(model: Model, q, qd, tau=None, body_loads=None, extra_mass=None,
 
 
 # up to this size the solve is unrolled elimination (n fused kernels); above it, a Cholesky
-# factorisation and two triangular solves (three library calls of ~1 µs each on XLA CPU whatever n)
-_UNROLLED_SOLVE = 12
+# factorisation and two triangular solves (three library calls of ~1 µs each on XLA CPU whatever
+# n). With the time loop compiled whole (mfm._xla) library calls are not allowed in it at all (they
+# would send it back to kernel-by-kernel dispatch), so elimination goes further there.
+_UNROLLED_SOLVE = 64 if _xla.LOOPS_COMPILED_WHOLE else 12
 
 
 def spd_solve(A, b):
     """x = A⁻¹ b for a symmetric positive-definite A (n, n), b (n,).
 
-    For n ≤ 12 by Gauss–Jordan elimination without pivoting, unrolled: the k-th step takes row k
+    For n ≤ 12 (n ≤ 64 with the time loop compiled whole, :mod:`mfm._xla`) by Gauss–Jordan elimination without pivoting, unrolled: the k-th step takes row k
     over its pivot and removes column k from the others, [A | b] ← [A | b] − (a_k − e_k) r_k / a_kk
     (a_k the k-th column, r_k the k-th row, so that row k becomes r_k / a_kk). No pivoting is
     needed: every pivot of an SPD matrix is positive (a ratio of leading principal minors) and the
     elimination is backward stable for SPD matrices. Measured 0.7 µs against 1.8 µs for Cholesky
-    at n = 7 (XLA CPU, one core). Larger n: Cholesky. A singular matrix gives non-finite values
+    at n = 7 (XLA CPU, one core). Larger n: Cholesky (LAPACK). A singular matrix gives non-finite values
     either way (a zero pivot); M* + HᵀA∞H is never indefinite.
     """
     n = A.shape[0]

@@ -62,7 +62,11 @@ class BodyPoints(eqx.Module):
         F = F.reshape(-1, 6)
         f, m = F[:, :3], F[:, 3:]
         mb = se3.rotate_t(R, m + jnp.cross(rho, f))
-        return jnp.zeros((n_bodies, 6)).at[idx].add(jnp.concatenate([f, mb], axis=1))
+        # summed onto the bodies by a static 0/1 matrix rather than a scatter-add: a scatter keeps
+        # XLA from compiling the time loop as one function (mfm._xla)
+        S = np.zeros((n_bodies, len(idx)))
+        S[idx, np.arange(len(idx))] = 1.0
+        return jnp.sum(S[:, :, None] * jnp.concatenate([f, mb], axis=1)[None], axis=1)
 
     @classmethod
     def on_bodies(cls, com, body_index, points) -> "BodyPoints":

@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import jax.numpy as jnp
 
+from . import _xla
+
 # Below this rotation angle the closed forms of exp/log switch to Taylor series (their relative
 # error there is below 1e-16 in float64).
 _SMALL_ANGLE = 1e-4
@@ -35,20 +37,23 @@ def rotate_t(R, v):
 
 # products X Y (m, k) × (k, p) up to this many multiplications are written as a multiply–reduce,
 # wider ones as a dot: XLA makes a wide multiply–reduce one slow library fusion (Wu & Yuan's BᵀMB,
-# 96 × 18 × 18: 55 µs/step traced, against a dot's few)
+# 96 × 18 × 18: 55 µs/step traced, against a dot's few). With the time loop compiled whole
+# (mfm._xla, library fusions off) always a multiply–reduce: the inline dot is the slow one there
+# (the same product 28 µs/step)
 _REDUCE_LIMIT = 8192
 
 
 def matmul_small(X, Y, *, transpose_x=False):
     """X Y for 2-D X (m, k), Y (k, p); with ``transpose_x``, Xᵀ Y for X (..., m), Y (..., p),
     summed over all leading axes. A multiply–reduce while m k p ≤ 8,192 (see :func:`rotate` for
-    why), a dot above. Xᵀ Y is reduced over X's leading axes directly: a transposed or reshaped
-    operand costs XLA extra copy kernels."""
+    why), a dot above; with the time loop compiled whole (:mod:`mfm._xla`) always a multiply–reduce
+    (XLA's inline dot of Wu & Yuan's BᵀMB cost 28 µs/step there). Xᵀ Y is reduced over X's leading
+    axes directly: a transposed or reshaped operand costs XLA extra copy kernels."""
     if transpose_x:
         m, k = X.shape[-1], X.size // X.shape[-1]
     else:
         m, k = X.shape
-    if m * k * Y.shape[-1] <= _REDUCE_LIMIT:
+    if _xla.LOOPS_COMPILED_WHOLE or m * k * Y.shape[-1] <= _REDUCE_LIMIT:
         if transpose_x:
             return jnp.sum(X[..., :, None] * Y[..., None, :], axis=tuple(range(X.ndim - 1)))
         return jnp.sum(X[:, :, None] * Y[None, :, :], axis=1)

@@ -70,6 +70,23 @@ def test_the_rollout_loop_is_compiled_whole(rm3):
     assert "xla_cpu_small_call" in txt
 
 
+@pytest.mark.parametrize("config,radiation", [("stansby_li", "state_space_exact"),
+                                              ("hallak_fwwp", "state_space_exact")])
+def test_every_load_keeps_the_loop_whole(config, radiation):
+    """The loads of the other systems (wind thrust, body matrices, hydraulic PTO): none brings an
+    op the whole-loop compilation refuses (a scatter, a LAPACK call, a library fusion). (Wu & Yuan's
+    catenary lines and 18 coordinates qualify too, measured; loading them costs 45 s.)"""
+    m = mfm.load(CONFIGS / f"{config}.toml")
+    loads = model_loads(m, hydro.Regular(height=1.0, period=8.0), dt=0.05, duration=1.0,
+                        ramp=0.5, radiation=radiation, integrator="verlet")
+    q0 = jnp.zeros(m.n_coordinates)
+    z0 = jnp.concatenate([ld.initial_state(m) for ld in loads])
+    txt = _rollout_jit.lower(m, loads, q0, q0, z0, jnp.asarray(0.0), jnp.asarray(0.05),
+                             n_steps=20, integrator=integrators.get("verlet"), save_every=20,
+                             record=False).compile().as_text()
+    assert "xla_cpu_small_call" in txt
+
+
 def test_compiled_whole_gives_the_kernel_by_kernel_numbers(rm3):
     """The same rollout in a process with XLA's default threshold (the loop run kernel by kernel):
     the two emitters evaluate the same HLO, so the states agree to round-off (1e-10 relative,

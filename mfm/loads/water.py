@@ -161,8 +161,10 @@ class Water(Load):
         if rows is not None:
             if tuple(rows) == tuple(mv):
                 F = F + Fr
-            else:   # a strategy on other dofs: only its moved rows do work
-                F = F + jnp.zeros_like(v).at[np.asarray(rows)].set(Fr)[mv]
+            else:   # a strategy on other dofs: only its moved rows do work; placed by a static
+                # 0/1 matrix, as a scatter would keep XLA from compiling the loop whole (mfm._xla)
+                P = (np.asarray(mv)[:, None] == np.asarray(rows)[None, :]).astype(float)
+                F = F + jnp.sum(P * Fr[None, :], axis=1)
         # quadratic drag on the translational dofs (k = body, a = axis); dense, as a scatter
         # would keep XLA from compiling the time loop as one function (mfm.simulate)
         k, a = mv // 6, mv % 6
