@@ -114,17 +114,34 @@ class Water(Load):
         """−∫K ξ̇ and the state derivative, by the radiation strategy."""
         return self.rad.force(t, v, z, memory)
 
-    def _forces(self, t, kin, z, memory):
-        g = self.geometry
+    def _forces(self, t, kin, z, memory, rows):
+        """The Cummins terms of the module docstring on the hydro dofs ``rows`` (static indices),
+        each (len(rows),): buoyancy as a load at r_k (moment (CoB − r_k) × f), −A∞ Ḣq̇ as
+        ``added_mass_bias``; and the radiation's ż, ξ̇ and Ḣq̇ (6K,). The time step asks for the
+        moved dofs only, the outputs and reactions for all. ξ̇ and Ḣq̇ are 0 outside the moved
+        dofs m (:func:`moving_dofs`), so A∞ Ḣq̇ reads columns m only."""
+        g, mv = self.geometry, self._moved
         xi = g.xi(kin)
         v, hbias = g.velocity_and_bias(kin)
-        exc = self._series(self.exc_values, t)
-        rad, zd = self.radiation_force(t, v, z, memory)
-        hyd_stat = -(self.C_wp @ xi)
-        vv = v.reshape(-1, 6)[:, :3]
-        drag = jnp.zeros_like(v).reshape(-1, 6).at[:, :3].set(-self.drag * jnp.abs(vv) * vv).reshape(-1)
-        return dict(excitation=exc, radiation=rad, hydrostatic=hyd_stat, drag=drag,
-                    added_mass_bias=-(self.A_inf @ hbias)), zd, v, hbias
+        r_rad, F_rad, zd = self.rad.force_rows(t, v, z, memory)
+        if r_rad is None:
+            rad = jnp.zeros(len(rows))
+        elif tuple(r_rad) == tuple(rows):
+            rad = F_rad
+        else:   # placed by a static 0/1 matrix: a scatter would keep XLA from compiling the time
+            # loop whole (mfm._xla)
+            P = (np.asarray(rows)[:, None] == np.asarray(r_rad)[None, :]).astype(float)
+            rad = jnp.sum(P * F_rad[None, :], axis=1)
+        # quadratic drag on the translational dofs (k = body, a = axis), dense for the same reason
+        k, a = rows // 6, rows % 6
+        vr = v[rows]
+        f, lever = self._buoyancy(kin)
+        buoy = jnp.concatenate([f, jnp.cross(lever - g._frames(kin)[2], f)], axis=1).reshape(-1)
+        return dict(excitation=self._series(self.exc_values, t)[rows], radiation=rad,
+                    hydrostatic=-(self.C_wp[rows] @ xi),
+                    drag=-(self.drag[k, np.minimum(a, 2)] * (a < 3)) * jnp.abs(vr) * vr,
+                    added_mass_bias=-(self.A_inf[rows][:, mv] @ hbias[mv]),
+                    buoyancy=buoy[rows]), zd, v, hbias
 
     def _buoyancy(self, kin):
         """ρgV ẑ at each centre of buoyancy: as loads at r_k (6K,) and the CoB lever (K, 3)."""
@@ -133,53 +150,28 @@ class Water(Load):
         f = jnp.zeros_like(lever).at[:, 2].set(self.buoyancy)
         return f, lever
 
-    def _buoyancy_wrench(self, kin, n_bodies):
-        f, lever = self._buoyancy(kin)
-        F = jnp.concatenate([f, jnp.zeros_like(f)], axis=1).reshape(-1)
-        return self.geometry.to_body_wrench(F, kin, n_bodies, point_offset=lever)
-
     @property
     def _moved(self) -> np.ndarray:
         """Indices of the moved hydro dofs (static): the rows of H that are not structurally 0."""
-        if self.spec is None:
-            return np.arange(self.A_inf.shape[0])
-        return np.asarray(self.spec.moving)
+        return self._all if self.spec is None else np.asarray(self.spec.moving)
+
+    @property
+    def _all(self) -> np.ndarray:
+        return np.arange(self.A_inf.shape[0])
 
     def _moved_load(self, ctx, H):
-        """The hydro load on the moved dofs, F[m] (n_m,), with ``H`` = H[m] (n_m, n_q) (the
-        Cummins terms of the module docstring; buoyancy as a load at r_k, moment (CoB − r_k) × f;
-        with ``added_mass="rhs"`` −A∞ H q̈ of the iterate) and the radiation's ż. Its virtual
-        power is the whole load's: the rows of H outside m are 0 at every q (:func:`moving_dofs`),
-        so Hᵀ F = H[m]ᵀ F[m], and ξ̇, Ḣq̇ are 0 there too."""
-        g, kin, mv = self.geometry, ctx.kin, self._moved
-        xi = g.xi(kin)
-        v, hbias = g.velocity_and_bias(kin)
-        rows, Fr, zd = self.rad.force_rows(ctx.t, v, ctx.z, ctx.memory)
-        Am = self.A_inf[mv][:, mv]
-        F = (self._series(self.exc_values, ctx.t)[mv] - self.C_wp[mv] @ xi
-             - Am @ hbias[mv])
-        if rows is not None:
-            if tuple(rows) == tuple(mv):
-                F = F + Fr
-            else:   # a strategy on other dofs: only its moved rows do work; placed by a static
-                # 0/1 matrix, as a scatter would keep XLA from compiling the loop whole (mfm._xla)
-                P = (np.asarray(mv)[:, None] == np.asarray(rows)[None, :]).astype(float)
-                F = F + jnp.sum(P * Fr[None, :], axis=1)
-        # quadratic drag on the translational dofs (k = body, a = axis); dense, as a scatter
-        # would keep XLA from compiling the time loop as one function (mfm.simulate)
-        k, a = mv // 6, mv % 6
-        c = self.drag[k, np.minimum(a, 2)] * (a < 3)
-        vm = v[mv]
-        F = F - c * jnp.abs(vm) * vm
-        f, lever = self._buoyancy(kin)
-        rho = g._frames(kin)[2]
-        buoy = jnp.concatenate([f, jnp.cross(lever - rho, f)], axis=1).reshape(-1)
-        F = F + buoy[mv]
+        """The hydro load on the moved dofs, F[m] (n_m,), with ``H`` = H[m] (n_m, n_q) (with
+        ``added_mass="rhs"`` −A∞ H q̈ of the iterate), and the radiation's ż. Its virtual power is
+        the whole load's: the rows of H outside m are 0 at every q (:func:`moving_dofs`), so
+        Hᵀ F = H[m]ᵀ F[m]."""
+        mv = self._moved
+        comps, zd, _, _ = self._forces(ctx.t, ctx.kin, ctx.z, ctx.memory, mv)
+        F = sum(comps.values())
         if self.added_mass == "rhs" and ctx.qdd_guess is not None:
             # seed 001 §5: −A∞ ξ̈ on the right-hand side with the corrector's acceleration iterate.
             # Without an iterate (start of a run, linearisation) the iteration's converged value
             # is used instead: A∞ on the left.
-            F = F - Am @ (H @ ctx.qdd_guess)
+            F = F - self.A_inf[mv][:, mv] @ (H @ ctx.qdd_guess)
         return F, zd
 
     def evaluate(self, ctx):
@@ -197,23 +189,19 @@ class Water(Load):
     def reaction_loads(self, ctx, out):
         # the whole −A∞ ξ̈ on the bodies: −A∞ Ḣq̇ and −A∞ H q̈ (with added_mass="rhs" the load
         # already holds −A∞ H q̈ of the recorded iterate)
-        kin, n = ctx.kin, ctx.model.n_bodies
-        comps, _, _, _ = self._forces(ctx.t, kin, ctx.z, ctx.memory)
+        kin = ctx.kin
+        comps, _, _, _ = self._forces(ctx.t, kin, ctx.z, ctx.memory, self._all)
         H, _, _ = self.geometry.h_matrix(kin)
         qdd = ctx.qdd_guess if out.mass is None else ctx.qdd
         F = sum(comps.values()) - self.A_inf @ (H @ qdd)
-        return self.geometry.to_body_wrench(F, kin, n) + self._buoyancy_wrench(kin, n)
+        return self.geometry.to_body_wrench(F, kin, ctx.model.n_bodies)
 
     def diagnostics(self, ctx, out):
         kin = ctx.kin
-        comps, _, v, hbias = self._forces(ctx.t, kin, ctx.z, ctx.memory)
+        comps, _, v, hbias = self._forces(ctx.t, kin, ctx.z, ctx.memory, self._all)
         H, _, _ = self.geometry.h_matrix(kin)
         comps["added_mass"] = -(self.A_inf @ (H @ ctx.qdd + hbias))
         comps.pop("added_mass_bias")
-        f, lever = self._buoyancy(kin)
-        rho = self.geometry._frames(kin)[2]
-        buoy = jnp.concatenate([f, jnp.cross(lever - rho, f)], axis=1)
-        comps["buoyancy"] = buoy.reshape(-1)
         return {"eta": self._series(self.eta_values, ctx.t), "xi": self.geometry.xi(kin),
                 "hydro_force": jnp.stack([comps[c] for c in HYDRO_COMPONENTS])}
 
