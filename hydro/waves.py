@@ -684,16 +684,49 @@ def _check_components(components) -> WaveComponents:
     return components
 
 
+def _uniform_step(t: np.ndarray):
+    """h when t[k] = t[0] + k h for every k to round-off (|deviation| ≤ 16 ε max|t|), else None."""
+    n = t.shape[0]
+    h = (t[-1] - t[0]) / (n - 1)
+    if not (np.isfinite(h) and h > 0.0):
+        return None
+    scale = max(float(np.max(np.abs(t))), abs(float(h)))
+    if np.max(np.abs(t - (t[0] + h * np.arange(n)))) > 16.0 * np.finfo(np.float64).eps * scale:
+        return None
+    return float(h)
+
+
+# Rows of one block of the uniform-grid harmonic sum: the K × n phase table is made once.
+_BLOCK = 256
+
+
 def _harmonic_sum(omega: np.ndarray, coeff: np.ndarray, t: np.ndarray) -> np.ndarray:
     """Re Σ_j coeff[j, :] e^{−iω_j t} for every t: (n_t, m) float64, chunked over t.
 
     Uses Re[(cos ωt − i sin ωt)(C_r + i C_i)] = cos(ωt)·C_r + sin(ωt)·C_i: two real matrix
     products, with at most _CHUNK_ENTRIES phases held at once.
+
+    On a uniform grid t_k = t_0 + k h (a time-step table), block b of K rows has
+    e^{−iω(t_0 + (bK + k) h)} = e^{−iωkh} · e^{−iω(t_0 + bKh)}: the K × n phase table e^{−iωkh}
+    is made once and each block's second factor is folded into its coefficients, so the
+    sines and cosines cost K·n instead of n_t·n (they were ~80 % of building a 20,000-step
+    excitation table). Both phases are made from their own products ω·(time), not by recursion,
+    so the result equals the direct sum to round-off.
     """
     n_t = t.shape[0]
     out = np.empty((n_t, coeff.shape[1]), dtype=np.float64)
     if omega.shape[0] == 0:
         out[:] = 0.0
+        return out
+    h = _uniform_step(t) if n_t >= 4 * _BLOCK else None
+    if h is not None:
+        k = h * np.arange(_BLOCK)
+        wk = np.multiply.outer(k, omega)
+        cos_k, sin_k = np.cos(wk), np.sin(wk)
+        for i in range(0, n_t, _BLOCK):
+            rows = min(_BLOCK, n_t - i)
+            cb = coeff * np.exp(-1j * omega * (t[0] + i * h))[:, None]
+            out[i:i + rows] = cos_k[:rows] @ cb.real + sin_k[:rows] @ cb.imag
         return out
     cr = np.ascontiguousarray(coeff.real)
     ci = np.ascontiguousarray(coeff.imag)
