@@ -2,10 +2,9 @@
 states) split into chunks of :func:`mfm.simulate_batch`, run one after another in this process or
 on a Dask distributed cluster, and gathered into one labelled dataset.
 
-Why chunks: one vmapped call over every case holds every case's carried state at once (the M4 134
-power matrix, 120 cases × 20,000 steps: 4.1 GB in one call) and runs slower per case-step past
-~16 cases (the states leave the caches: 52 µs per case-step at 16 cases, 87–93 µs at 64–128,
-benchmarks/RESULTS.md); chunks of ~16 bound the memory and keep the fast size. Why Dask: it is
+Why chunks: one ``simulate_batch`` call over every case holds every case's excitation table
+and saved outputs at once (the M4 134 power matrix, 120 cases × 20,000 steps: 3 GB in one call);
+chunks bound the memory. Why Dask: it is
 the field's library for spreading Python work over processes and machines (a ``LocalCluster`` on
 one machine, the same call on any cluster given its scheduler address), with futures per task, so
 that one chunk that fails does not lose the others.
@@ -37,7 +36,7 @@ _simulate = importlib.import_module("mfm.simulate")     # the module (mfm.simula
 
 # options passed through to simulate_batch (one value for every case, except dt and ramp)
 BATCH_OPTIONS = ("integrator", "radiation", "state_space_options", "memory", "save_every", "t0",
-                 "q0", "qd0", "loads", "outputs")
+                 "q0", "qd0", "loads", "outputs", "lanes")
 
 # the models a worker process keeps, by the hash of their pickled bytes: a model unpickled again
 # would find its compilations (the HydroSpec is compared by content) but not its HydroSpec's
@@ -123,7 +122,7 @@ def _check_chunk_size(chunk_size):
     if isinstance(chunk_size, bool) or not isinstance(chunk_size, numbers.Integral) \
             or chunk_size < 1:
         raise ValueError(f"chunk_size: {chunk_size!r}; give a whole number ≥ 1 of cases per "
-                         "vmapped call (16 is the fastest per case-step for M4 134)")
+                         "simulate_batch call")
     return int(chunk_size)
 
 
@@ -187,7 +186,7 @@ def sweep(model, seas, *, dt=None, n_steps: int | None = None, chunk_size: int =
         Model: one topology, one hydro spec), as ``simulate_batch`` takes.
     seas: a sea state or one per case (``hydro.waves``; None for still water).
     dt, ramp: s, one number or one per case. n_steps: steps of every case.
-    chunk_size: the most cases per vmapped call. The cases are split into ⌈B / chunk_size⌉
+    chunk_size: the most cases per ``simulate_batch`` call. The cases are split into ⌈B / chunk_size⌉
         chunks of one size (the last padded by repeating a case, dropped after): one compilation per
         process.
     client: None (default: the chunks one after another in this process; no dask needed),
@@ -215,7 +214,7 @@ def sweep(model, seas, *, dt=None, n_steps: int | None = None, chunk_size: int =
         ``state_space_options``, ``save_every``, ``t0`` and ``parameters``; the chunks and the
         cluster do not apply.
     options: ``simulate_batch``'s other options (integrator, radiation, state_space_options,
-        memory, save_every, t0, q0, qd0, loads, outputs), the same for every case. The fast path
+        memory, save_every, t0, q0, qd0, loads, outputs, lanes), the same for every case. The fast path
         for long sea states is ``integrator="verlet", radiation="state_space_exact"``.
 
     Returns ``simulate_batch``'s dataset (case, step, coordinate; sea labels ``sea_hs``,

@@ -75,6 +75,26 @@ def test_chunks_in_process_equal_one_batch_and_keep_its_labels(rm3, seas, refere
     assert P.unstack("case").shape == (2, 2)
 
 
+def test_threads_and_lanes_give_the_same_cases(rm3, seas, reference):
+    """simulate_batch runs its cases in parts from host threads (one per core by default) and in
+    groups of ``lanes`` vmapped together: every split must give the reference's numbers (RTOL:
+    only the vmapped round-off differs), a padded last part included, once compiled per shape."""
+    trace = sys.modules["mfm.simulate"].TRACES
+    before = trace["rollout"]
+    # 3 cases in 2 threads: parts of 2, the last padded by repeating its case, dropped after;
+    # lanes=2 is a shape nothing else here compiles: the two threads share one compilation
+    three = mfm.simulate_batch(rm3, seas[:3], dt=0.1, threads=2, lanes=2, **KW)
+    assert trace["rollout"] == before + 1
+    assert three.sizes["case"] == 3 and three.attrs["lanes"] == 2
+    assert_same(three, reference.isel(case=slice(0, 3)))
+    assert_same(mfm.simulate_batch(rm3, seas, dt=0.1, threads=2, lanes=1, **KW), reference)
+    assert_same(mfm.simulate_batch(rm3, seas, dt=0.1, threads=1, lanes=4, **KW), reference)
+    for bad in (0, 1.5, True):
+        for name in ("threads", "lanes"):
+            with pytest.raises(ValueError, match=name):
+                mfm.simulate_batch(rm3, seas, dt=0.1, **{name: bad}, **KW)
+
+
 def test_plan_pads_the_last_chunk_to_one_shape():
     plan = sweep_mod.plan_chunks(120, 16)        # 8 chunks of 15: no padding
     assert [c.cases.size for c in plan] == [15] * 8 and all(c.n_real == 15 for c in plan)
