@@ -6,6 +6,7 @@ Reports medians over repeats: µs per jit-compiled forward_dynamics call, compil
 wall time of a 20,000-step simulation (rollout only, and the full `simulate` with its dataset).
 """
 import argparse
+import os
 import time
 from pathlib import Path
 
@@ -13,6 +14,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
 import mfm
 from timing import median_time
 

@@ -7,6 +7,7 @@ fresh model); compile time and warm wall time of the compiled rollout with convo
 state space; and the whole `simulate` call (dataset included) warm.
 """
 import argparse
+import os
 import statistics
 import time
 import warnings
@@ -14,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
 import hydro
 import mfm
 from timing import median_time

@@ -10,6 +10,7 @@ PTO power on the run's time grid (what is compared here). The linear level's war
 modes (cached per model and dt, as the state-space fit is per model); its cold first call (the fit,
 the eigendecomposition of the 1,021-state system, compilation) is printed too.
 """
+import os
 import statistics
 import sys
 import time
@@ -21,6 +22,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
 import hydro  # noqa: E402
 import mfm  # noqa: E402
 

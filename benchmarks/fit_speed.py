@@ -13,11 +13,13 @@ benchmarks/fit_speed.py``; the configs and databases are this checkout's).
 """
 import argparse
 import ast
+import os
 import statistics
 import time
 import warnings
 from pathlib import Path
 
+os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
 import hydro
 import mfm
 

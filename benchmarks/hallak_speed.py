@@ -16,6 +16,7 @@ Goals (issue 11): the RAO set ≤ 1 s after compilation; the sea state ≤ 2 s w
 """
 import argparse
 import math
+import os
 import time
 import warnings
 from pathlib import Path
@@ -23,6 +24,7 @@ from pathlib import Path
 import jax.numpy as jnp
 import numpy as np
 
+os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
 import hydro
 import mfm
 from mfm.simulate import model_loads

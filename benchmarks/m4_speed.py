@@ -18,6 +18,7 @@ and, with ``--sweep``, the whole Fig. 7 sweep (3 layouts × 11 Tp, 20,000 steps 
 Table 3: 0.0044 s per step (MFM, 111) → 88 s for 20,000 steps.
 """
 import argparse
+import os
 import time
 import warnings
 from pathlib import Path
@@ -25,6 +26,7 @@ from pathlib import Path
 import jax.numpy as jnp
 import numpy as np
 
+os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
 import hydro
 import mfm
 from mfm.simulate import model_loads

@@ -16,6 +16,7 @@ Goals (issue 10): one sea state ≤ 2 s warm; the 36-heading sweep ≤ 60 s.
 """
 import argparse
 import math
+import os
 import time
 import warnings
 from pathlib import Path
@@ -23,6 +24,7 @@ from pathlib import Path
 import jax.numpy as jnp
 import numpy as np
 
+os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
 import hydro
 import mfm
 from mfm.simulate import model_loads

@@ -9,11 +9,13 @@ of a 60-period run at dt = T/100, against frequency_response with the same radia
 the raw database A(ω), B(ω). Prints |x_TD/x_FD − 1|.
 """
 import math
+import os
 import warnings
 from pathlib import Path
 
 import numpy as np
 
+os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
 import hydro
 import mfm
 

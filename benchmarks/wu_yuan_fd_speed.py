@@ -10,6 +10,7 @@ the model as identity-hashed static data (hydro.prepare.HydroSpec), so five spac
 topology are five compilations (issue 13).
 """
 import argparse
+import os
 import sys
 import time
 import warnings
@@ -20,6 +21,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tools"))
 
+os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
 from timing import first_and_warm  # noqa: E402
 
 

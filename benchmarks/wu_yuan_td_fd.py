@@ -33,6 +33,7 @@ Numbers and the command are recorded in benchmarks/RESULTS.md.
 """
 import argparse
 import math
+import os
 import time
 import warnings
 from pathlib import Path
@@ -40,6 +41,7 @@ from pathlib import Path
 import jax.numpy as jnp
 import numpy as np
 
+os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
 import hydro
 import mfm
 from mfm.loads.catenary import linearise_lines

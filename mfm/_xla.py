@@ -20,6 +20,15 @@ time step avoids the first two (static 0/1 sums, unrolled elimination) and mfm a
 XLA's experimental YNNPACK fusions (``--xla_cpu_experimental_ynn_fusion_type=``), into which XLA
 rewrote some small multiply–reduces (this also made batches of 4–128 cases 20–35 % faster).
 
+**Compiled programs kept on disk.** A fresh Python process compiles every program again: for
+M4 134 with :func:`mfm.simulate`'s defaults that is most of its first call. mfm therefore turns on
+jax's persistent compilation cache (programs that took ≥ 1 s to compile, under
+``$XDG_CACHE_HOME/mfm/jax``, default ``~/.cache/mfm/jax``, at most :data:`CACHE_BYTES`, the least
+recently used dropped first), so a later process with the same model, options, jax and XLA flags
+loads them instead. The results are the same bits (the same executable). Set
+``MFM_COMPILATION_CACHE`` to a folder to use that one, or to ``off`` to keep no cache; jax's own
+setting (``JAX_COMPILATION_CACHE_DIR`` or ``jax.config``) wins over both.
+
 XLA reads ``XLA_FLAGS`` once, when jax starts its backend: mfm adds the option there at import,
 unless ``XLA_FLAGS`` already names it (yours wins; ``=1024`` restores XLA's default). If jax's
 backend is already running when mfm is imported (jax used before ``import mfm``), the option cannot
@@ -93,3 +102,40 @@ def _set_flags() -> tuple[bool, str]:
 
 
 LOOPS_COMPILED_WHOLE, LOOP_THRESHOLD = _set_flags()
+
+
+CACHE_ENV = "MFM_COMPILATION_CACHE"
+# the most the cache folder mfm chooses may hold (jax drops the least recently used beyond it)
+CACHE_BYTES = 2 * 2**30
+
+
+def default_cache_dir() -> str:
+    """``$XDG_CACHE_HOME/mfm/jax`` (default ``~/.cache/mfm/jax``)."""
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return os.path.join(base, "mfm", "jax")
+
+
+def _set_cache() -> str | None:
+    """Turn on jax's persistent compilation cache unless jax already has one or
+    ``MFM_COMPILATION_CACHE`` is off; returns the folder in use (None: no cache)."""
+    import jax
+
+    own = jax.config.jax_compilation_cache_dir
+    if own:
+        return own
+    setting = os.environ.get(CACHE_ENV, "").strip()
+    if setting.lower() in ("off", "0", "false", "no", "none"):
+        return None
+    path = setting or default_cache_dir()
+    jax.config.update("jax_compilation_cache_dir", path)
+    if jax.config.jax_compilation_cache_max_size == -1:
+        try:
+            import filelock  # noqa: F401  (jax bounds the cache only with it: a dependency of mfm)
+        except ImportError:
+            pass
+        else:
+            jax.config.update("jax_compilation_cache_max_size", CACHE_BYTES)
+    return path
+
+
+COMPILATION_CACHE = _set_cache()

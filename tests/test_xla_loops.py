@@ -105,3 +105,49 @@ def test_compiled_whole_gives_the_kernel_by_kernel_numbers(rm3):
         a, b = np.asarray(here[k]), np.asarray(other[k])
         assert np.all(np.isfinite(a)) and np.abs(a).max() > 0
         np.testing.assert_allclose(a, b, rtol=1e-10, atol=1e-10 * np.abs(b).max())
+
+
+_CACHE_SCRIPT = f"""
+import json, jax
+hits = []
+jax.monitoring.register_event_listener(
+    lambda name, **kw: hits.append(1) if name == "/jax/compilation_cache/cache_hits" else None)
+import mfm
+jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)   # RM3 compiles fast
+here = {{"q": None, "qd": None}}
+if RUN:
+    exec({_rm3_rollout_script(20)!r}.replace("print(json.dumps(", "here.update(("), {{"here": here}})
+print(json.dumps({{"dir": jax.config.jax_compilation_cache_dir, "hits": len(hits),
+                  "q": here["q"], "qd": here["qd"]}}))
+"""
+
+
+def _child(env_changes, run=False):
+    """A fresh process with these environment changes: its cache folder, and with ``run`` the
+    cache hits and states of a short RM3 rollout."""
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("JAX_COMPILATION_CACHE_DIR", _xla.CACHE_ENV)}
+    env.update(env_changes)
+    out = subprocess.run([sys.executable, "-c", f"RUN = {run}\n" + _CACHE_SCRIPT], env=env, cwd=ROOT,
+                         capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_compiled_programs_are_kept_on_disk_and_loaded_by_a_later_process(tmp_path):
+    """mfm turns on jax's persistent compilation cache: a second fresh process loads the
+    programs the first compiled (cache hits) and gives the same bits; MFM_COMPILATION_CACHE names
+    the folder or turns it off; jax's own JAX_COMPILATION_CACHE_DIR wins over both."""
+    folder = tmp_path / "cache"
+    first = _child({_xla.CACHE_ENV: str(folder)}, run=True)
+    assert first["dir"] == str(folder) and any(folder.iterdir())
+    second = _child({_xla.CACHE_ENV: str(folder)}, run=True)
+    assert second["hits"] > first["hits"]
+    assert second["q"] == first["q"] and second["qd"] == first["qd"]
+    assert _child({_xla.CACHE_ENV: "off"})["dir"] is None
+    own = tmp_path / "own"
+    assert _child({_xla.CACHE_ENV: str(folder), "JAX_COMPILATION_CACHE_DIR": str(own)})["dir"] \
+        == str(own)
+    # the default folder, under XDG_CACHE_HOME
+    assert _child({"XDG_CACHE_HOME": str(tmp_path / "xdg")})["dir"] \
+        == str(tmp_path / "xdg" / "mfm" / "jax")
