@@ -149,6 +149,7 @@ def child_m4(new, repeats, batch):
         seas = [hydro.Jonswap(hs=h, tp=t, gamma=3.3, seed=1, omega_range=(1.0, 25.0))
                 for h in hss for t in tps]
         res["batch"] = []
+        res["threads"] = sys.modules["mfm.simulate"].default_threads()
         for B in (1, 4, 16, 64, 128):
             ss_b = (seas * 2)[:B]
             dts = np.array([s.tp / 200 for s in ss_b])
@@ -293,7 +294,9 @@ def report(new, old, rev):
              f"{(p[keys[2]] - p[keys[1]]) / N_M4 * 1e6:.1f} | {fl['radiation']:,} |")
     L.append("")
     if "batch" in m4:
-        L.append("**Batches** (`simulate_batch`, Verlet, exact radiation, 2,000 steps per case):\n")
+        L.append("**Batches** (`simulate_batch`, Verlet, exact radiation, 2,000 steps per case; "
+                 f"its CPU defaults: the cases in turn in {m4.get('threads', 1)} parts, one thread "
+                 "each):\n")
         L.append("| cases | first | warm | µs per case-step | peak memory (process) |")
         L.append("|---|---|---|---|---|")
         for b in m4["batch"]:
@@ -301,7 +304,7 @@ def report(new, old, rev):
                      f"{b['warm'] / (b['B'] * 2000) * 1e6:.1f} | {b['maxrss_GB']:.1f} GB |")
         pm = m4["power_matrix"]
         L.append(f"\n**Power matrix** 10 H_s (0.01–0.06 m) × 12 T_p (0.8–1.8 s), 100 T_p each "
-                 f"(20,000 steps), one `simulate_batch` call, compilation included: {pm['wall']:.1f} s "
+                 f"(20,000 steps), one `simulate_batch` call (its defaults), water loads, fit and compilation included: {pm['wall']:.1f} s "
                  f"({pm['wall'] / pm['cases']:.2f} s per sea state), peak memory {pm['maxrss_GB']:.1f} GB.\n")
     L.append("**RM3, regular wave H 2.5 m, T 8 s, 200 s at dt 0.1 s** (accuracy against RK4 at "
              "dt/4; pitch rms and PTO power over the last 100 s):\n")
