@@ -36,7 +36,7 @@ _simulate = importlib.import_module("mfm.simulate")     # the module (mfm.simula
 
 # options passed through to simulate_batch (one value for every case, except dt and ramp)
 BATCH_OPTIONS = ("integrator", "radiation", "state_space_options", "memory", "save_every", "t0",
-                 "q0", "qd0", "loads", "outputs", "lanes")
+                 "q0", "qd0", "loads", "outputs", "lanes", "threads")
 
 # the models a worker process keeps, by the hash of their pickled bytes: a model unpickled again
 # would find its compilations (the HydroSpec is compared by content) but not its HydroSpec's
@@ -214,7 +214,8 @@ def sweep(model, seas, *, dt=None, n_steps: int | None = None, chunk_size: int =
         ``state_space_options``, ``save_every``, ``t0`` and ``parameters``; the chunks and the
         cluster do not apply.
     options: ``simulate_batch``'s other options (integrator, radiation, state_space_options,
-        memory, save_every, t0, q0, qd0, loads, outputs, lanes), the same for every case. The fast path
+        memory, save_every, t0, q0, qd0, loads, outputs, lanes, threads), the same for every
+        case; on a cluster ``threads`` is 1 unless given (the workers share the cores). The fast path
         for long sea states is ``integrator="verlet", radiation="state_space_exact"``.
 
     Returns ``simulate_batch``'s dataset (case, step, coordinate; sea labels ``sea_hs``,
@@ -298,6 +299,8 @@ def sweep(model, seas, *, dt=None, n_steps: int | None = None, chunk_size: int =
                     bar.update(1)
         else:
             workers = len(c.scheduler_info().get("workers", {})) or 1
+            # a worker runs its chunk on one thread (the workers share the cores), unless told
+            args["options"] = {"threads": 1, **options}
             results = _run_on_cluster(c, models, chunks, todo, seas_l, dts, ramps, args, bar)
         if bar is not None:
             bar.close()

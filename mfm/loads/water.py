@@ -427,20 +427,24 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
                      source=str(path), moving=moving_dofs(model, idx, np.asarray(db["reference_point"].values) - com0))
 
 
+@jax.jit
+def _h_samples(model, geo, qs):
+    """H(q) at each row of qs, in one compiled call (op by op, the tree walk was ~180 small
+    compilations: 8 s of loading M4 134); compiled once per model structure."""
+    from ..kinematics import kinematics
+
+    return jax.vmap(lambda q: geo.h_matrix(kinematics(model, q, jnp.zeros_like(q)))[0])(qs)
+
+
 def moving_dofs(model, body_index, d_ref, n_samples: int = 3, seed: int = 0) -> np.ndarray:
     """Indices of the hydro dofs (6 per wet body: the velocity of its reference point and its
     angular velocity, inertial axes) that the model's joints can move: the rows of H(q) in
     ξ̇ = H q̇ that are not 0 at ``n_samples`` random configurations (|q| ≤ 0.3). A structural zero
     (a planar model has no sway, roll or yaw) is 0 at every q; a row that is 0 by accident at
     three random q is not generic. Radiation is modelled on these dofs only."""
-    from ..kinematics import kinematics
-
     geo = BodyPoints(body_index=tuple(int(i) for i in body_index), d_ref=jnp.asarray(d_ref),
                      ref0=jnp.zeros((len(body_index), 3)))
     rng = np.random.default_rng(seed)
     qs = jnp.asarray(rng.uniform(-0.3, 0.3, (n_samples, model.n_coordinates)))
-    # one compiled, vmapped call: op by op, the tree walk was ~180 small compilations (8 s of
-    # loading M4 134)
-    H = jax.jit(jax.vmap(lambda q: geo.h_matrix(kinematics(model, q, jnp.zeros_like(q)))[0]))(qs)
-    peak = np.abs(np.asarray(H)).max(axis=(0, 2))
+    peak = np.abs(np.asarray(_h_samples(model, geo, qs))).max(axis=(0, 2))
     return np.flatnonzero(peak > 1e-12 * max(float(np.max(peak)), 1e-300))
