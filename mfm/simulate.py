@@ -269,16 +269,23 @@ def _rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, r
 
     carry, saved = jax.lax.scan(block, carry, None, length=n_blocks)
     if deferred:
-        # groups of a fixed width, the last one padded: every sample is computed by the same
-        # vmapped program whatever n_blocks, so a run in chunks (progress bar) gives the same bits
-        W = DEFERRED_RECORD_WIDTH
-        G = -(-n_blocks // W)
-        pad = lambda a: jnp.concatenate([a, jnp.repeat(a[-1:], G * W - n_blocks, 0)]).reshape(  # noqa: E731
-            (G, W) + a.shape[1:])
-        groups = jax.tree_util.tree_map(pad, saved)
-        out = jax.lax.map(jax.vmap(lambda sm: _saved(model, loads, *sm, record)), groups)
-        saved = jax.tree_util.tree_map(lambda a: a.reshape((G * W,) + a.shape[2:])[:n_blocks], out)
+        # groups of a fixed width: every sample is computed by the same vmapped program whatever
+        # n_blocks, so a run in chunks (progress bar) gives the same bits
+        saved = _map_in_groups(lambda sm: _saved(model, loads, *sm, record), saved,
+                               DEFERRED_RECORD_WIDTH)
     return carry, saved
+
+
+def _map_in_groups(f, xs, width):
+    """``f`` over the leading axis of the pytree ``xs``: ``jax.lax.map`` over groups of ``width``
+    items that one ``jax.vmap`` evaluates together, the last group padded by repeating the last
+    item (its results dropped). The shapes are written out, not inferred: items may be empty."""
+    n = jax.tree_util.tree_leaves(xs)[0].shape[0]
+    G = -(-n // width)
+    pad = lambda a: jnp.concatenate([a, jnp.repeat(a[-1:], G * width - n, 0)]).reshape(  # noqa: E731
+        (G, width) + a.shape[1:])
+    out = jax.lax.map(jax.vmap(f), jax.tree_util.tree_map(pad, xs))
+    return jax.tree_util.tree_map(lambda a: a.reshape((G * width,) + a.shape[2:])[:n], out)
 
 
 def _rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_every, record):
@@ -318,12 +325,9 @@ def _over_cases(f, model, model_axis, batched, lanes):
     g = (lambda a: f(model, *a)) if model_axis is None else (lambda a: f(*a))
     if lanes <= 1:
         return jax.lax.map(g, xs)
-    # groups of `lanes` by hand (the caller pads the cases to a multiple of it): lax.map's own
-    # batch_size fails on the empty state of a model without load states (its reshape divides by 0)
-    n = jax.tree_util.tree_leaves(xs)[0].shape[0]
-    split = lambda a: a.reshape((n // lanes, lanes) + a.shape[1:])  # noqa: E731
-    out = jax.lax.map(jax.vmap(g), jax.tree_util.tree_map(split, xs))
-    return jax.tree_util.tree_map(lambda a: a.reshape((n,) + a.shape[2:]), out)
+    # not lax.map's own batch_size: it fails on the empty state of a model without load states
+    # (its reshape divides by 0)
+    return _map_in_groups(g, xs, lanes)
 
 
 def default_lanes(n_cases: int) -> int:
@@ -962,7 +966,6 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     # compiled program serves every part, each run from its own host thread
     size = -(-B // threads)
     lanes = min(lanes, size)
-    size = -(-size // lanes) * lanes                  # whole groups of lanes in each part
     groups = [np.minimum(np.arange(k, k + size), B - 1) for k in range(0, B, size)]
     args = [(stack([pick(models, i) for i in g]) if model_axis == 0 else m0,
              stack([loads[i] for i in g]), jnp.asarray(dts_all[g])) for g in groups]
