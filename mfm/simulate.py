@@ -79,13 +79,14 @@ AUTO_CONVOLUTION_LIMIT = 2e10
 def choose_radiation(model: Model, *, dt, n_steps, integrator="rk4", memory=None):
     """The radiation strategy ``radiation="auto"`` takes, and why: ``(name, reason)``.
 
-    The convolution costs n_steps × (evaluations per step) × n_lags × n² multiply–adds (n the
-    moved hydro dofs, n_lags = T_K/dt with T_K the memory from the decay of K, or ``memory``); the
-    state space a fit once (seconds to a minute) and then O(n · poles) per evaluation. Above
-    :data:`AUTO_CONVOLUTION_LIMIT` multiply–adds the state space is taken, its states advanced
-    exactly (``"state_space_exact"``, stable with every integrator); below it the convolution, the
-    direct evaluation of the Cummins integral with no fit. The reason is recorded in the result
-    (``radiation_choice``)."""
+    The convolution costs n_steps × S × n_lags × n² multiply–adds (S the distinct stage offsets
+    of the integrator, at which the history sum is formed once per step, :class:`mfm.loads.radiation.Convolution`;
+    n the moved hydro dofs; n_lags = T_K/dt with T_K the memory from the decay of K, or
+    ``memory``); the state space a fit once (seconds to a minute) and then O(n · poles) per
+    evaluation. Above :data:`AUTO_CONVOLUTION_LIMIT` multiply–adds the state space is taken, its
+    states advanced exactly (``"state_space_exact"``, stable with every integrator); below it the
+    convolution, the direct evaluation of the Cummins integral with no fit. The reason is
+    recorded in the result (``radiation_choice``)."""
     if model.hydro is None:
         return "none", "no water"
     integ = _integrators.get(integrator)
@@ -93,10 +94,10 @@ def choose_radiation(model: Model, *, dt, n_steps, integrator="rk4", memory=None
     T_K = spec.memory() if memory is None else float(memory)
     n = len(spec.moving)
     lags = int(math.ceil(T_K / dt))
-    macs = float(n_steps) * getattr(integ, "evaluations", 2) * lags * n * n
-    what = (f"convolution {n_steps} steps × {getattr(integ, 'evaluations', 2)} evaluations × "
-            f"{lags} lags (T_K {T_K:.3g} s / dt {dt:.3g} s) × {n}² moved dofs = {macs:.2g} "
-            f"multiply–adds")
+    S = len(_stage_offsets(integ))
+    macs = float(n_steps) * S * lags * n * n
+    what = (f"convolution {n_steps} steps × {S} stage offsets × {lags} lags (T_K {T_K:.3g} s / "
+            f"dt {dt:.3g} s) × {n}² moved dofs = {macs:.2g} multiply–adds")
     if macs > AUTO_CONVOLUTION_LIMIT:
         return "state_space_exact", f"auto: {what} > {AUTO_CONVOLUTION_LIMIT:.0e}: state space"
     return "convolution", f"auto: {what} ≤ {AUTO_CONVOLUTION_LIMIT:.0e}: convolution"

@@ -131,9 +131,10 @@ def test_convolution_on_moved_dofs_equals_all_dofs(m111):
     v[list(spec.moving)] = rng.normal(size=9)
     hist = rng.normal(size=(w_all.n_lags, 18))
     hist[:, [k for k in range(18) if k not in spec.moving]] = 0.0
-    F_all, _ = w_all.radiation_force(0.005, jnp.asarray(v), None, (0.0, jnp.asarray(hist)))
+    F_all, _ = w_all.radiation_force(0.005, jnp.asarray(v), None,
+                                     w_all.rad.memory_at(0.0, jnp.asarray(hist)))
     F_sub, _ = w_sub.radiation_force(0.005, jnp.asarray(v), None,
-                                     (0.0, jnp.asarray(hist[:, list(spec.moving)])))
+                                     w_sub.rad.memory_at(0.0, jnp.asarray(hist[:, list(spec.moving)])))
     np.testing.assert_allclose(np.asarray(F_sub)[list(spec.moving)], np.asarray(F_all)[list(spec.moving)],
                                rtol=1e-12, atol=1e-12 * np.abs(F_all).max())
 

@@ -62,10 +62,10 @@ def test_blow_up_stops_with_time_and_cause():
 
 
 def test_auto_radiation_takes_the_cheaper_and_says_why():
-    # the convolution's work n_steps × evaluations × (T_K/dt) lags × n² against the limit: M4 134
-    # (24 moved dofs, T_K ≈ 39 s) over 100 T_p at T_p/200 with RK4 is 3e11 multiply–adds
-    # (minutes): the state space; 200 steps of it (3e9) and RM3's 2000 steps (6e7): the convolution.
-    # Verlet does one evaluation per step: a quarter of RK4's work.
+    # the convolution's work n_steps × stage offsets × (T_K/dt) lags × n² against the limit (the
+    # history sum is formed once per step for each stage offset: RK4 3, Verlet 2): M4 134 (24
+    # moved dofs, T_K ≈ 39 s) over 100 T_p at T_p/200 with RK4 is 2e11 multiply–adds (minutes):
+    # the state space; 200 steps of it (2e9) and RM3's 2000 steps (5e7): the convolution.
     from mfm.simulate import AUTO_CONVOLUTION_LIMIT, choose_radiation
 
     m4 = mfm.load(CONFIGS / "m4_134.toml")
@@ -74,7 +74,7 @@ def test_auto_radiation_takes_the_cheaper_and_says_why():
     lags = int(why.split(" lags")[0].split()[-1])
     assert abs(lags - m4.hydro.memory() / 0.006) <= 1
     assert choose_radiation(m4, dt=0.006, n_steps=200)[0] == "convolution"
-    n_rk4 = int(AUTO_CONVOLUTION_LIMIT / (4 * lags * 24**2))
+    n_rk4 = int(AUTO_CONVOLUTION_LIMIT / (3 * lags * 24**2))
     assert choose_radiation(m4, dt=0.006, n_steps=n_rk4 + 1)[0] == "state_space_exact"
     assert choose_radiation(m4, dt=0.006, n_steps=n_rk4 + 1, integrator="verlet")[0] == "convolution"
     assert choose_radiation(MODEL, dt=0.01, n_steps=10**9) == ("none", "no water")

@@ -80,10 +80,16 @@ class DatabaseRadiation(NoRadiation):
 
 
 class Convolution(NoRadiation):
-    """Direct convolution. ``W_current`` (S, n, n), ``W_lag`` (S, N, n, n): the weights of the
-    current velocity and of the N step-start samples for each of the S stage offsets
-    ``stage_offsets`` (fractions of dt, from the integrator) over the moved dofs ``dofs``.
-    Memory: (t_n, history (N, n) newest first)."""
+    """Direct convolution over the moved dofs ``dofs`` (n of them): the force at a stage offset s
+    of the step (``stage_offsets``, fractions of dt, from the integrator) is
+
+        ∫₀^{T_K} K(τ) ξ̇(t − τ) dτ = W_c[s] ξ̇(t) + Σ_j W_j[s] ξ̇(t_n − j dt)   (j = 0 … N−1).
+
+    The history sum does not change within a step, so it is formed once per step for every
+    offset, when the memory is updated, as one matrix–vector product ``W_lag`` (S, n, N·n) times
+    the history flattened (N·n): a stage then adds only W_c[s] ξ̇(t). (Formed per stage, the sum
+    cost S slices of W and four products of N·n² per RK4 step.) ``W_current`` (S, n, n).
+    Memory: (t_n, history (N, n) newest first, the history sum for each offset (S, n))."""
     W_current: jnp.ndarray
     W_lag: jnp.ndarray
     dt: jnp.ndarray
@@ -93,19 +99,24 @@ class Convolution(NoRadiation):
     n_lags: int = eqx.field(static=True)
     name: ClassVar[str] = "convolution"
 
+    def memory_at(self, t, hist):
+        """The memory at step start t with velocity history ``hist`` (N, n), newest first."""
+        return (jnp.asarray(t, jnp.float64), hist, self.W_lag @ hist.reshape(-1))
+
     def init_memory(self, v, t0):
         v = v[np.asarray(self.dofs)]
-        return (jnp.asarray(t0, jnp.float64), jnp.zeros((self.n_lags, v.shape[0])).at[0].set(v))
+        return self.memory_at(t0, jnp.zeros((self.n_lags, v.shape[0])).at[0].set(v))
 
     def update_memory(self, v, t, memory):
-        return (t, jnp.concatenate([v[np.asarray(self.dofs)][None], memory[1][:-1]], axis=0))
+        return self.memory_at(t, jnp.concatenate([v[np.asarray(self.dofs)][None], memory[1][:-1]],
+                                               axis=0))
 
     def force_rows(self, t, v, z, memory):
-        t_n, hist = memory
+        t_n, _, lagged = memory
         # the stage of the step: the nearest of the offsets the integrator declared
         offs = jnp.asarray(self.stage_offsets)
         r = jnp.argmin(jnp.abs((t - t_n) / self.dt - offs))
-        F = self.W_current[r] @ v[np.asarray(self.dofs)] + jnp.einsum("jab,jb->a", self.W_lag[r], hist)
+        F = self.W_current[r] @ v[np.asarray(self.dofs)] + lagged[r]
         return self.dofs, -F, None
 
     def coefficients(self, spec, omega):
@@ -128,10 +139,13 @@ class Convolution(NoRadiation):
     def build(cls, spec, dt, memory, stage_offsets):
         W_current, W_lag = spec.kernel(dt, memory, offsets=stage_offsets)
         T_K = spec.memory() if memory is None else float(memory)
-        return cls(W_current=jnp.asarray(W_current), W_lag=jnp.asarray(W_lag),
+        S, N, n, _ = W_lag.shape
+        # (S, N, n_a, n_b) -> (S, n_a, N·n_b): row a of offset s against the flattened history
+        W_flat = np.ascontiguousarray(np.transpose(W_lag, (0, 2, 1, 3)).reshape(S, n, N * n))
+        return cls(W_current=jnp.asarray(W_current), W_lag=jnp.asarray(W_flat),
                    dt=jnp.asarray(dt, jnp.float64), memory_length=float(T_K),
                    stage_offsets=tuple(float(s) for s in stage_offsets),
-                   dofs=tuple(spec.moving), n_lags=W_lag.shape[1])
+                   dofs=tuple(spec.moving), n_lags=N)
 
 
 class StateSpace(NoRadiation):
