@@ -473,6 +473,13 @@ def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=
     of output names (e.g. ``("point_acceleration",)``) records only those, and z comes back
     empty (the batch form: the loads' states are not kept per sample).
     """
+    args, options = _rollout_call(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integrator,
+                                  loads=loads, save_every=save_every, t0=t0, z0=z0, record=record)
+    return _rollout_jit(*args, **options)
+
+
+def _rollout_call(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0, z0, record):
+    """The arguments and static options of :func:`rollout`'s compiled call, checked."""
     loads = _as_loads(loads)
     integ = _integrators.get(integrator)
     if isinstance(n_steps, bool) or not isinstance(n_steps, numbers.Integral) or n_steps < 1:
@@ -485,10 +492,21 @@ def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=
     if z0 is None:
         parts = [ld.initial_state(model) for ld in loads]
         z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
-    return _rollout_jit(model, loads, q0, qd0, jnp.asarray(z0, jnp.float64),
-                        jnp.asarray(t0, jnp.float64), jnp.asarray(dt, jnp.float64),
-                        n_steps=int(n_steps), integrator=integ, save_every=int(save_every),
-                        record=record)
+    args = (model, loads, q0, qd0, jnp.asarray(z0, jnp.float64), jnp.asarray(t0, jnp.float64),
+            jnp.asarray(dt, jnp.float64))
+    return args, dict(n_steps=int(n_steps), integrator=integ, save_every=int(save_every),
+                      record=record)
+
+
+def _compile_ahead(model, q0, qd0, **options):
+    """Compile :func:`rollout`'s recorded call (``record=True``) for these arguments without
+    running it: the call that follows finds it compiled. Where the arguments cannot be made
+    (a bad value), nothing is compiled: the call itself then says what is wrong."""
+    try:
+        args, static = _rollout_call(model, q0, qd0, z0=None, record=True, **options)
+    except (ValueError, TypeError):
+        return
+    _rollout_jit.lower(*args, **static).compile()
 
 
 def _rollout_progress(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0, bar):
@@ -780,8 +798,15 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     free = []
     if check_stability:
         # one linearisation at q0 gives the shortest period and the coordinates that nothing
-        # pulls back (those of no_restoring(model, q0, loads=<the extra loads>), `mfm info`'s)
-        Jq, K = linearised_at_rest(model, q0, loads)
+        # pulls back (those of no_restoring(model, q0, loads=<the extra loads>), `mfm info`'s).
+        # Its compilation (a Jacobian of the dynamics) runs on a second thread while this one
+        # compiles the run, which then starts after the warnings below.
+        with concurrent.futures.ThreadPoolExecutor(1) as pool:
+            linearised = pool.submit(linearised_at_rest, model, q0, loads)
+            if progress is None:     # (a run in chunks compiles other functions)
+                _compile_ahead(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ,
+                               loads=loads, save_every=save_every, t0=t0)
+            Jq, K = linearised.result()
         free = free_coordinates(model, K)
     if check_stability and math.isfinite(integ.stability_limit):
         T_min = _period_from_jacobian(Jq)
