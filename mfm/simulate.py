@@ -79,10 +79,10 @@ AUTO_CONVOLUTION_LIMIT = 2e10
 def choose_radiation(model: Model, *, dt, n_steps, integrator="rk4", memory=None):
     """The radiation strategy ``radiation="auto"`` takes, and why: ``(name, reason)``.
 
-    The convolution costs n_steps × S × n_lags × n² multiply–adds (S the distinct stage offsets
-    of the integrator, at which the history sum is formed once per step, :class:`mfm.loads.radiation.Convolution`;
-    n the moved hydro dofs; n_lags = T_K/dt with T_K the memory from the decay of K, or
-    ``memory``); the state space a fit once (seconds to a minute) and then O(n · poles) per
+    The convolution costs n_steps × S × n_lags × n² multiply–adds (S the stage offsets of the
+    integrator, for each of which the history sum is formed once per step,
+    :class:`mfm.loads.radiation.Convolution`; n the moved hydro dofs; n_lags = T_K/dt with T_K the
+    memory from the decay of K, or ``memory``); the state space a fit once (seconds to a minute) and then O(n · poles) per
     evaluation. Above :data:`AUTO_CONVOLUTION_LIMIT` multiply–adds the state space is taken, its
     states advanced exactly (``"state_space_exact"``, stable with every integrator); below it the
     convolution, the direct evaluation of the Cummins integral with no fit. The reason is

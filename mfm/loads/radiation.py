@@ -87,8 +87,8 @@ class Convolution(NoRadiation):
 
     The history sum does not change within a step, so it is formed once per step for every
     offset, when the memory is updated, as one matrix–vector product ``W_lag`` (S, n, N·n) times
-    the history flattened (N·n): a stage then adds only W_c[s] ξ̇(t). (Formed per stage, the sum
-    cost S slices of W and four products of N·n² per RK4 step.) ``W_current`` (S, n, n).
+    the history flattened (N·n): a stage then adds only W_c[s] ξ̇(t). (Formed at every evaluation,
+    it cost a slice of W and a product of N·n² each time: four per RK4 step.) ``W_current`` (S, n, n).
     Memory: (t_n, history (N, n) newest first, the history sum for each offset (S, n))."""
     W_current: jnp.ndarray
     W_lag: jnp.ndarray
