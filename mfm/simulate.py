@@ -82,8 +82,8 @@ def choose_radiation(model: Model, *, dt, n_steps, integrator="rk4", memory=None
     The convolution costs n_steps × S × n_lags × n² multiply–adds (S the stage offsets of the
     integrator, for each of which the history sum is formed once per step,
     :class:`mfm.loads.radiation.Convolution`; n the moved hydro dofs; n_lags = T_K/dt with T_K the
-    memory from the decay of K, or ``memory``); the state space a fit once (seconds to a minute) and then O(n · poles) per
-    evaluation. Above :data:`AUTO_CONVOLUTION_LIMIT` multiply–adds the state space is taken, its
+    memory from the decay of K, or ``memory``); the state space a fit once (seconds to a minute)
+    and then O(n · poles) per evaluation. Above :data:`AUTO_CONVOLUTION_LIMIT` multiply–adds the state space is taken, its
     states advanced exactly (``"state_space_exact"``, stable with every integrator); below it the
     convolution, the direct evaluation of the Cummins integral with no fit. The reason is
     recorded in the result (``radiation_choice``)."""
@@ -94,7 +94,9 @@ def choose_radiation(model: Model, *, dt, n_steps, integrator="rk4", memory=None
     T_K = spec.memory() if memory is None else float(memory)
     n = len(spec.moving)
     lags = int(math.ceil(T_K / dt))
-    S = len(_stage_offsets(integ))
+    # an integrator of the user's that declares no offsets: its evaluations per step
+    offsets = getattr(integ, "stage_offsets", None)
+    S = len(offsets) if offsets else getattr(integ, "evaluations", 2)
     macs = float(n_steps) * S * lags * n * n
     what = (f"convolution {n_steps} steps × {S} stage offsets × {lags} lags (T_K {T_K:.3g} s / "
             f"dt {dt:.3g} s) × {n}² moved dofs = {macs:.2g} multiply–adds")
@@ -498,17 +500,6 @@ def _rollout_call(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every,
                       record=record)
 
 
-def _compile_ahead(model, q0, qd0, **options):
-    """Compile :func:`rollout`'s recorded call (``record=True``) for these arguments without
-    running it: the call that follows finds it compiled. Where the arguments cannot be made
-    (a bad value), nothing is compiled: the call itself then says what is wrong."""
-    try:
-        args, static = _rollout_call(model, q0, qd0, z0=None, record=True, **options)
-    except (ValueError, TypeError):
-        return
-    _rollout_jit.lower(*args, **static).compile()
-
-
 def _rollout_progress(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0, bar):
     """:func:`rollout` (``record=True``) in chunks with a progress bar: numpy outputs, the same
     values; it stops early once the state is non-finite."""
@@ -795,17 +786,21 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                         added_mass=added_mass, integrator=integ) + _as_loads(loads)
     q0 = _initial_vector(model, q0, "q0")
     qd0 = _initial_vector(model, qd0, "qd0")
+    # the recorded run's compiled call (a run in chunks, with a progress bar, compiles others)
+    run = None if progress is not None else _rollout_call(
+        model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
+        save_every=save_every, t0=t0, z0=None, record=True)
     free = []
     if check_stability:
         # one linearisation at q0 gives the shortest period and the coordinates that nothing
         # pulls back (those of no_restoring(model, q0, loads=<the extra loads>), `mfm info`'s).
         # Its compilation (a Jacobian of the dynamics) runs on a second thread while this one
-        # compiles the run, which then starts after the warnings below.
+        # compiles the run (jit's lower/compile: the call below finds it compiled), which then
+        # starts after the warnings below.
         with concurrent.futures.ThreadPoolExecutor(1) as pool:
             linearised = pool.submit(linearised_at_rest, model, q0, loads)
-            if progress is None:     # (a run in chunks compiles other functions)
-                _compile_ahead(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ,
-                               loads=loads, save_every=save_every, t0=t0)
+            if run is not None:
+                _rollout_jit.lower(*run[0], **run[1]).compile()
             Jq, K = linearised.result()
         free = free_coordinates(model, K)
     if check_stability and math.isfinite(integ.stability_limit):
@@ -829,8 +824,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
             AccuracyWarning, stacklevel=2)
     bar = _progress_bar(progress, n_steps, model.name)
     if bar is None:
-        out = rollout(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
-                      save_every=save_every, t0=t0, record=True)
+        out = _rollout_jit(*run[0], **run[1])
     else:
         out = _rollout_progress(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ,
                                 loads=loads, save_every=save_every, t0=t0, bar=bar)
