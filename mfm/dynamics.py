@@ -172,9 +172,10 @@ def reaction_loads(model: Model, ev: Evaluation):
     return jnp.stack(f), jnp.stack(m)
 
 
-def energies(model: Model, q, qd):
-    """Kinetic ½ q̇ᵀM*q̇ and potential (gravity Σ m g z_i + joint springs) energy, J."""
-    kin = kinematics(model, q, qd)
+def energies(model: Model, q, qd, kin=None):
+    """Kinetic ½ q̇ᵀM*q̇ and potential (gravity Σ m g z_i + joint springs) energy, J. ``kin``:
+    the kinematics at (q, q̇) where the caller has them (one copy less to compile)."""
+    kin = kinematics(model, q, qd) if kin is None else kin
     T = 0.5 * jnp.sum(kin.X * _apply_mass(model, kin.X))
     V = jnp.sum(model.mass * model.gravity * kin.E[:, 2, 3])
     V = V + 0.5 * jnp.sum(model.stiffness * (q - model.rest) ** 2)

@@ -207,7 +207,7 @@ def _record(model, loads, s, mem):
         diag.update(ld.diagnostics(ctx, out))
     ev_r = ev._replace(F=ev.F - (0.0 if body is None else body) + (0.0 if F is None else F))
     f_j, m_j = reaction_loads(model, ev_r)
-    T, V = energies(model, s.q, s.qd)
+    T, V = energies(model, s.q, s.qd, kin)
     angles = jax.vmap(se3.euler_zyx)(kin.E[:, :3, :3])
     return dict(body_position=kin.E[:, :3, 3], body_rotation=angles, joint_force=f_j,
                 joint_moment=m_j, kinetic_energy=T, potential_energy=V, qdd=ev.qdd, **diag)
@@ -239,10 +239,15 @@ def _saved(model, loads, s, mem, record):
 
 
 def _rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, record):
-    """The initial carry (integrator state, load memories) and its saved outputs."""
+    """The initial carry (integrator state, load memories) and its saved outputs (deferred ones
+    by the same vmapped program as the later samples', :func:`_record_deferred`)."""
     mem0 = _init_memories(model, loads, t0, q0, qd0, dt)
     state = integrator.init(dynamics_function(model, loads, mem0), t0, q0, qd0, z0)
-    return (state, mem0), _saved(model, loads, state, mem0, record)
+    carry = (state, mem0)
+    if _deferred(carry, record):
+        one = _record_deferred(model, loads, jax.tree_util.tree_map(lambda a: a[None], carry))
+        return carry, jax.tree_util.tree_map(lambda a: a[0], one)
+    return carry, _saved(model, loads, state, mem0, record)
 
 
 # per-sample memory (floats) up to which the outputs of a recorded run are computed after the
@@ -251,32 +256,45 @@ DEFERRED_RECORD_MEMORY = 10_000
 DEFERRED_RECORD_WIDTH = 32
 
 
+def _deferred(carry, record) -> bool:
+    """Whether a recorded run evaluates its outputs after the time loop (:func:`_rollout_blocks`):
+    ``record is True`` and a memory of at most :data:`DEFERRED_RECORD_MEMORY` floats."""
+    mem_size = sum(int(np.prod(np.shape(a))) for a in jax.tree_util.tree_leaves(carry[1]))
+    return record is True and mem_size <= DEFERRED_RECORD_MEMORY
+
+
 def _rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, record):
     """``n_blocks`` blocks of ``save_every`` steps from ``carry``: (carry, the saved outputs of
     each block's last step, stacked). With ``record is True`` and a small memory (the state
     space's, not the convolution's history) the loop keeps only the state and memory of each
-    saved step and the outputs are evaluated afterwards in one vmapped pass: the serial loop
-    carries the integration alone (RM3: recording every step cost 5× the integration inside it)."""
+    saved step and the outputs are evaluated afterwards in one vmapped pass
+    (:func:`_record_deferred`): the serial loop carries the integration alone (RM3: recording
+    every step cost 5× the integration inside it). ``record="carry"``: the saved carries
+    themselves, for that pass to be made by the caller."""
 
     def one_step(carry, _):
         s, mem = carry
         s = integrator.step(dynamics_function(model, loads, mem), s, dt)
         return (s, _update_memories(model, loads, s, mem)), None
 
-    mem_size = sum(int(np.prod(np.shape(a))) for a in jax.tree_util.tree_leaves(carry[1]))
-    deferred = record is True and mem_size <= DEFERRED_RECORD_MEMORY
+    deferred = record == "carry" or _deferred(carry, record)
 
     def block(carry, _):
         carry, _ = jax.lax.scan(one_step, carry, None, length=save_every)
         return carry, (carry if deferred else _saved(model, loads, *carry, record))
 
     carry, saved = jax.lax.scan(block, carry, None, length=n_blocks)
-    if deferred:
-        # groups of a fixed width: every sample is computed by the same vmapped program whatever
-        # n_blocks, so a run in chunks (progress bar) gives the same bits
-        saved = _map_in_groups(lambda sm: _saved(model, loads, *sm, record), saved,
-                               DEFERRED_RECORD_WIDTH)
+    if deferred and record is True:
+        saved = _record_deferred(model, loads, saved)
     return carry, saved
+
+
+def _record_deferred(model, loads, carries):
+    """The outputs (:func:`_saved`, ``record=True``) of stacked carries, in groups of a fixed
+    width: every sample is computed by the same vmapped program whatever their number, so a run
+    in chunks (progress bar) gives the same bits."""
+    return _map_in_groups(lambda sm: _saved(model, loads, *sm, True), carries,
+                          DEFERRED_RECORD_WIDTH)
 
 
 def _map_in_groups(f, xs, width):
@@ -293,9 +311,18 @@ def _map_in_groups(f, xs, width):
 
 def _rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_every, record):
     TRACES["rollout"] += 1
-    carry, first = _rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, record)
-    _, traj = _rollout_blocks(model, loads, carry, dt, n_steps // save_every, integrator,
-                              save_every, record)
+    n_blocks = n_steps // save_every
+    carry, first = _rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, False)
+    if _deferred(carry, record):
+        # the initial sample's outputs in the same pass as the others': one copy of the outputs'
+        # program to compile, not two (M4 134: ~4 s of a first call)
+        _, carries = _rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every,
+                                     "carry")
+        stacked = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), carry, carries)
+        return _record_deferred(model, loads, stacked)
+    if record is not False:
+        first = _saved(model, loads, *carry, record)
+    _, traj = _rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, record)
     return jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), first, traj)
 
 
@@ -698,6 +725,12 @@ def stable_dt(T_min: float, integ) -> float:
     return T_min * integ.stability_limit / (2 * math.pi)
 
 
+def _compile_ahead(jitted, *args, **static):
+    """Compile ``jitted`` for these arguments (jit's lower/compile): a later call with arguments
+    of the same structure and shapes finds it compiled, traced once."""
+    return jitted.lower(*args, **static).compile()
+
+
 def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="rk4",
              q0=None, qd0=None, loads=None, save_every: int = 1, t0: float = 0.0,
              ramp: float = 0.0, radiation: str = "auto", memory: float | None = None,
@@ -781,28 +814,43 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                                              memory=memory)
         if model.hydro is None:
             radiation = "convolution"          # no water: nothing to choose
-    loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp, radiation=radiation,
-                        memory=memory, state_space_options=state_space_options,
-                        added_mass=added_mass, integrator=integ) + _as_loads(loads)
     q0 = _initial_vector(model, q0, "q0")
     qd0 = _initial_vector(model, qd0, "qd0")
-    # the recorded run's compiled call (a run in chunks, with a progress bar, compiles others)
-    run = None if progress is not None else _rollout_call(
-        model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
-        save_every=save_every, t0=t0, z0=None, record=True)
+    extra = _as_loads(loads)
     free = []
-    if check_stability:
-        # one linearisation at q0 gives the shortest period and the coordinates that nothing
-        # pulls back (those of no_restoring(model, q0, loads=<the extra loads>), `mfm info`'s).
-        # Its compilation (a Jacobian of the dynamics) runs on a second thread while this one
-        # compiles the run (jit's lower/compile: the call below finds it compiled), which then
-        # starts after the warnings below.
-        with concurrent.futures.ThreadPoolExecutor(1) as pool:
-            linearised = pool.submit(linearised_at_rest, model, q0, loads)
-            if run is not None:
-                _rollout_jit.lower(*run[0], **run[1]).compile()
-            Jq, K = linearised.result()
-        free = free_coordinates(model, K)
+    # The checks' linearisation at q0 (a Jacobian of the dynamics, ~6 s to compile for M4 134)
+    # compiles on a second thread while this one builds the run's water (its radiation fit, in
+    # numpy) and compiles the run. An error here returns at once: that compilation finishes on
+    # its own.
+    pool = concurrent.futures.ThreadPoolExecutor(1)
+    try:
+        if check_stability:
+            # the loads at rest hold no sea and no radiation memory: still water's have their
+            # structure, so the Jacobian compiles while this thread builds the run's water
+            # (its radiation fit) and is then evaluated with the run's own loads
+            rest = _at_rest(model_loads(model, None, dt=dt, duration=duration, t0=t0, ramp=ramp,
+                                        radiation="none", added_mass=added_mass,
+                                        integrator=integ) + extra)
+            ahead = pool.submit(_compile_ahead, _stiffness_jacobian, model, rest,
+                                jnp.asarray(q0, jnp.float64))
+        loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
+                            radiation=radiation, memory=memory,
+                            state_space_options=state_space_options, added_mass=added_mass,
+                            integrator=integ) + extra
+        # the recorded run's call, compiled ahead of the checks' warnings
+        run = None if progress is not None else _rollout_call(
+            model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
+            save_every=save_every, t0=t0, z0=None, record=True)
+        if run is not None:
+            _compile_ahead(_rollout_jit, *run[0], **run[1])
+        if check_stability:
+            ahead.result()
+            # one linearisation at q0 gives the shortest period and the coordinates that nothing
+            # pulls back (those of no_restoring(model, q0, loads=<the extra loads>), `mfm info`'s)
+            Jq, K = linearised_at_rest(model, q0, loads)
+            free = free_coordinates(model, K)
+    finally:
+        pool.shutdown(wait=False)
     if check_stability and math.isfinite(integ.stability_limit):
         T_min = _period_from_jacobian(Jq)
         if math.isfinite(T_min) and 2 * math.pi * dt / T_min > integ.stability_limit:
