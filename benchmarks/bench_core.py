@@ -15,6 +15,7 @@ import jax.numpy as jnp
 import numpy as np
 
 os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
+os.environ.setdefault("MFM_FIT_CACHE", "off")          # fit times measured, not read from disk (hydro.fitcache)
 import mfm
 from timing import median_time
 

@@ -15,11 +15,13 @@ import argparse
 import ast
 import os
 import statistics
+import sys
 import time
 import warnings
 from pathlib import Path
 
 os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
+os.environ.setdefault("MFM_FIT_CACHE", "off")          # fit times measured, not read from disk (hydro.fitcache)
 import hydro
 import mfm
 
@@ -44,6 +46,8 @@ def main():
         for _ in range(args.repeats):
             m = mfm.load(CONFIGS / f"{name}.toml")
             m.hydro.database()
+            if "hydro.fitcache" in sys.modules:   # fits kept by content in the process
+                sys.modules["hydro.fitcache"].clear()
             t0 = time.perf_counter()
             ss = m.hydro.state_space(**options)
             times.append(time.perf_counter() - t0)

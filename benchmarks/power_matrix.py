@@ -38,6 +38,7 @@ from pathlib import Path
 
 import numpy as np
 os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
+os.environ.setdefault("MFM_FIT_CACHE", "off")          # fit times measured, not read from disk (hydro.fitcache)
 
 ROOT = Path(__file__).resolve().parents[1]
 TP, HS = np.round(np.linspace(0.8, 1.8, 12), 3), np.round(np.linspace(0.01, 0.06, 10), 3)

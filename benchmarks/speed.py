@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
+os.environ.setdefault("MFM_FIT_CACHE", "off")          # fits too (hydro.fitcache)
 
 ROOT = Path(__file__).resolve().parents[1]
 SEED_PER_STEP = 0.0044          # s, seed 001 Table 3 (MATLAB MFM, 111 layout, i5 laptop)
@@ -98,6 +99,8 @@ def child_m4(new, repeats, batch):
     if new:
         # the fit's own time, in a model that has none cached
         m_fresh = mfm.load(ROOT / "configs" / "m4_134.toml")
+        if "hydro.fitcache" in sys.modules:       # fits kept by content in the process
+            sys.modules["hydro.fitcache"].clear()
         t0 = time.perf_counter()
         m_fresh.hydro.state_space()
         res["fit"]["wall"] = time.perf_counter() - t0
@@ -214,8 +217,10 @@ def child_defaults():
 
 
 def run_child(tree, what, new, repeats, batch, cache="off"):
-    # cache: MFM_COMPILATION_CACHE of the child ("off": every compilation timed, none loaded)
-    env = dict(os.environ, PYTHONPATH=str(tree), OMP_NUM_THREADS="1", MFM_COMPILATION_CACHE=cache)
+    # cache: a folder for the child's compiled programs (MFM_COMPILATION_CACHE) and radiation fits
+    # (MFM_FIT_CACHE, a subfolder), or "off": every compilation and fit timed, none loaded
+    env = dict(os.environ, PYTHONPATH=str(tree), OMP_NUM_THREADS="1", MFM_COMPILATION_CACHE=cache,
+               MFM_FIT_CACHE=cache if cache == "off" else str(Path(cache) / "fits"))
     cmd = [sys.executable, str(Path(__file__).resolve()), "--child", what, "--repeats", str(repeats)]
     cmd += (["--new"] if new else []) + (["--batch"] if batch else [])
     t0 = time.perf_counter()
@@ -273,9 +278,10 @@ def report(new, old, rev):
     d = m4["defaults"]
     L.append(f"**`mfm.simulate(mfm.load('configs/m4_134.toml'), sea, duration=120, dt=0.006, "
              f"ramp=6)` with the defaults**, a fresh process (load, fit, compile, run, dataset): "
-             f"{d['wall']:.1f} s without a compilation cache ({d['filling']:.1f} s filling one); "
-             f"{d['cached']:.1f} s in a later fresh process that loads the compiled programs from "
-             f"it (`mfm._xla`); the same call again in one process {d['warm']:.1f} s. Integrator "
+             f"{d['wall']:.1f} s without caches ({d['filling']:.1f} s filling them); "
+             f"{d['cached']:.1f} s in a later fresh process that loads the compiled programs and "
+             f"the radiation fit from them (`mfm._xla`, `hydro.fitcache`); the same call again in "
+             f"one process {d['warm']:.1f} s. Integrator "
              f"{d['integrator']}; {d['choice']}.\n")
     s = m4["simulate rk4/state_space"]
     L.append(f"`mfm.simulate` (dataset recorded every step), RK4, state space: first {s['first']:.1f} s, "
@@ -343,8 +349,8 @@ def main():
         return
     new = {"rm3": run_child(ROOT, "rm3", True, args.repeats, False),
            "m4": run_child(ROOT, "m4", True, args.repeats, not args.skip_batch)}
-    # the defaults call in two fresh processes sharing a compilation cache: the second loads
-    # what the first compiled (mfm._xla)
+    # the defaults call in two fresh processes sharing the caches: the second loads what the
+    # first compiled and fitted (mfm._xla, hydro.fitcache)
     with tempfile.TemporaryDirectory() as cache:
         walls = [run_child(ROOT, "defaults", True, 0, False, cache=cache)["wall"] for _ in range(2)]
     new["m4"]["defaults"].update(filling=walls[0], cached=walls[1])

@@ -255,7 +255,9 @@ class HydroSpec:
         of the largest displaced volume: RM3's (0.2, 2.0) rad/s at full scale, 1.2–12 rad/s for the
         M4 model, so each database is fitted where its waves act (clipped to its grid). Only the
         dofs the model moves are fitted (:attr:`moving`), with one common pole set when more
-        than two bodies are coupled (``pole_sharing``, :func:`hydro.statespace.fit_state_space`)."""
+        than two bodies are coupled (``pole_sharing``, :func:`hydro.statespace.fit_state_space`).
+        A fit made before, in this process or an earlier one, is read back (:mod:`hydro.fitcache`).
+        """
         options.setdefault("dofs", tuple(self.dofs[k] for k in self.moving))
         # many coupled bodies: one pole set for all entries (states O(n_dof · order) instead of
         # the per-entry fit's O(n_dof² · order))
@@ -267,9 +269,10 @@ class HydroSpec:
             options["omega_fit"] = (max(0.2 * wc, float(om[0])), min(2.0 * wc, float(om[-1])))
         key = ("ss", tuple(sorted(options.items())))
         if key not in self._cache:
-            from .statespace import fit_state_space
+            from .fitcache import cached_fit
 
-            self._cache[key] = fit_state_space(self.database(), **options)
+            # kept by content, in the process and on disk (hydro.fitcache): seconds per fit
+            self._cache[key] = cached_fit(self.database(), **options)
         return self._cache[key]
 
     def kernel(self, dt: float, memory: float | None = None, subdivisions: int = 16,

@@ -18,14 +18,18 @@ if "xla_backend_optimization_level" not in os.environ.get("XLA_FLAGS", ""):
 # by the controller (before the workers start) and removed at its end, so a run never reads an
 # earlier run's compilations and times as CI does; a cache dir given from outside is kept as given.
 # Measured: hallak_wec's first linear_system 37 s -> 12 s in a second process.
-if "PYTEST_XDIST_WORKER" not in os.environ and "JAX_COMPILATION_CACHE_DIR" not in os.environ:
+# The state-space fits likewise (hydro.fitcache): one folder for the run, so a config fitted in
+# one worker or notebook is read back in the others, and never an earlier run's fits.
+if "PYTEST_XDIST_WORKER" not in os.environ:
     import atexit
     import shutil
     import tempfile
 
-    _CACHE = tempfile.mkdtemp(prefix="mfm-jax-cache-")
-    os.environ["JAX_COMPILATION_CACHE_DIR"] = _CACHE
-    atexit.register(shutil.rmtree, _CACHE, ignore_errors=True)
+    for _VAR, _PREFIX in (("JAX_COMPILATION_CACHE_DIR", "mfm-jax-cache-"),
+                          ("MFM_FIT_CACHE", "mfm-fit-cache-")):
+        if _VAR not in os.environ:
+            os.environ[_VAR] = tempfile.mkdtemp(prefix=_PREFIX)
+            atexit.register(shutil.rmtree, os.environ[_VAR], ignore_errors=True)
 # cache the small compilations too (the default keeps only those over 1 s)
 os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", "0.05")
 os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_ENTRY_SIZE_BYTES", "0")

@@ -1,0 +1,191 @@
+"""State-space radiation fits kept by their content: in the process and on disk.
+
+A fit (:func:`hydro.statespace.fit_state_space`) costs seconds (M4 134: ~5 s, Wu & Yuan: ~20 s)
+and depends only on the database's arrays, the fit's options and the fitting code. So a fit is
+kept under the sha256 of all three (with numpy's version: its linear algebra makes the bits):
+
+- in the process, so that a config loaded twice fits once (and its compiled run, keyed on the
+  fit's report, is reused);
+- on disk, as a pickle under ``$XDG_CACHE_HOME/mfm/fits`` (default ``~/.cache/mfm/fits``), so
+  that a later process reads it in milliseconds, like jax's compilation cache (:mod:`mfm._xla`).
+  ``MFM_FIT_CACHE`` names another folder, or ``off`` for none. The folder holds at most
+  :data:`CACHE_BYTES`, the least recently used dropped first. A file that cannot be read is
+  fitted again and written anew; a folder that cannot be written is warned about once and the
+  run goes on without it. Pickles run code when read: the folder is the user's own, as jax's is.
+
+A fit read back equals the one written to the last bit; its report gains ``cache``: the file it
+came from (``""`` when it was fitted in this process).
+"""
+from __future__ import annotations
+
+import collections
+import hashlib
+import os
+import pickle
+import tempfile
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+# the most the default folder may hold; a fit of M4 134 (960 states) is about 8 MB
+CACHE_BYTES = 512 * 2**20
+# fits kept in the process (the least recently used dropped first)
+MEMORY_ITEMS = 16
+# the code a fit depends on: a change in any of these files is another key
+_SOURCES = ("statespace.py", "radiation.py", "fitcache.py")
+
+_memory: collections.OrderedDict = collections.OrderedDict()
+_warned = False
+
+
+def cache_dir() -> Path | None:
+    """The folder of the disk cache, or None when ``MFM_FIT_CACHE`` is ``off``."""
+    setting = os.environ.get("MFM_FIT_CACHE", "").strip()
+    if setting.lower() in ("off", "0", "false", "no", "none"):
+        return None
+    if setting:
+        return Path(setting).expanduser()
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "mfm" / "fits"
+
+
+def fit_key(db, options: dict) -> str:
+    """sha256 of what a fit depends on: every array, dimension and attribute of ``db`` (the
+    database as the fit sees it), the options, the fitting code's source and numpy's version."""
+    h = hashlib.sha256()
+    for name in sorted(map(str, db.variables)):
+        v = db.variables[name]
+        a = np.ascontiguousarray(v.values)
+        h.update(f"{name}{v.dims}{a.dtype.str}{a.shape}".encode())
+        h.update(a.tobytes() if a.dtype.kind in "fciub" else repr(a.tolist()).encode())
+        h.update(repr(sorted(v.attrs.items(), key=repr)).encode())
+    h.update(repr(sorted(((k, v) for k, v in db.attrs.items() if k != "date_read"),
+                         key=repr)).encode())
+    h.update(repr(sorted(options.items(), key=repr)).encode())
+    here = Path(__file__).parent
+    for name in _SOURCES:
+        h.update((here / name).read_bytes())
+    h.update(np.__version__.encode())
+    return h.hexdigest()
+
+
+def clear() -> None:
+    """Forget the fits kept in this process (the folder's stay): what a benchmark that times
+    fits calls before each."""
+    _memory.clear()
+
+
+def _remember(key, fit):
+    _memory[key] = fit
+    _memory.move_to_end(key)
+    while len(_memory) > MEMORY_ITEMS:
+        _memory.popitem(last=False)
+    return fit
+
+
+def _with_source(fit, source: str):
+    import dataclasses
+    from types import MappingProxyType
+
+    return dataclasses.replace(fit, report=MappingProxyType({**fit.report, "cache": source}))
+
+
+def _to_plain(fit) -> dict:
+    """The fit's fields, its report as a dict (a mappingproxy does not pickle)."""
+    import dataclasses
+
+    return {f.name: (dict(getattr(fit, f.name)) if f.name == "report" else getattr(fit, f.name))
+            for f in dataclasses.fields(fit)}
+
+
+def _from_plain(fields: dict):
+    from types import MappingProxyType
+
+    from .statespace import StateSpaceRadiation
+
+    fit = StateSpaceRadiation(**{**fields, "report": MappingProxyType(fields["report"])})
+    for a in (fit.A, fit.B, fit.C, fit.added_mass_inf, *fit.poles, *fit.residues):
+        a.setflags(write=False)        # read-only, as fit_state_space makes them
+    return fit
+
+
+def _read(path: Path):
+    try:
+        with open(path, "rb") as f:
+            return _from_plain(pickle.load(f))
+    except FileNotFoundError:
+        return None
+    except Exception:                 # a damaged or foreign file: fitted again, written anew
+        return None
+    finally:
+        try:
+            os.utime(path)            # recently used: dropped last
+        except OSError:
+            pass
+
+
+def _write(folder: Path, path: Path, fit) -> None:
+    global _warned
+    tmp = None
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        # a whole file or none: written aside, then renamed (another process may read it now)
+        fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
+        with os.fdopen(fd, "wb") as f:
+            pickle.dump(_to_plain(fit), f, protocol=pickle.HIGHEST_PROTOCOL)
+        os.replace(tmp, path)
+        tmp = None
+        _trim(folder)
+    except Exception as e:            # the cache is a shortcut: never the reason a run fails
+        if not _warned:
+            warnings.warn(f"the state-space fit cache {folder} cannot be written ({e}); fits are "
+                          "kept in this process only. Set MFM_FIT_CACHE to a writable folder, or "
+                          "to off", RuntimeWarning, stacklevel=4)
+            _warned = True
+    finally:
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+
+
+def _trim(folder: Path, limit: int = CACHE_BYTES) -> None:
+    """Drop the least recently used fits until the folder holds at most ``limit`` bytes."""
+    files = []
+    for p in folder.glob("*.pkl"):
+        try:
+            st = p.stat()
+        except OSError:
+            continue
+        files.append((st.st_mtime, st.st_size, p))
+    total = sum(s for _, s, _ in files)
+    for _, size, p in sorted(files):
+        if total <= limit:
+            break
+        try:
+            p.unlink()
+            total -= size
+        except OSError:
+            pass
+
+
+def cached_fit(db, **options):
+    """:func:`hydro.statespace.fit_state_space` (``db``, ``options``), from the process's fits,
+    else the disk cache, else fitted (and kept in both)."""
+    key = fit_key(db, options)
+    if key in _memory:
+        _memory.move_to_end(key)
+        return _memory[key]
+    folder = cache_dir()
+    path = None if folder is None else folder / f"{key}.pkl"
+    fit = None if path is None else _read(path)
+    if fit is not None:
+        return _remember(key, _with_source(fit, str(path)))
+    from .statespace import fit_state_space
+
+    fit = fit_state_space(db, **options)
+    if path is not None:
+        _write(folder, path, fit)
+    return _remember(key, _with_source(fit, ""))

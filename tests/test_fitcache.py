@@ -1,0 +1,131 @@
+"""The state-space fit cache (hydro.fitcache): a fit read back from disk equals the fit made by
+fit_state_space itself to the last bit; the key follows the data, the options and the code; a
+damaged file is fitted again; ``off`` writes nothing; a folder that cannot be written warns once
+and the fit is still returned; the folder is trimmed least recently used first.
+
+Independent reference: hydro.statespace.fit_state_space called directly (no cache)."""
+import collections
+import dataclasses
+import os
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mfm
+from hydro import fitcache as FC
+from hydro import statespace as S
+
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
+ARRAYS = ("A", "B", "C", "added_mass_inf")
+
+
+@pytest.fixture(scope="module")
+def sphere_db():
+    return mfm.load(CONFIGS / "sphere.toml", hydro=True).hydro.database()
+
+
+@pytest.fixture
+def folder(tmp_path, monkeypatch):
+    """An empty cache folder and an empty in-process cache."""
+    monkeypatch.setenv("MFM_FIT_CACHE", str(tmp_path / "fits"))
+    monkeypatch.setattr(FC, "_memory", collections.OrderedDict())
+    return tmp_path / "fits"
+
+
+def _same_fit(a, b):
+    for name in ARRAYS:
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+    assert a.dofs == b.dofs and a.entries == b.entries
+    for pa, pb in zip(a.poles + a.residues, b.poles + b.residues):
+        np.testing.assert_array_equal(pa, pb)
+
+
+def test_a_fit_read_back_equals_the_fit(sphere_db, folder):
+    ref = S.fit_state_space(sphere_db)
+    made = FC.cached_fit(sphere_db)
+    files = list(folder.glob("*.pkl"))
+    assert len(files) == 1 and made.report["cache"] == ""
+    _same_fit(made, ref)
+    assert FC.cached_fit(sphere_db) is made              # the process keeps it
+    FC.clear()                                   # a later process: from the file
+    read = FC.cached_fit(sphere_db)
+    assert read.report["cache"] == str(files[0])
+    _same_fit(read, ref)
+    assert {k: v for k, v in read.report.items() if k != "cache"} == \
+        {k: v for k, v in made.report.items() if k != "cache"}
+    assert not read.A.flags.writeable and not read.poles[0].flags.writeable
+    # through the spec: HydroSpec.state_space uses it
+    FC.clear()
+    spec_fit = mfm.load(CONFIGS / "sphere.toml").hydro.state_space(omega_fit=(0.3, 3.0))
+    assert len(list(folder.glob("*.pkl"))) == 2 and spec_fit.report["cache"] == ""
+
+
+def test_the_key_follows_data_options_and_code(sphere_db, monkeypatch):
+    k = FC.fit_key(sphere_db, {})
+    assert FC.fit_key(sphere_db.copy(deep=True), {}) == k
+    assert FC.fit_key(sphere_db, {"order": 4}) != k
+    db = sphere_db.copy(deep=True)
+    B = db["radiation_damping"].values
+    B.flat[np.flatnonzero(B)[0]] *= 1 + 1e-15           # one value, one ulp
+    assert FC.fit_key(db, {}) != k
+    monkeypatch.setattr(FC, "_SOURCES", FC._SOURCES[:-1])  # other code: another key
+    assert FC.fit_key(sphere_db, {}) != k
+
+
+def test_a_damaged_file_is_fitted_again(sphere_db, folder):
+    folder.mkdir()
+    path = folder / f"{FC.fit_key(sphere_db, {})}.pkl"
+    path.write_bytes(b"not a pickle")
+    fit = FC.cached_fit(sphere_db)
+    assert fit.report["cache"] == ""
+    _same_fit(fit, S.fit_state_space(sphere_db))
+    FC.clear()
+    assert FC.cached_fit(sphere_db).report["cache"] == str(path)   # written anew
+
+
+def test_off_writes_nothing(sphere_db, tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    monkeypatch.setenv("MFM_FIT_CACHE", "off")
+    monkeypatch.setattr(FC, "_memory", collections.OrderedDict())
+    assert FC.cache_dir() is None
+    FC.cached_fit(sphere_db)
+    assert not any(tmp_path.rglob("*.pkl"))
+    monkeypatch.setenv("MFM_FIT_CACHE", "")
+    assert FC.cache_dir() == tmp_path / "mfm" / "fits"
+
+
+def test_a_folder_that_cannot_be_written_warns_once(sphere_db, tmp_path, monkeypatch):
+    blocker = tmp_path / "file"
+    blocker.write_text("a file where the folder would be")
+    monkeypatch.setenv("MFM_FIT_CACHE", str(blocker / "fits"))
+    monkeypatch.setattr(FC, "_memory", collections.OrderedDict())
+    monkeypatch.setattr(FC, "_warned", False)
+    with pytest.warns(RuntimeWarning, match="MFM_FIT_CACHE"):
+        fit = FC.cached_fit(sphere_db)
+    assert fit.report["cache"] == ""
+    FC.clear()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        FC.cached_fit(sphere_db, order=4)                # the second failure is silent
+    assert not list(tmp_path.glob("**/*.tmp"))
+
+
+def test_the_folder_is_trimmed_least_recently_used_first(tmp_path):
+    for k, name in enumerate(("old", "middle", "new")):
+        p = tmp_path / f"{name}.pkl"
+        p.write_bytes(b"x" * 100)
+        os.utime(p, (1000 + k, 1000 + k))
+    (tmp_path / "other.txt").write_bytes(b"x" * 1000)     # not a fit: left alone
+    FC._trim(tmp_path, limit=250)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["middle.pkl", "new.pkl", "other.txt"]
+
+
+def test_plain_form_round_trips_every_field(sphere_db):
+    fit = S.fit_state_space(sphere_db)
+    back = FC._from_plain(FC._to_plain(fit))
+    assert [f.name for f in dataclasses.fields(back)] == [f.name for f in dataclasses.fields(fit)]
+    _same_fit(back, fit)
+    assert dict(back.report) == dict(fit.report)
