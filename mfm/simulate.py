@@ -825,10 +825,11 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     pool = concurrent.futures.ThreadPoolExecutor(1)
     try:
         if check_stability:
-            # the loads at rest hold no sea and no radiation memory: still water's have their
-            # structure, so the Jacobian compiles while this thread builds the run's water
-            # (its radiation fit) and is then evaluated with the run's own loads
-            rest = _at_rest(model_loads(model, None, dt=dt, duration=duration, t0=t0, ramp=ramp,
+            # the loads at rest hold no sea, no radiation memory and no table of the run's
+            # length (Water.static_load): still water's, over one step, have their structure, so
+            # the Jacobian compiles while this thread builds the run's water (its radiation fit)
+            # and is then evaluated with the run's own loads
+            rest = _at_rest(model_loads(model, None, dt=dt, duration=dt, t0=t0, ramp=ramp,
                                         radiation="none", added_mass=added_mass,
                                         integrator=integ) + extra)
             ahead = pool.submit(_compile_ahead, _stiffness_jacobian, model, rest,
