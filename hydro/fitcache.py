@@ -51,19 +51,39 @@ def cache_dir() -> Path | None:
     return Path(base) / "mfm" / "fits"
 
 
+def _update(h, x) -> None:
+    """Hash ``x`` into ``h``: containers item by item, arrays by their bytes (a repr elides the
+    middle of a large array: two arrays could hash alike)."""
+    if isinstance(x, dict):
+        h.update(f"dict{len(x)}".encode())
+        for k in sorted(x, key=repr):
+            _update(h, k)
+            _update(h, x[k])
+        return
+    if isinstance(x, (list, tuple)):
+        h.update(f"{type(x).__name__}{len(x)}".encode())
+        for item in x:
+            _update(h, item)
+        return
+    a = None if isinstance(x, (str, bytes)) else np.asarray(x)
+    if a is not None and a.dtype.kind in "fciub":
+        h.update(f"{a.dtype.str}{a.shape}".encode())
+        h.update(np.ascontiguousarray(a).tobytes())
+    elif a is not None and a.ndim:
+        h.update(repr(a.tolist()).encode())        # labels: every item
+    else:
+        h.update(repr(x).encode())
+
+
 def fit_key(db, options: dict) -> str:
     """sha256 of what a fit depends on: every array, dimension and attribute of ``db`` (the
     database as the fit sees it), the options, the fitting code's source and numpy's version."""
     h = hashlib.sha256()
     for name in sorted(map(str, db.variables)):
         v = db.variables[name]
-        a = np.ascontiguousarray(v.values)
-        h.update(f"{name}{v.dims}{a.dtype.str}{a.shape}".encode())
-        h.update(a.tobytes() if a.dtype.kind in "fciub" else repr(a.tolist()).encode())
-        h.update(repr(sorted(v.attrs.items(), key=repr)).encode())
-    h.update(repr(sorted(((k, v) for k, v in db.attrs.items() if k != "date_read"),
-                         key=repr)).encode())
-    h.update(repr(sorted(options.items(), key=repr)).encode())
+        _update(h, (name, v.dims, v.values, dict(v.attrs)))
+    _update(h, {k: v for k, v in db.attrs.items() if k != "date_read"})
+    _update(h, dict(options))
     here = Path(__file__).parent
     for name in _SOURCES:
         h.update((here / name).read_bytes())

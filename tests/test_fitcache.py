@@ -71,6 +71,13 @@ def test_the_key_follows_data_options_and_code(sphere_db, monkeypatch):
     B = db["radiation_damping"].values
     B.flat[np.flatnonzero(B)[0]] *= 1 + 1e-15           # one value, one ulp
     assert FC.fit_key(db, {}) != k
+    # an array option differing in the middle (its repr would elide it): another key
+    w = np.linspace(0.1, 10.0, 5000)
+    w2 = w.copy()
+    w2[2500] += 1e-9
+    assert repr(w) == repr(w2)
+    assert FC.fit_key(sphere_db, {"passivity_omega": w}) != \
+        FC.fit_key(sphere_db, {"passivity_omega": w2})
     monkeypatch.setattr(FC, "_SOURCES", FC._SOURCES[:-1])  # other code: another key
     assert FC.fit_key(sphere_db, {}) != k
 
