@@ -82,11 +82,11 @@ def choose_radiation(model: Model, *, dt, n_steps, integrator="rk4", memory=None
     The convolution costs n_steps × S × n_lags × n² multiply–adds (S the stage offsets of the
     integrator, for each of which the history sum is formed once per step,
     :class:`mfm.loads.radiation.Convolution`; n the moved hydro dofs; n_lags = T_K/dt with T_K the
-    memory from the decay of K, or ``memory``); the state space a fit once (seconds to a minute)
-    and then O(n · poles) per evaluation. Above :data:`AUTO_CONVOLUTION_LIMIT` multiply–adds the state space is taken, its
-    states advanced exactly (``"state_space_exact"``, stable with every integrator); below it the
-    convolution, the direct evaluation of the Cummins integral with no fit. The reason is
-    recorded in the result (``radiation_choice``)."""
+    memory from the decay of K, or ``memory``); the state space a fit once (seconds to a minute) and
+    then O(n · poles) per evaluation. Above :data:`AUTO_CONVOLUTION_LIMIT` multiply–adds the state
+    space is taken, its states advanced exactly (``"state_space_exact"``, stable with every
+    integrator); below it the convolution, the direct evaluation of the Cummins integral with no
+    fit. The reason is recorded in the result (``radiation_choice``)."""
     if model.hydro is None:
         return "none", "no water"
     integ = _integrators.get(integrator)
@@ -312,7 +312,7 @@ def _map_in_groups(f, xs, width):
 def _rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_every, record):
     TRACES["rollout"] += 1
     n_blocks = n_steps // save_every
-    carry, first = _rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, False)
+    carry, _ = _rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, False)
     if _deferred(carry, record):
         # the initial sample's outputs in the same pass as the others': one copy of the outputs'
         # program to compile, not two (M4 134: ~4 s of a first call)
@@ -320,8 +320,7 @@ def _rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_e
                                      "carry")
         stacked = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), carry, carries)
         return _record_deferred(model, loads, stacked)
-    if record is not False:
-        first = _saved(model, loads, *carry, record)
+    first = _saved(model, loads, *carry, record)
     _, traj = _rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, record)
     return jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), first, traj)
 
@@ -643,14 +642,23 @@ def free_coordinates(model: Model, K) -> list[str]:
     return [c for k, c in enumerate(model.coordinates) if float(K[k, k]) <= 1e-9 * scale]
 
 
+def _still_water_loads(model: Model, loads=None, *, added_mass="lhs", integrator="rk4"):
+    """``model``'s own loads in still water (no radiation memory) and the extra ``loads``: what the
+    checks linearise at rest (:func:`_at_rest`). At rest they have the structure of every run's
+    loads at rest, whatever its sea, radiation and length (:meth:`Water.static_load` holds no
+    table of the run's length), so one compiled linearisation serves them all."""
+    return model_loads(model, None, dt=1.0, duration=1.0, radiation="none", added_mass=added_mass,
+                       integrator=integrator) + _as_loads(loads)
+
+
 def no_restoring(model: Model, q0=None, *, loads=None) -> list[str]:
     """The coordinates of ``model`` nothing pulls back at q0 (default 0, the start of
     :func:`simulate` and ``mfm simulate`` without ``--initial``), under its own loads in still
     water and ``loads`` (:func:`free_coordinates`): what ``mfm info`` reports, and what
     :func:`simulate` records in its ``no_restoring`` attribute for a run from the same q0 with
     the same extra loads, whatever its sea."""
-    lds = model_loads(model, None, dt=1.0, duration=1.0, radiation="none") + _as_loads(loads)
-    _, K = linearised_at_rest(model, _initial_vector(model, q0, "q0"), lds)
+    _, K = linearised_at_rest(model, _initial_vector(model, q0, "q0"),
+                              _still_water_loads(model, loads))
     return free_coordinates(model, K)
 
 
@@ -825,20 +833,19 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     pool = concurrent.futures.ThreadPoolExecutor(1)
     try:
         if check_stability:
-            # the loads at rest hold no sea, no radiation memory and no table of the run's
-            # length (Water.static_load): still water's, over one step, have their structure, so
-            # the Jacobian compiles while this thread builds the run's water (its radiation fit)
-            # and is then evaluated with the run's own loads
-            rest = _at_rest(model_loads(model, None, dt=dt, duration=dt, t0=t0, ramp=ramp,
-                                        radiation="none", added_mass=added_mass,
-                                        integrator=integ) + extra)
+            # still water's loads at rest have the structure of the run's, so the Jacobian
+            # compiles while this thread builds the run's water (its radiation fit) and is then
+            # evaluated with the run's own loads
+            rest = _at_rest(_still_water_loads(model, extra, added_mass=added_mass,
+                                               integrator=integ))
             ahead = pool.submit(_compile_ahead, _stiffness_jacobian, model, rest,
                                 jnp.asarray(q0, jnp.float64))
         loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                             radiation=radiation, memory=memory,
                             state_space_options=state_space_options, added_mass=added_mass,
                             integrator=integ) + extra
-        # the recorded run's call, compiled ahead of the checks' warnings
+        # the recorded run, compiled here: beside the Jacobian's compile where the water builds
+        # faster than that (no fit), and before the checks' warnings
         run = None if progress is not None else _rollout_call(
             model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
             save_every=save_every, t0=t0, z0=None, record=True)
