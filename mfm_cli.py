@@ -4,7 +4,7 @@ It is a top-level module, outside the ``mfm`` package, because importing anythin
 runs ``mfm/__init__``, which imports jax (about 2 s) and switches it to float64 before any
 submodule can use it. Here only the standard library is imported, so ``mfm --help``,
 ``mfm --version`` and a mistyped argument answer at once; :func:`main` imports the commands
-(:mod:`mfm.cli`) once the arguments are known to be good.
+(:mod:`mfm.io.cli`) once the arguments are known to be good.
 """
 from __future__ import annotations
 
@@ -148,7 +148,9 @@ def main(argv=None):
     """Parse ``argv`` (default: ``sys.argv[1:]``) and run the command; returns the exit code
     (0, or 2 with one ``mfm COMMAND: error: ...`` line for a config, input or simulation error)."""
     args = build_parser().parse_args(argv)
-    from mfm import cli   # the commands, and with them mfm and jax: only now that there is work
+    if getattr(args, "progress", None) is not None:
+        args.progress = progress_option(args.progress)     # simulate's progress= argument
+    from mfm.io import cli   # the commands, and with them mfm and jax: only now that there is work
 
     try:
         getattr(cli, args.func)(args)

@@ -20,7 +20,7 @@ os.environ.setdefault("MFM_FIT_CACHE", "off")          # fit times measured, not
 import hydro
 import mfm
 from timing import median_time
-from mfm.simulate import model_loads, rollout
+from mfm.timedomain.simulation import model_loads, rollout
 
 ROOT = Path(__file__).resolve().parents[1]
 warnings.simplefilter("ignore")

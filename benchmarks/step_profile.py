@@ -200,7 +200,7 @@ def main():
     import hydro
     import mfm
     from mfm import integrators
-    from mfm.simulate import _rollout_jit, model_loads
+    from mfm.timedomain.simulation import _rollout_jit, model_loads
 
     tp = 1.2
     dt = tp / 200

@@ -19,7 +19,7 @@ it in 60 iterations), RK4. About 17 min and 5.1 GB on the shared 2-core machine.
    60 periods, ramp 5 T, from the static equilibrium), the lines linearised about it in both
    domains (mfm.loads.catenary.linearise_lines): the complex amplitude of each hinge angle and of
    the platform's surge, heave and pitch over the last 10 periods (least squares with free terms
-   for the natural modes still alive there, :func:`alive`, mfm.wec.harmonic_amplitude) and each
+   for the natural modes still alive there, :func:`alive`, mfm.studies.wec.harmonic_amplitude) and each
    PTO's mean power there, against mfm.frequency_response(..., radiation="state_space") with the
    same fit: |TD/FD − 1| (the issue's acceptance: 1 %); and the same amplitudes from the 10
    periods before (what transient is left);
@@ -46,7 +46,7 @@ os.environ.setdefault("MFM_FIT_CACHE", "off")          # fit times measured, not
 import hydro
 import mfm
 from mfm.loads.catenary import linearise_lines
-from mfm.simulate import model_loads
+from mfm.timedomain.simulation import model_loads
 from timing import first_and_warm
 
 warnings.simplefilter("ignore", hydro.database.HydroDatabaseWarning)
@@ -65,7 +65,7 @@ def lap(t0, what):
 def alive(wn, zeta, t_start, omega):
     """The natural frequencies whose free transient can still be seen at t_start (e^{−ζ ω t} >
     1e-8; ζ ≤ 0 always), away from the wave's ω by > 10 %: the free terms of
-    mfm.wec.harmonic_amplitude. The long-dead modes are left out: the hinges' fourteen modes at
+    mfm.studies.wec.harmonic_amplitude. The long-dead modes are left out: the hinges' fourteen modes at
     4.1–4.9 s (ζ 0.55–0.75, dead in seconds) would put 56 near-ω columns into the least squares
     over 10 periods, which then take part of the wave's own harmonic (14 % at T 6 s, measured)."""
     wn, zeta = np.asarray(wn), np.asarray(zeta)
@@ -234,7 +234,7 @@ def main():
                 xs = []
                 for j in (0, 1):         # the last 10 periods, and the 10 before (transients left?)
                     sel = (t > t[-1] - (10 * j + 10) * T) & (t <= t[-1] - 10 * j * T)
-                    xs.append(mfm.wec.harmonic_amplitude(t[sel], ds.q.values[k, sel, i], om,
+                    xs.append(mfm.studies.wec.harmonic_amplitude(t[sel], ds.q.values[k, sel, i], om,
                                                          alive(wn, zeta, t[sel][0], om)))
                 errs[name] = abs(xs[0] / rao[i] - 1)
                 drift[name] = abs(xs[0] / xs[1] - 1)
@@ -270,7 +270,7 @@ def main():
             sel = t > t[-1] - n_win * T
             q = d.q.values[0, sel]
             ex = alive(wn, zeta, t[sel][0], om)
-            amp = {c: abs(mfm.wec.harmonic_amplitude(t[sel], q[:, lin.coordinates.index(c)], om, ex))
+            amp = {c: abs(mfm.studies.wec.harmonic_amplitude(t[sel], q[:, lin.coordinates.index(c)], om, ex))
                    for c in COMPARED}
             ten = d.fairlead_tension.values[0, sel]           # (step, line)
             out[label] = dict(mean=q[:, 0].mean() - q0[0], amp=amp, tmax=float(ten.max()),

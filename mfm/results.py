@@ -181,7 +181,7 @@ def _joint_dampers(ds, model, damping, q, qd, dim):
 
 
 # ------------------------------------------------------------------------------- time domain
-# what every run records per sample besides q, q̇, q̈ (mfm.simulate._record): dims after time, attrs
+# what every run records per sample besides q, q̇, q̈ (mfm.timedomain.simulation._record): dims after time, attrs
 RECORD_DIMS = {
     "body_position": (("body", "axis"), {"long_name": "centre of mass position, inertial axes",
                                          "units": "m"}),
@@ -235,7 +235,7 @@ def time_series(model, loads, integ, dt, t, q, qd, qdd, iters, rec, settings) ->
 
 def linear_time_series(model, loads, t, q, qd, qdd, q0, eta, settings, source=None,
                        dampers=()) -> xr.Dataset:
-    """The dataset of :func:`mfm.linear.linear_response`: q, q̇, q̈ (time, coordinate), the power
+    """The dataset of :func:`mfm.frequency.linear.linear_response`: q, q̇, q̈ (time, coordinate), the power
     of the joint dampers and of the loads' linearised PTOs (``dampers``, :func:`linear_dampers`),
     ``eta`` and the ``equilibrium`` it is linearised about."""
     ds = xr.Dataset(

@@ -22,10 +22,10 @@ import pytest
 from scipy.optimize import brentq
 
 import mfm
-from mfm.config import parse_config
+from mfm.io.config import parse_config
 from mfm.loads import CatenaryLines, JointLoad
 from mfm.loads.catenary import catenary_forces, linearise_lines
-from mfm.tree import ConfigError
+from mfm.mechanics.tree import ConfigError
 
 mp = pytest.importorskip("moorpy")
 
@@ -138,7 +138,7 @@ def _elastic_grounded(x, h, length, w, ea):
 
 def test_wu_yuan_line_at_rest(lines):
     model, ld = lines
-    from mfm.kinematics import kinematics
+    from mfm.mechanics.kinematics import kinematics
     import jax.numpy as jnp
 
     H, V, inside = (np.asarray(a) for a in ld.tensions(ld.fairleads.positions(
@@ -280,7 +280,7 @@ def test_fairlead_leaving_the_table_is_an_error_naming_the_line():
     model = hull_model()
     ld = CatenaryLines.create(model, wy_lines(table_extent=[3.0, 3.0], table_step=[0.5, 0.5]))
     assert (ld.table_margin(model, np.zeros(3)) > 2.9).all()
-    from mfm.simulate import SimulationError
+    from mfm.timedomain.simulation import SimulationError
 
     with pytest.raises(SimulationError, match=r"catenary line 'L\d' (left|was .* from the edge of) its table .*widen table_extent"):
         mfm.simulate(model, None, duration=20.0, dt=0.1, qd0={"hull.surge": 1.0}, loads=ld,
@@ -321,7 +321,7 @@ def test_tension_rao_is_the_lines_own_linearisation(lines):
     # frequency_outputs: for a unit surge amplitude the tension amplitude is ∂T/∂x, against a
     # central difference of MoorPy's tension (δ 1 cm) along each line's own direction (1e-4)
     model, ld = lines
-    from mfm.kinematics import kinematics
+    from mfm.mechanics.kinematics import kinematics
     import jax.numpy as jnp
 
     kin0 = kinematics(model, jnp.zeros(3))
@@ -381,7 +381,7 @@ def test_linearised_lines_are_the_first_order_expansion(lines):
     # force is f₀ + ∂f/∂r Δr exactly (1e-9) while the nonlinear lines' tensions differ from it by
     # more than 10 % of their change (the lines stiffen: H 390 → 638 kN at 5 m)
     model, ld = lines
-    from mfm.kinematics import kinematics
+    from mfm.mechanics.kinematics import kinematics
     import jax.numpy as jnp
 
     q0 = np.array([3.0, 1.0, -0.5])
@@ -543,7 +543,7 @@ def test_six_dof_stiffness_against_moorpy_finite_difference(wy_platform, pose):
     q0 = np.asarray(pose)
     ms, body = moorpy_platform(ld, com)
     # the same fairleads: MoorPy's rotation convention and mfm's free joint agree
-    from mfm.kinematics import kinematics
+    from mfm.mechanics.kinematics import kinematics
     import jax.numpy as jnp
 
     moorpy_generalised_forces(ms, body, com, q0)

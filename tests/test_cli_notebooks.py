@@ -8,7 +8,7 @@ import xarray as xr
 from conftest import CONFIGS, ROOT
 from nbclient import NotebookClient
 
-from mfm.cli import main
+from mfm_cli import main
 
 
 def test_cli_info(capsys):

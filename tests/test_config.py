@@ -6,7 +6,7 @@ import pytest
 
 import mfm
 from conftest import CONFIGS
-from mfm.config import parse_config
+from mfm.io.config import parse_config
 
 BASE = {
     "model": {"name": "t"},

@@ -4,7 +4,7 @@ import jax.numpy as jnp
 import numpy as np
 
 import mfm
-from mfm.config import parse_config
+from mfm.io.config import parse_config
 
 G = 9.81
 
@@ -173,7 +173,7 @@ def test_spd_solve_matches_lapack_across_the_unrolled_threshold():
     # the unrolled elimination (n ≤ 12) and the Cholesky path (n > 12) against numpy's LU solve on
     # SPD matrices with condition numbers up to 1e8 (M4 134's M* + HᵀA∞H is ~1e4): backward
     # stable, so the relative error is a few ε·cond
-    from mfm.dynamics import spd_solve
+    from mfm.mechanics.dynamics import spd_solve
     rng = np.random.default_rng(3)
     for n in (1, 2, 7, 12, 13, 20):
         for cond in (1.0, 1e4, 1e8):

@@ -117,7 +117,7 @@ def test_database_held_open_while_mfm_hydro_rewrites_it(tmp_path):
 
 def test_result_held_open_while_the_cli_writes_it(tmp_path):
     out = tmp_path / "run.nc"
-    cli = [sys.executable, "-m", "mfm.cli", "simulate", str(ROOT / "configs" / "double_pendulum.toml"),
+    cli = [sys.executable, "-m", "mfm", "simulate", str(ROOT / "configs" / "double_pendulum.toml"),
            "--duration", "0.2", "--dt", "0.01", "--initial", "upper.angle=0.3", "--out", str(out)]
     r = run_python(f"""
         import os, subprocess, numpy as np, xarray as xr

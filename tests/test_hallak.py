@@ -21,7 +21,7 @@ import mfm
 from conftest import CONFIGS
 from mfm.frequency import (_mass_and_damping_at, critical_damping, cubic_natural_frequencies,
                            linear_system, natural_frequencies)
-from mfm.simulate import choose_radiation
+from mfm.timedomain.simulation import choose_radiation
 
 RHO, G = 1000.0, 9.80665
 OMEGA = np.round(0.19 + 0.03 * np.arange(48), 2)      # Table 4 (index 46: 1.54, printed 1.55)
@@ -210,7 +210,7 @@ def test_massless_column_hulls_are_checked_with_the_platform():
 def test_scenario_reading_another_configs_database_is_checked_by_its_hulls():
     """hallak_hydro_coupled.toml has no [hydro.bem]: it reads the fully coupled config's database,
     whose hulls it shares; the staleness check compares the hulls (and finds them equal)."""
-    from mfm.bemgen import database_is_stale
+    from mfm.io.bemgen import database_is_stale
 
     stale, why = database_is_stale(CONFIGS / "hallak_hydro_coupled.toml")
     assert not stale and "matches the hulls" in why

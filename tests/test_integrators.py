@@ -5,7 +5,7 @@ import pytest
 import scipy.linalg
 
 import mfm
-from mfm.config import parse_config
+from mfm.io.config import parse_config
 from mfm.loads import Load, LoadOutput
 
 M, K, C = 2.0, 50.0, 1.5          # slider mass, spring, damper

@@ -6,8 +6,9 @@ import jax.numpy as jnp
 import numpy as np
 from conftest import CONFIGS
 
+from hydro.prepare import HydroSpec
 import mfm
-from mfm.simulate import TRACES
+from mfm.timedomain.simulation import TRACES
 
 MODEL = mfm.load(CONFIGS / "m4_111.toml", hydro=False)  # mechanics in vacuum
 Q0 = np.array([0.0, 0.0, 0.05, -0.1])
@@ -80,7 +81,7 @@ def test_the_same_config_loaded_twice_compiles_once():
     # any difference in the data is another key: other drag, or an attribute set after the spec
     # was made (its hash is not frozen at construction)
     spec = a.hydro
-    other = mfm.water.HydroSpec(spec.db, spec.body_index, spec.config_names, spec.ref0 - spec.d_ref,
+    other = HydroSpec(spec.db, spec.body_index, spec.config_names, spec.ref0 - spec.d_ref,
                                 np.array([[0.0, 0.0, 1.0]]))
     assert other != spec
     changed = copy.copy(spec)

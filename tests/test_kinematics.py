@@ -6,7 +6,7 @@ from conftest import CONFIGS
 
 import mfm
 from mfm import se3
-from mfm.config import parse_config
+from mfm.io.config import parse_config
 
 RNG = np.random.default_rng(3)
 # All comparisons below are between exact expressions evaluated in float64 on O(1)–O(10) numbers;

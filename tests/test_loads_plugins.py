@@ -13,7 +13,7 @@ from conftest import CONFIGS, ROOT
 import hydro
 import mfm
 from mfm.loads import BodyPointOutputs, JointLoad, LinearBodyMatrix
-from mfm.wec import harmonic_amplitude
+from mfm.studies.wec import harmonic_amplitude
 
 pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 
@@ -77,7 +77,7 @@ def test_model_type_does_not_build():
     # mfm.model is the type; building (config → tree → model + loads) lives in mfm.build
     src = (ROOT / "mfm" / "model.py").read_text()
     assert "load_config" not in src and "def load(" not in src
-    assert mfm.load is mfm.build.load
+    assert mfm.load is mfm.io.build.load
 
 
 def _sphere_heave_config(tmp_path, extra=""):
@@ -130,7 +130,7 @@ def test_hinge_preload_equilibrium_by_hand():
     # a rod on a hinge with a torsion spring k, CoM at distance L below the hinge; preload τ:
     # τ − k θ − m g L sin θ = 0, solved by hand with scipy's brentq
     from scipy.optimize import brentq
-    from mfm.config import parse_config
+    from mfm.io.config import parse_config
 
     k, mass, L, tau = 300.0, 10.0, 0.5, 40.0
     model = mfm.compile_tree(parse_config({"bodies": [
@@ -228,7 +228,7 @@ def test_hydraulic_pto_enters_the_frequency_domain():
     # β damps it, in the linearisation exactly as k = κ, m = μ, c = β on the heave coordinate
     m = mfm.load(CONFIGS / "sphere.toml")
     from mfm.loads import HydraulicPTO
-    from mfm.points import BodyPoints
+    from mfm.mechanics.points import BodyPoints
 
     i = m.body_index("sphere")
     pto = HydraulicPTO(a=BodyPoints.on_bodies(m.com, [i], [[0.0, 0.0, -0.3]]),
@@ -247,7 +247,7 @@ def test_hydraulic_pto_enters_the_frequency_domain():
 
 def test_config_tables_come_from_the_registry():
     from mfm.loads.registry import TABLES, load_class
-    from mfm.config import TOP_KEYS
+    from mfm.io.config import TOP_KEYS
 
     for table in TABLES:
         assert table in TOP_KEYS
@@ -268,7 +268,7 @@ def test_integrator_stage_offsets_drive_the_convolution():
     with pytest.raises(TypeError, match="stage_offsets"):
         mfm.simulate(m, None, duration=0.1, dt=0.01, integrator=Silent())
     # RK4 evaluates at 0, dt/2, dt: one weight set per stage
-    from mfm.simulate import model_loads
+    from mfm.timedomain.simulation import model_loads
 
     ld = model_loads(m, None, dt=0.01, duration=0.1, memory=1.0)[0]
     assert ld.rad.W_lag.shape[0] == 3 and ld.rad.stage_offsets == (0.0, 0.5, 1.0)

@@ -65,7 +65,7 @@ def test_every_shipped_config_loads_without_capytaine():
 
 
 def test_mfm_hydro_without_capytaine_prints_the_install_command(tmp_path):
-    r = _run(NO_CAPYTAINE + "from mfm.cli import main\n"
+    r = _run(NO_CAPYTAINE + "from mfm_cli import main\n"
              f"sys.exit(main(['hydro', 'configs/m4_111.toml', '--out', {str(tmp_path / 'x.nc')!r}]))")
     assert r.returncode == 2, r.stderr
     assert 'pip install -e ".[bem]"' in r.stderr and "Traceback" not in r.stderr
@@ -127,7 +127,7 @@ def test_wamit_nan_token_and_truncated_line_name_file_and_line(rm3_copy):
                                           ("nan", "nan"), ("true", "True")])
 def test_hydro_rho_must_be_a_positive_number(tmp_path, value, shown):
     from mfm import ConfigError
-    from mfm.config import load_config
+    from mfm.io.config import load_config
 
     p = _config_copy(tmp_path, "rm3.toml", **{"body_coupling = true":
                                              f"body_coupling = true\nrho = {value}"})
@@ -137,7 +137,7 @@ def test_hydro_rho_must_be_a_positive_number(tmp_path, value, shown):
 
 def test_binary_config_names_the_file(tmp_path):
     from mfm import ConfigError
-    from mfm.config import load_config
+    from mfm.io.config import load_config
 
     p = tmp_path / "model.toml"
     p.write_bytes(b"\x89PNG\r\n\x1a\n\x00\xff\xfe binary")
@@ -166,7 +166,7 @@ def test_empty_or_foreign_netcdf_names_the_file(tmp_path):
 
 # ------------------------------------------------------------------------------ stale databases
 def test_edited_hull_radius_makes_the_database_stale(tmp_path):
-    from mfm.bemgen import database_is_stale
+    from mfm.io.bemgen import database_is_stale
 
     for c in SHIPPED:
         stale, why = database_is_stale(c)
@@ -261,8 +261,8 @@ file = "hull.stl"
 
 # ------------------------------------------------------------------------------ swapped bodies
 def _wet(config, names=None):
-    from mfm.config import load_config
-    from mfm.water import open_any_database
+    from mfm.io.config import load_config
+    from hydro.prepare import open_any_database
 
     options, bodies = load_config(config)
     h = options["hydro"]
@@ -318,11 +318,12 @@ def test_help_and_version_import_neither_mfm_nor_jax():
     assert r.returncode == 0, r.stderr
     assert "mfm 0." in r.stdout or "mfm unknown" in r.stdout
     assert "--no-plot" in r.stdout
-    # the old entry points are the same function
-    import mfm.cli
+    # the old entry point (mfm.cli.main, a moved path that warns once) is the same function
     import mfm_cli
 
-    assert mfm.cli.main is mfm_cli.main
+    with pytest.warns(FutureWarning, match="mfm_cli.main"):
+        from mfm.cli import main as old_main
+    assert old_main is mfm_cli.main
 
 
 @pytest.mark.parametrize("argv, match", [
@@ -335,7 +336,7 @@ def test_help_and_version_import_neither_mfm_nor_jax():
     (["simulate", "C", "--wave", "regular", "--height", "-2", "--period", "8"], "--height: '-2'"),
 ])
 def test_cli_argument_checks(argv, match, capsys):
-    from mfm.cli import main
+    from mfm_cli import main
 
     argv = [str(CONFIGS / "rm3.toml") if a == "C" else a for a in argv]
     with pytest.raises(SystemExit) as e:
@@ -345,7 +346,7 @@ def test_cli_argument_checks(argv, match, capsys):
 
 
 def test_cli_checks_out_before_the_run(tmp_path, capsys):
-    from mfm.cli import main
+    from mfm_cli import main
 
     blocker = tmp_path / "file"
     blocker.write_text("x")
@@ -362,7 +363,7 @@ def test_cli_checks_out_before_the_run(tmp_path, capsys):
 
 
 def test_rao_summary_never_calls_the_grid_edge_a_peak():
-    from mfm.cli import _peak_text
+    from mfm.io.cli import _peak_text
 
     om = np.linspace(0.2, 2.0, 10)
     assert _peak_text(om, 1 / om, "m/m").startswith("no peak inside the grid (largest |RAO| 5 m/m "
@@ -377,7 +378,7 @@ def test_info_and_the_run_summary_name_the_same_free_coordinates(tmp_path, capsy
     it: K_ss = 0, and tilting the arm makes it slide, so K is indefinite): `mfm info` and the
     `mfm simulate` summary print the same line, naming the slider only. (They disagreed: info
     read K's diagonal at q = 0, the run a zero column of ∂q̈/∂q, which the arm's coupling fills.)"""
-    from mfm.cli import main
+    from mfm_cli import main
 
     cfg = tmp_path / "slider.toml"
     cfg.write_text("""
@@ -416,7 +417,7 @@ damping = 0.1
 def test_rm3_spar_surge_drift_said_by_info_and_the_run_summary(tmp_path, capsys):
     """RM3 has no surge restoring (no mooring): `mfm info` and the `mfm simulate` summary name
     spar.surge, and only it, in the same line (in waves too); the result file carries the list."""
-    from mfm.cli import main
+    from mfm_cli import main
 
     assert main(["info", str(CONFIGS / "rm3.toml")]) == 0
     out = capsys.readouterr().out
@@ -449,7 +450,7 @@ def test_plot_result_files(tmp_path, capsys):
     """`mfm simulate` draws its PNG beside the NetCDF; `mfm plot` draws simulation, RAO and
     batch files."""
     from hydro.database import split_complex
-    from mfm.cli import main
+    from mfm_cli import main
 
     nc = tmp_path / "dp.nc"
     assert main(["simulate", str(CONFIGS / "double_pendulum.toml"), "--duration", "1", "--dt",
@@ -482,7 +483,7 @@ def test_layouts_in_one_figure_keep_their_own_titles():
     import matplotlib.pyplot as plt
 
     import mfm
-    from mfm.plotting import plot_layout
+    from mfm.io.plotting import plot_layout
 
     fig, axes = plt.subplots(2, 2)
     for row, name in zip(axes, ("m4_111", "m4_132")):
@@ -518,7 +519,7 @@ def _same_numbers(a, b):
 
 
 def test_chunk_plan_one_length_few_blocks_wasted():
-    from mfm.simulate import chunk_plan
+    from mfm.timedomain.simulation import chunk_plan
 
     assert chunk_plan(7) == (1, 7)
     for n in (21, 100, 211, 2000, 20000, 99991):
@@ -532,7 +533,7 @@ def test_progress_bar_gives_the_same_numbers_with_one_compilation(capsys):
     the last one past the end, its extra step dropped) and writes the bar to stderr; the results
     equal the unchunked run's to the last bit."""
     import mfm
-    from mfm.simulate import TRACES
+    from mfm.timedomain.simulation import TRACES
 
     m = mfm.load(CONFIGS / "double_pendulum.toml")
     kw = dict(duration=2.11, dt=0.01, q0={"upper.angle": 0.5}, integrator="rk4")
@@ -582,7 +583,7 @@ def test_cli_progress_choice(tmp_path, capsys):
     (refreshed every 10 s); on shows it at once."""
     import io
 
-    from mfm.cli import main
+    from mfm_cli import main
     from mfm_cli import progress_option
 
     class Terminal(io.StringIO):

@@ -9,8 +9,8 @@ from conftest import CONFIGS
 
 import hydro
 import mfm
-from mfm.cli import main
-from mfm.config import parse_config
+from mfm_cli import main
+from mfm.io.config import parse_config
 
 # per module, not session-wide: a database warning is expected here (the shipped BEM data)
 pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")

@@ -5,7 +5,7 @@ import xarray as xr
 from conftest import CONFIGS
 
 import mfm
-from mfm.config import parse_config
+from mfm.io.config import parse_config
 
 MODEL = mfm.load(CONFIGS / "m4_134.toml", hydro=False)  # mechanics in vacuum
 
@@ -66,7 +66,7 @@ def test_auto_radiation_takes_the_cheaper_and_says_why():
     # history sum is formed once per step for each stage offset: RK4 3, Verlet 2): M4 134 (24
     # moved dofs, T_K ≈ 39 s) over 100 T_p at T_p/200 with RK4 is 2e11 multiply–adds (minutes):
     # the state space; 200 steps of it (2e9) and RM3's 2000 steps (5e7): the convolution.
-    from mfm.simulate import AUTO_CONVOLUTION_LIMIT, choose_radiation
+    from mfm.timedomain.simulation import AUTO_CONVOLUTION_LIMIT, choose_radiation
 
     m4 = mfm.load(CONFIGS / "m4_134.toml")
     name, why = choose_radiation(m4, dt=0.006, n_steps=20_000)
@@ -89,7 +89,7 @@ def test_outputs_computed_after_the_loop_equal_those_inside_it(monkeypatch):
 
     import jax
 
-    S = importlib.import_module("mfm.simulate")   # the module (mfm.simulate is also the function)
+    S = importlib.import_module("mfm.timedomain.simulation")   # the module (mfm.simulate is also the function)
     m = mfm.load(CONFIGS / "double_pendulum.toml")
     kw = dict(duration=1.37, dt=0.01, q0={"upper.angle": 0.8}, save_every=1)
     after = mfm.simulate(m, **kw)

@@ -20,8 +20,8 @@ import hydro
 import mfm
 from mfm import wec
 from mfm.frequency import linear_system
-from mfm.kinematics import kinematics
-from mfm.points import BodyPoints
+from mfm.mechanics.kinematics import kinematics
+from mfm.mechanics.points import BodyPoints
 
 pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 

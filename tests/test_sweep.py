@@ -21,7 +21,7 @@ import hydro
 import mfm
 from conftest import CONFIGS
 
-sweep_mod = sys.modules["mfm.sweep"]          # mfm.sweep is the function
+sweep_mod = sys.modules["mfm.studies.sweep"]          # mfm.sweep is the function
 
 pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 
@@ -79,7 +79,7 @@ def test_threads_and_lanes_give_the_same_cases(rm3, seas, reference):
     """simulate_batch runs its cases in parts from host threads (one per core by default) and in
     groups of ``lanes`` vmapped together: every split must give the reference's numbers (RTOL:
     only the vmapped round-off differs), a padded last part included, once compiled per shape."""
-    trace = sys.modules["mfm.simulate"].TRACES
+    trace = sys.modules["mfm.timedomain.simulation"].TRACES
     before = trace["rollout"]
     # 3 cases in 2 threads: parts of 2, the last padded by repeating its case, dropped after;
     # lanes=2 is a shape nothing else here compiles: the two threads share one compilation
@@ -187,7 +187,7 @@ def test_missing_dask_names_the_extra(rm3, seas, monkeypatch):
 
 
 def _traces():
-    return dict(sys.modules["mfm.simulate"].TRACES)
+    return dict(sys.modules["mfm.timedomain.simulation"].TRACES)
 
 
 def test_two_worker_cluster_equals_one_batch_and_compiles_once_per_worker(rm3, seas, reference):

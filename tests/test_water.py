@@ -8,6 +8,7 @@ import pytest
 from conftest import CONFIGS, ROOT
 
 import hydro
+from hydro.prepare import HydroSpec
 import mfm
 from mfm.frequency import equilibrium, frequency_response, natural_frequencies
 
@@ -53,11 +54,11 @@ def test_sphere_heave_free_decay_period():
         w = math.sqrt(C33 / (mass + float(db.added_mass.interp(omega=w)[2, 2])))
     T_n = 2 * math.pi / w
     # the same sphere with heave alone free
-    bodies = mfm.config.parse_config({"bodies": [
+    bodies = mfm.io.config.parse_config({"bodies": [
         {"name": "sphere", "mass": mass, "com": [0, 0, -0.3], "principal_inertia": [833.3] * 3,
          "joint": {"type": "free", "dofs": ["heave"]}}]})[1]
     heave = mfm.compile_tree(bodies, name="sphere heave")
-    heave = dataclasses.replace(heave, hydro=mfm.water.load_hydro_spec(
+    heave = dataclasses.replace(heave, hydro=mfm.loads.water.load_hydro_spec(
         heave, bodies, {"database": str(ROOT / "hydro" / "data" / "sphere.nc")}, ROOT))
     ds = mfm.simulate(heave, None, duration=6 * T_n, dt=T_n / 200, q0=[0.05])
     t, z = ds.time.values, ds.q.values[:, 0]
@@ -187,7 +188,7 @@ def test_drag_decay_is_analytic():
     # only −½ρC_D A|u|u acting, u(t) = u₀/(1 + k u₀ t/M), k = ½ρC_D A (M includes A∞).
     m = load("sphere")
     spec = m.hydro
-    spec2 = mfm.water.HydroSpec(spec.db, spec.body_index, spec.config_names, np.asarray(m.com)[[0]],
+    spec2 = HydroSpec(spec.db, spec.body_index, spec.config_names, np.asarray(m.com)[[0]],
                                 np.array([[0.0, 0.0, 2.0 * math.pi]]))
     spec2.C_wp = np.zeros_like(spec2.C_wp)
     spec2.volume = np.zeros_like(spec2.volume)

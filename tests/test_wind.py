@@ -12,7 +12,7 @@ import pytest
 from conftest import CONFIGS, ROOT
 
 import mfm
-from mfm.config import parse_config
+from mfm.io.config import parse_config
 from mfm.loads import BodyPointOutputs, LinearBodyMatrix, WindThrust
 from mfm.loads.wind import WindWarning
 

@@ -81,7 +81,7 @@ def test_locked_variant_is_model_m_with_rigid_hinges(tmp_path):
     """The severe-sea variant (tools/wu_yuan_configs.py config_text(m, locked=True)): the same
     bodies, hulls, lines and database as model m, every hinge locked (no coordinate, no PTO
     damper, no preload): 6 coordinates. Parsed only (the water and the lines are model m's)."""
-    from mfm.config import load_config
+    from mfm.io.config import load_config
 
     gen = generator()
     for m in (1, 5):

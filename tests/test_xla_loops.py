@@ -12,7 +12,7 @@ import pytest
 import hydro
 import mfm
 from mfm import _xla, integrators
-from mfm.simulate import _rollout_jit, model_loads
+from mfm.timedomain.simulation import _rollout_jit, model_loads
 
 from conftest import CONFIGS, ROOT
 
@@ -35,7 +35,7 @@ def _rm3_rollout_script(n_steps):
     """The rollout both processes run: RM3 in a regular wave, Verlet with exact radiation."""
     return f"""
 import json, jax.numpy as jnp, hydro, mfm
-from mfm.simulate import model_loads
+from mfm.timedomain.simulation import model_loads
 m = mfm.load({str(CONFIGS / 'rm3.toml')!r})
 q0 = jnp.zeros(m.n_coordinates)
 q, qd = mfm.rollout(m, q0, q0, dt=0.1, n_steps={n_steps}, integrator="verlet",

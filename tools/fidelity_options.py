@@ -119,7 +119,7 @@ def head_sea_dofs(model):
 def run_level(model, sea, level, settings, ss_options=None):
     """One pilot run of ``level`` (the levels of mfm.fidelity) and its warm wall time: the second
     call, as mfm.reduce times it."""
-    from mfm.fidelity import LEVEL_OPTIONS, Reduction
+    from mfm.studies.fidelity import LEVEL_OPTIONS, Reduction
 
     T = settings["T"]
     dt = T / PILOT["steps_per_period"]
@@ -135,7 +135,7 @@ def run_level(model, sea, level, settings, ss_options=None):
 
     def go():
         if red is None:
-            from mfm.linear import linear_response
+            from mfm.frequency.linear import linear_response
             return linear_response(model, sea, duration=duration, dt=dt, ramp=ramp,
                                    state_space_options=ss_options)
         return red.run(model, sea, duration=duration)
@@ -152,7 +152,7 @@ def run_level(model, sea, level, settings, ss_options=None):
 
 
 def measure(ds, settings):
-    from mfm.fidelity import _measures
+    from mfm.studies.fidelity import _measures
 
     T = settings["T"]
     return _measures(ds, slice(PILOT["settle_periods"] * T, None), settings["coordinates"])
@@ -160,8 +160,8 @@ def measure(ds, settings):
 
 def expected(model, sea, coordinates):
     """The spectral level's expected statistics (no time series): mean power per PTO, std per
-    coordinate, in the keys of mfm.fidelity._measures."""
-    from mfm.spectral import spectral_response
+    coordinate, in the keys of mfm.studies.fidelity._measures."""
+    from mfm.frequency.spectral import spectral_response
 
     ds = spectral_response(model, sea)
     out = {f"pto_power[{p}]": float(ds.pto_power_mean.sel(pto=p)) for p in ds.pto.values}
@@ -185,7 +185,7 @@ def plan(system):
 
 def study(system, path, log=print):
     import mfm
-    from mfm.fidelity import _errors
+    from mfm.studies.fidelity import _errors
 
     settings = SYSTEMS[system]
     data = json.loads(path.read_text()) if path.exists() else {}

@@ -5,7 +5,7 @@ excitation modulus against the finest mesh.
     python tools/mesh_convergence.py configs/stansby_li.toml --dx 1.4 1.0 --omega 0.5 1.0 1.5
 
 Every solve uses the config's own [hydro.bem] settings with ``dx``, ``omega``, one heading
-(``--heading``, degrees) and ω = ∞ (the reader needs it) overridden (`mfm.bemgen.generate(overrides=...)`), into a
+(``--heading``, degrees) and ω = ∞ (the reader needs it) overridden (`mfm.io.bemgen.generate(overrides=...)`), into a
 temporary directory; capytaine is needed. Modes: ``--modes`` (default Surge Heave Pitch).
 """
 import argparse
@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from hydro.prepare import open_any_database
-from mfm.bemgen import generate
+from mfm.io.bemgen import generate
 
 
 def main():

@@ -49,8 +49,8 @@ T/25 (every case saves there: the same estimator for all):
 
 Wall time: ``warm_s`` is the median of repeated warm calls (3 when a call is under 2 s, 2 under
 5 s — RM3's rows: 10 s —, else 1; each row has its ``repeats``) of what a run costs once compiled: the loads for this sea and grid
-(:func:`mfm.simulate.model_loads`: excitation tables, convolution weights, exact propagators) and
-the compiled rollout (:func:`mfm.simulate.rollout`, no per-sample outputs) to its last sample;
+(:func:`mfm.timedomain.simulation.model_loads`: excitation tables, convolution weights, exact propagators) and
+the compiled rollout (:func:`mfm.timedomain.simulation.rollout`, no per-sample outputs) to its last sample;
 ``compile_s`` is the first call's excess over it (tracing and XLA compilation; the state-space fit
 is made before and cached). A run that goes non-finite is recorded as ``"non-finite"`` with the
 time it stopped.
@@ -121,7 +121,7 @@ SYSTEMS = {
 
 
 def _sim():
-    return importlib.import_module("mfm.simulate")
+    return importlib.import_module("mfm.timedomain.simulation")
 
 
 def load_system(system, **overrides):
@@ -235,7 +235,7 @@ def linear_case(model, sea, cfg, *, n_per_T, time_it=True):
     ``status = "refused"`` and the ``reason``."""
     import mfm
 
-    lin = importlib.import_module("mfm.linear")
+    lin = importlib.import_module("mfm.frequency.linear")
     T = cfg["T"]
     kw = dict(duration=cfg["periods"] * T, dt=T / n_per_T, ramp=5 * T,
               save_every=n_per_T // SAVE_PER_PERIOD)

@@ -32,7 +32,7 @@ MODES = ("surge", "sway", "heave", "roll", "pitch", "yaw")
 
 
 class Context(NamedTuple):
-    """Where a load is evaluated. ``kin``: the :class:`~mfm.kinematics.Kinematics` at (q, q̇);
+    """Where a load is evaluated. ``kin``: the :class:`~mfm.mechanics.kinematics.Kinematics` at (q, q̇);
     ``z``: the load's own states; ``memory``: its discrete memory of the current step (read-only
     within a step); ``qdd_guess``: the acceleration iterate of a predictor–corrector integrator
     (Beeman) or None; ``qdd``: the accelerations, known only when outputs are recorded."""

@@ -17,9 +17,9 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
-from ..parsing import body_ref, number, tables
-from ..points import BodyPoints
-from ..tree import ConfigError
+from ..validation import body_ref, number, tables
+from ..mechanics.points import BodyPoints
+from ..mechanics.tree import ConfigError
 from .base import MODES, Load, LoadOutput
 
 KEYS = {"name", "body", "point", "stiffness", "damping", "damping_ratio", "notes"}
@@ -86,7 +86,7 @@ class LinearBodyMatrix(Load):
 
     @classmethod
     def from_parsed(cls, parsed, model):
-        from ..frequency import critical_damping
+        from ..frequency.response import critical_damping
 
         idx = [model.body_index(t["body"]) for t in parsed]
         pts = []

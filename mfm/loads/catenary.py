@@ -64,9 +64,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..parsing import body_ref, number, tables, unknown, vector
-from ..points import BodyPoints
-from ..tree import ConfigError
+from ..validation import body_ref, number, tables, unknown, vector
+from ..mechanics.points import BodyPoints
+from ..mechanics.tree import ConfigError
 from .base import Load, LoadOutput
 
 LINE_KEYS = {"length", "weight", "mass_per_length", "EA", "seabed_friction"}
@@ -207,7 +207,7 @@ class CatenaryLines(Load):
         V, each line's derivatives taken from its table at r_F,0 (jax). The fairleads move with
         their bodies as before; :func:`mfm.equilibrium` and :func:`mfm.frequency_response` give the
         same results with either (the same force and derivative at q₀)."""
-        from ..kinematics import kinematics
+        from ..mechanics.kinematics import kinematics
 
         if self.linear:
             raise ValueError("linearised: these catenary lines are linearised already")
@@ -290,7 +290,7 @@ class CatenaryLines(Load):
     def table_margin(self, model, q):
         """Per line the smallest distance (m) from the fairlead's (x, z) at q to its table's
         edge, negative outside."""
-        from ..kinematics import kinematics
+        from ..mechanics.kinematics import kinematics
 
         x, z, _ = (np.asarray(a) for a in self.spans(self.fairleads.positions(
             kinematics(model, jnp.asarray(q, jnp.float64)))))
@@ -301,7 +301,7 @@ class CatenaryLines(Load):
         return np.array(out)
 
     def describe_nonfinite(self, model, q, qd):
-        from ..kinematics import kinematics
+        from ..mechanics.kinematics import kinematics
 
         q = np.asarray(q, dtype=float)
         if self.linear or not np.isfinite(q).all():      # linearised lines have no table to leave
@@ -455,7 +455,7 @@ def linearise_lines(model, q0=None):
     """``model`` with each of its :class:`CatenaryLines` loads replaced by
     :meth:`CatenaryLines.linearised` about ``q0`` (default: the static equilibrium of the model,
     :func:`mfm.equilibrium`). Raises ValueError when the model has no catenary lines."""
-    from ..frequency import equilibrium
+    from ..frequency.response import equilibrium
 
     if not any(isinstance(ld, CatenaryLines) for ld in model.loads):
         raise ValueError(f"model: {model.name!r} has no [[catenary_lines]] to linearise")

@@ -18,9 +18,9 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
-from ..parsing import body_ref, number, tables, vector
-from ..points import BodyPoints
-from ..tree import ConfigError
+from ..validation import body_ref, number, tables, vector
+from ..mechanics.points import BodyPoints
+from ..mechanics.tree import ConfigError
 from .base import LinearDampers, Load, LoadOutput
 
 PTO_KEYS = {"name", "kind", "body", "point", "anchor_body", "anchor", "mu", "beta", "kappa", "notes"}

@@ -11,8 +11,8 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
-from ..parsing import number, tables
-from ..tree import ConfigError
+from ..validation import number, tables
+from ..mechanics.tree import ConfigError
 from .base import Load, LoadOutput
 
 

@@ -10,15 +10,15 @@ from __future__ import annotations
 import jax.numpy as jnp
 import numpy as np
 
-from ..points import BodyPoints
-from ..tree import ConfigError
+from ..mechanics.points import BodyPoints
+from ..mechanics.tree import ConfigError
 from .base import Load, LoadOutput
-from ..parsing import body_ref, tables, vector
+from ..validation import body_ref, tables, vector
 
 
 class PointSprings(Load):
     """Linear springs at body points (e.g. a linear mooring), N. ``points`` the attachment points
-    (:class:`~mfm.points.BodyPoints`, p₀ = their positions at q = 0); ``stiffness`` (m, 3) N/m."""
+    (:class:`~mfm.mechanics.points.BodyPoints`, p₀ = their positions at q = 0); ``stiffness`` (m, 3) N/m."""
     points: BodyPoints
     stiffness: jnp.ndarray
 

@@ -12,9 +12,9 @@ from __future__ import annotations
 import equinox as eqx
 import numpy as np
 
-from ..parsing import body_ref, tables, vector
-from ..points import BodyPoints
-from ..tree import ConfigError
+from ..validation import body_ref, tables, vector
+from ..mechanics.points import BodyPoints
+from ..mechanics.tree import ConfigError
 from .base import Load, LoadOutput
 
 

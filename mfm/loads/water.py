@@ -40,8 +40,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .. import se3
-from ..points import BodyPoints
+from ..mechanics import se3
+from ..mechanics.points import BodyPoints
 from .base import FrequencyTerms, Load, LoadOutput
 from .radiation import NoRadiation, grid_subdivisions, strategy
 
@@ -94,7 +94,7 @@ class Water(Load):
         return self.rad.n_states
 
     def init_memory(self, model, t0, q0, qd0, dt):
-        from ..kinematics import kinematics
+        from ..mechanics.kinematics import kinematics
 
         v, _ = self.geometry.velocity_and_bias(kinematics(model, q0, qd0))
         return self.rad.init_memory(v, t0)
@@ -234,8 +234,8 @@ class Water(Load):
     def describe_nonfinite(self, model, q, qd):
         if self.added_mass != "rhs":
             return None
-        from ..dynamics import mass_matrix
-        from ..kinematics import kinematics
+        from ..mechanics.dynamics import mass_matrix
+        from ..mechanics.kinematics import kinematics
 
         # the fixed-point iteration a ← M*⁻¹(F − Hᵀ A∞ H a) contracts only if the spectral radius
         # of M*⁻¹ Hᵀ A∞ H is below 1
@@ -254,7 +254,7 @@ class Water(Load):
         """Still water, no memory: buoyancy, water-plane stiffness, A∞ (in the mass). Its tables
         are two rows of zeros (the interpolation clips to them: zero at every t) whatever the
         run's length: the loads at rest of every run of a model have one structure (one compiled
-        linearisation, :func:`mfm.simulate.linearised_at_rest`) and hold no table of the run's
+        linearisation, :func:`mfm.timedomain.simulation.linearised_at_rest`) and hold no table of the run's
         length (M4 134, 10⁶ RK4 steps: 0.8 GB)."""
         def zeros(a):
             return jnp.zeros((2,) + a.shape[1:], a.dtype)
@@ -307,7 +307,7 @@ class Water(Load):
             F̂_ξ(ω) = X(ω, β) − [−ω² (A(ω) − A∞) − iω B(ω)] H₀ x̂
 
         (A∞ is in the mass, hydrostatics and buoyancy in the static load), as body wrenches at q₀
-        (the map of :meth:`~mfm.points.BodyPoints.to_body_wrench`, linear: real and imaginary
+        (the map of :meth:`~mfm.mechanics.points.BodyPoints.to_body_wrench`, linear: real and imaginary
         parts each)."""
         A_rel, B, X, H0 = self._frequency_coefficients(kin0, omega, heading, options,
                                                        options.get("excitation", True))
@@ -394,7 +394,7 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
     from hydro.database import HydroDatabaseWarning, select_bodies
     from hydro.prepare import HydroSpec, open_any_database
 
-    from ..tree import ConfigError
+    from ..mechanics.tree import ConfigError
 
     path = Path(options["database"])
     if not path.is_absolute():
@@ -437,7 +437,7 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
 def _h_samples(model, geo, qs):
     """H(q) at each row of qs, in one compiled call (op by op, the tree walk was ~180 small
     compilations: 8 s of loading M4 134); compiled once per model structure."""
-    from ..kinematics import kinematics
+    from ..mechanics.kinematics import kinematics
 
     return jax.vmap(lambda q: geo.h_matrix(kinematics(model, q, jnp.zeros_like(q)))[0])(qs)
 

@@ -44,9 +44,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..parsing import body_ref, number, tables, vector
-from ..points import BodyPoints
-from ..tree import ConfigError
+from ..validation import body_ref, number, tables, vector
+from ..mechanics.points import BodyPoints
+from ..mechanics.tree import ConfigError
 from .base import Load, LoadOutput
 
 KEYS = {"name", "body", "hub", "rotor_radius", "wind_speed", "thrust_coefficient", "rho_air",

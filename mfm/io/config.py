@@ -1,4 +1,4 @@
-"""TOML float-tree configs → validated :class:`~mfm.tree.BodySpec` lists.
+"""TOML float-tree configs → validated :class:`~mfm.mechanics.tree.BodySpec` lists.
 
 Format (every key is checked; an unknown key is an error)::
 
@@ -37,12 +37,12 @@ from typing import Any
 
 import numpy as np
 
-from .loads.registry import TABLES as LOAD_TABLES
-from .loads.registry import load_class
-from .parsing import number as _number
-from .parsing import unknown as _unknown
-from .parsing import vector as _vector
-from .tree import (JOINT_KINDS, PLANAR_DOFS, ROOT_DOFS, BodySpec, ConfigError, JointSpec,
+from ..loads.registry import TABLES as LOAD_TABLES
+from ..loads.registry import load_class
+from ..validation import number as _number
+from ..validation import unknown as _unknown
+from ..validation import vector as _vector
+from ..mechanics.tree import (JOINT_KINDS, PLANAR_DOFS, ROOT_DOFS, BodySpec, ConfigError, JointSpec,
                    check_inertia, tree_order)
 
 # the tables of loads (moorings, ptos, ...) come from the load registry (mfm.loads.registry)

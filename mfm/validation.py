@@ -1,10 +1,10 @@
 """Small checks shared by every config table parser (the body tree and the load tables): each
-raises :class:`~mfm.tree.ConfigError` naming the key path, the value and what is accepted."""
+raises :class:`~mfm.mechanics.tree.ConfigError` naming the key path, the value and what is accepted."""
 from __future__ import annotations
 
 import numpy as np
 
-from .tree import ConfigError
+from .mechanics.tree import ConfigError
 
 
 def unknown(keys, allowed, where):

@@ -43,9 +43,9 @@ import jax.numpy as jnp
 import numpy as np
 import xarray as xr
 
-from . import frequency as _fd
-from . import results
-from .model import Model
+from . import response as _fd
+from .. import results
+from ..mechanics.model import Model
 from .spectral import _check_sea
 
 # the largest condition number of the mode matrix V accepted: the modes' round-off grows as
@@ -54,7 +54,7 @@ MAX_MODE_CONDITION = 1e10
 
 
 def _number(value, what, **kw):
-    from .simulate import _number as number
+    from ..timedomain.simulation import _number as number
 
     return number(value, what, **kw)
 
@@ -113,7 +113,7 @@ def modal_step(A, B, layout, dt):
 
 
 def _modal_step(A, B, layout, dt):
-    from .loads.radiation import phi_functions
+    from ..loads.radiation import phi_functions
 
     lam, V = np.linalg.eig(A)
     W = np.linalg.solve(V, np.eye(len(lam)))
@@ -218,7 +218,7 @@ def lti_response(M, C, K, f, dt, *, save_every: int = 1, H0=None, rad=None, free
 
 def _free_columns(K):
     """Coordinates nothing depends on the position of: a zero column of K (≤ 1e-9 of its largest
-    entry, the threshold of :func:`mfm.simulate.free_coordinates`)."""
+    entry, the threshold of :func:`mfm.timedomain.simulation.free_coordinates`)."""
     scale = max(float(np.abs(K).max()), 1e-300)
     return [k for k in range(K.shape[1]) if float(np.abs(K[:, k]).max()) <= 1e-9 * scale]
 
@@ -247,9 +247,9 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
     from hydro.excitation import excitation_time_series
     from hydro.waves import elevation
 
-    from .loads.base import Load
-    from .loads.radiation import StateSpace
-    from .loads.water import Water
+    from ..loads.base import Load
+    from ..loads.radiation import StateSpace
+    from ..loads.water import Water
 
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: linear_response needs a "

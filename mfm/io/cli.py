@@ -1,8 +1,9 @@
 """Command line: ``mfm info | simulate | rao | hydro | plot``: the commands.
 
 The parser and the entry point are in the top-level module :mod:`mfm_cli` (importing this module
-imports the ``mfm`` package, and with it jax); ``main`` and ``build_parser`` are re-exported
-here. Each command imports the rest of what it needs (xarray, matplotlib, hydro) itself.
+imports the ``mfm`` package, and with it jax): it calls the commands here, and nothing here
+imports it back. Each command imports the rest of what it needs (xarray, matplotlib, hydro)
+itself.
 """
 from __future__ import annotations
 
@@ -10,10 +11,8 @@ import sys
 import time
 from pathlib import Path
 
-from mfm_cli import build_parser, main, progress_option  # noqa: F401  (main: re-exported)
 
 LENGTH_SUFFIXES = ("surge", "sway", "heave", "stroke")
-
 
 def _unit(coordinate: str) -> str:
     """SI unit of a coordinate from its name: root surge/sway/heave and prismatic strokes are
@@ -64,7 +63,7 @@ def cmd_info(args):
     import numpy as np
 
     import mfm
-    from mfm.config import load_config
+    from mfm.io.config import load_config
 
     options, _ = load_config(args.config)
     wet = "hydro" in options and not args.no_hydro
@@ -102,7 +101,7 @@ def cmd_info(args):
     print(f"\ntotal mass {float(model.mass.sum()):g} kg")
     if args.no_restoring:
         return
-    from mfm.simulate import no_restoring
+    from mfm.timedomain.simulation import no_restoring
 
     print("\nrestoring at q0 = 0, where `mfm simulate` starts without --initial (" +
           ("with the water" if wet else "mechanics only: no [hydro] table" if "hydro" not in options
@@ -155,7 +154,7 @@ def cmd_simulate(args):
                           q0=_pairs(args.initial, "--initial"),
                           qd0=_pairs(args.initial_velocity, "--initial-velocity"),
                           save_every=args.save_every, ramp=args.ramp, radiation=args.radiation,
-                          progress=progress_option(args.progress))
+                          progress=args.progress)
     except mfm.SimulationError as e:
         # keep what was computed: the run up to the last finite sample, marked incomplete
         if e.dataset is not None:
@@ -184,7 +183,7 @@ def cmd_simulate(args):
             print(f"  mean power of {p}: {float(half.pto_power.sel(pto=p).mean()):.6g} W")
     print("  " + _restoring_text(ds.attrs.get("no_restoring", "not checked")))
     if not args.no_plot:
-        from mfm.plotting import save_result_plot
+        from mfm.io.plotting import save_result_plot
 
         save_result_plot(ds, png)
         print(f"  figure -> {png}")
@@ -192,7 +191,7 @@ def cmd_simulate(args):
 
 def _restoring_text(no_restoring: str) -> str:
     """The line on free drift of ``mfm info`` and of the ``mfm simulate`` summary, from the
-    coordinates :func:`mfm.simulate.no_restoring` names (comma-separated, as in a result's
+    coordinates :func:`mfm.timedomain.simulation.no_restoring` names (comma-separated, as in a result's
     ``no_restoring`` attribute)."""
     if no_restoring == "not checked":
         return "restoring not checked (check_stability=False)"
@@ -251,7 +250,7 @@ def cmd_rao(args):
 
 
 def cmd_hydro(args):
-    from mfm.bemgen import generate
+    from mfm.io.bemgen import generate
 
     generate(args.config, out=args.out, force=args.force, n_threads=args.threads)
 
@@ -263,7 +262,7 @@ def cmd_plot(args):
     src = Path(args.config)
     if src.suffix == ".nc":
         out = _writable(args.out or src.with_suffix(".png"), "--out", (".png",))
-        from mfm.plotting import save_result_plot
+        from mfm.io.plotting import save_result_plot
 
         if not src.exists():
             raise FileNotFoundError(f"result file {str(src)!r} not found")
@@ -277,7 +276,7 @@ def cmd_plot(args):
         return
     out = _writable(args.out or Path(src.with_suffix(".png").name), "--out", (".png",))
     import mfm
-    from mfm.plotting import plot_layout
+    from mfm.io.plotting import plot_layout
 
     model = mfm.load(args.config, hydro=False)
     fig = plot_layout(model)
@@ -285,5 +284,3 @@ def cmd_plot(args):
     print(f"layout of {model.name} -> {out}")
 
 
-if __name__ == "__main__":
-    sys.exit(main())

@@ -44,7 +44,7 @@ and the BEM settings in ``[hydro.bem]`` (every key checked, unknown keys are err
 
 Bodies without a ``geometry`` table are dry (not in the database). The reference point of each
 body's 6 modes defaults to its CoM at q = 0: the MFM applies loads about the CoM, and
-:mod:`mfm.water` maps any reference point anyway.
+:mod:`mfm.loads.water` maps any reference point anyway.
 
 The file is written atomically (a temporary file, checked by loading it the way ``mfm.load``
 does, then renamed), so a failed or interrupted run never leaves a partial database.
@@ -64,7 +64,7 @@ from pathlib import Path
 import numpy as np
 
 from .config import load_config
-from .tree import ConfigError
+from ..mechanics.tree import ConfigError
 
 BEM_KEYS = {"omega_min", "omega_max", "n_omega", "omega", "headings_deg", "water_depth", "dx",
             "lid", "symmetry", "infinite_frequency", "rho", "g", "deep_water_kh", "notes"}
@@ -373,8 +373,8 @@ def database_is_stale(config_path, database=None) -> tuple[bool, str]:
 def _check_database(path: Path, config_path: Path, options: dict, bodies) -> None:
     """Load ``path`` the way ``mfm.load(config)`` does (open_any_database → from_capytaine →
     schema checks → the config's bodies on the tree)."""
-    from .compile import compile_tree
-    from .loads.water import load_hydro_spec
+    from ..mechanics.compile import compile_tree
+    from ..loads.water import load_hydro_spec
 
     model = compile_tree(bodies, name=options["name"], gravity=options["gravity"])
     hyd = dict(options.get("hydro") or {})

@@ -3,7 +3,7 @@
 A tree is a list of bodies; each body hangs from its parent (or from the inertial frame, for a
 root: usually one, several for bodies that are not connected, such as two floats that interact only
 through the water) by a joint. Everything here is plain numpy and Python: it is checked once, when a config
-is loaded, and then compiled into a :class:`mfm.model.Model` of jax arrays.
+is loaded, and then compiled into a :class:`mfm.mechanics.model.Model` of jax arrays.
 
 Conventions (DESIGN §2): inertial frame with origin on the still-water line, z up. Each body frame
 sits at the body's centre of mass and is parallel to the inertial frame at q = 0. Joint axes and

@@ -4,9 +4,9 @@ cheapest level whose answer stays within a tolerance of the full model on the sc
 The levels, cheapest first:
 
 - ``"spectral"``: the linear frequency-domain response summed over the sea's components
-  (:func:`mfm.spectral.spectral_response`), no time stepping. Linear about the equilibrium: no
+  (:func:`mfm.frequency.spectral.spectral_response`), no time stepping. Linear about the equilibrium: no
   drag, no large rotations, no stops.
-- ``"linear"``: the same linear model in the time domain (:func:`mfm.linear.linear_response`):
+- ``"linear"``: the same linear model in the time domain (:func:`mfm.frequency.linear.linear_response`):
   radiation by the state-space fit, the modes stepped exactly; it has the start-up transient and
   ramp that the spectral level's steady state has not.
 - ``"fast"``: the full nonlinear model stepped once per step (``integrator="verlet"``) with the
@@ -37,8 +37,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .model import Model
-from .spectral import _check_sea
+from ..mechanics.model import Model
+from ..frequency.spectral import _check_sea
 
 LEVELS = ("spectral", "linear", "fast", "full")
 # the run options each time-domain level gives mfm.simulate
@@ -102,19 +102,19 @@ class Reduction:
         duration = _positive(duration, "duration")
         model = variant_model(model, self.variant)
         if self.level == "spectral":
-            from .spectral import spectral_response
+            from ..frequency.spectral import spectral_response
             t = self.dt * np.arange(int(round(duration / self.dt)) + 1)
             return spectral_response(model, sea, t=t)
         ramp = self.pilot[1] if ramp is None else ramp
         if self.level == "linear":
-            from .linear import linear_response
+            from ..frequency.linear import linear_response
             return linear_response(model, sea, duration=duration, dt=self.dt, ramp=ramp)
-        simulate = importlib.import_module("mfm.simulate").simulate
+        simulate = importlib.import_module("mfm.timedomain.simulation").simulate
         return simulate(model, sea, duration=duration, dt=self.dt, ramp=ramp, **self.options)
 
 
 def _positive(value, what):
-    return importlib.import_module("mfm.simulate")._number(value, what, positive=True)
+    return importlib.import_module("mfm.timedomain.simulation")._number(value, what, positive=True)
 
 
 def _measures(ds, window, coordinates):

@@ -1,4 +1,4 @@
-"""Validated bodies (in tree order) → a :class:`~mfm.model.Model`: static topology, jax-array
+"""Validated bodies (in tree order) → a :class:`~mfm.mechanics.model.Model`: static topology, jax-array
 parameters. The step of :mod:`mfm.build` that knows nothing of configs or loads."""
 from __future__ import annotations
 

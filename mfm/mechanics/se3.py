@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import jax.numpy as jnp
 
-from . import _xla
+from .. import _xla
 
 # Below this rotation angle the closed forms of exp/log switch to Taylor series (their relative
 # error there is below 1e-16 in float64).

@@ -26,9 +26,9 @@ import time as _time
 import numpy as np
 import xarray as xr
 
-from . import frequency as _fd
-from . import results
-from .model import Model
+from . import response as _fd
+from .. import results
+from ..mechanics.model import Model
 
 def _check_sea(sea):
     if sea is None or not hasattr(sea, "components"):
@@ -168,7 +168,7 @@ def spectral_sweep(model: Model, seas, *, t=None, q0=None, loads=None,
     step). Attributes: provenance, ``level = "spectral"``, the seas, ``n_frequencies_solved`` (the
     union), the wall times of the RAO solve and of the whole call.
     """
-    from .simulate import _sea_labels
+    from ..timedomain.simulation import _sea_labels
 
     start = _time.perf_counter()
     if model.hydro is None:

@@ -25,14 +25,14 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from . import results
-from .dynamics import Evaluation, gravity_loads, joint_loads, mass_matrix, reaction_loads
-from .kinematics import kinematics
-from .model import Model
+from .. import results
+from ..mechanics.dynamics import Evaluation, gravity_loads, joint_loads, mass_matrix, reaction_loads
+from ..mechanics.kinematics import kinematics
+from ..mechanics.model import Model
 
 
 def _as_loads(loads):
-    from .simulate import _as_loads as as_loads
+    from ..timedomain.simulation import _as_loads as as_loads
 
     return as_loads(loads)
 
@@ -40,7 +40,7 @@ def _as_loads(loads):
 def system_loads(model: Model, loads=None) -> tuple:
     """The loads of the linearisation: the model's water in still water (no radiation memory: the
     frequency domain adds its radiation as an impedance), the config's loads and ``loads``."""
-    from .simulate import model_loads
+    from ..timedomain.simulation import model_loads
 
     return model_loads(model, None, dt=1.0, duration=1.0, radiation="none") + _as_loads(loads)
 
@@ -48,7 +48,7 @@ def system_loads(model: Model, loads=None) -> tuple:
 def _static_parts(model, static, mems, q, qd):
     """Q(q, q̇) (generalised loads other than inertia) and the acceleration-proportional matrix
     of the loads at rest (None when no load has one)."""
-    from .simulate import applied_loads
+    from ..timedomain.simulation import applied_loads
 
     nz = sum(ld.n_states for ld in static)
     kin = kinematics(model, q, qd)
@@ -195,7 +195,7 @@ def linearise(model: Model, q0=None, *, loads=None):
 
 
 def _water(loads):
-    from .loads.water import Water
+    from ..loads.water import Water
 
     return next((ld for ld in loads if isinstance(ld, Water)), None)
 
@@ -225,12 +225,12 @@ def _amplitudes(model, sys, omega, heading, options):
 def _reaction_function(model, loads):
     """The joint reactions of :func:`mfm.simulate` (``_record``: every load's
     :meth:`~mfm.loads.base.Load.reaction_loads` on the bodies, gravity, then
-    :func:`mfm.dynamics.reaction_loads`) as a function R(q, q̇, q̈) → (n, 6) [force; moment about
+    :func:`mfm.mechanics.dynamics.reaction_loads`) as a function R(q, q̇, q̈) → (n, 6) [force; moment about
     the joint point], inertial axes, with the loads at rest in still water (their static loads):
     the joint springs and dampers, and loads acting on the coordinates directly, reach the joints
     through each body's Newton–Euler residual, as in the time domain."""
-    from .simulate import _state_offsets, applied_loads
-    from .loads.base import Context
+    from ..timedomain.simulation import _state_offsets, applied_loads
+    from ..loads.base import Context
 
     static, mems = _static_functions(model, loads)
     offs = _state_offsets(static)
@@ -293,7 +293,7 @@ def joint_reactions(model: Model, omega, x, *, heading: float = 0.0, q0=None, lo
     the parent, or the inertial frame, to the body; inertial axes; moment about the joint point),
     linearised about q₀ for the coordinate amplitudes x (n_ω, n_q) (x(t) = Re[x̂ e^{−iωt}]).
 
-    With R(q, q̇, q̈) the reactions of the time domain (:func:`mfm.dynamics.reaction_loads` of each
+    With R(q, q̇, q̈) the reactions of the time domain (:func:`mfm.mechanics.dynamics.reaction_loads` of each
     body's Newton–Euler residual M_i Ẋ_i + ω × J ω − F_i, summed from the leaves) under the loads
     at rest (gravity, hydrostatics and buoyancy, A∞, PTO μ/β/κ, joint springs and dampers),
 
@@ -583,8 +583,8 @@ def critical_damping(model: Model, body: str, mode: str, ratio: float, *, point=
     linearisation: with φ the least-norm coordinate motion that moves that dof of the point by one
     unit, k = φᵀKφ, m(ω) = φᵀM(ω)φ (added mass at the mode's frequency, iterated), it is
     c = 2 ζ √(k m). Used by ``[[body_matrices]] damping_ratio``."""
-    from .loads.base import MODES
-    from .points import BodyPoints
+    from ..loads.base import MODES
+    from ..mechanics.points import BodyPoints
 
     j = MODES.index(mode)
     i = model.body_index(body)

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from .model import Model
+    from ..mechanics.model import Model
 
 
 def plot_layout(model: "Model", q=None, *, ax=None, title=None):
@@ -15,7 +15,7 @@ def plot_layout(model: "Model", q=None, *, ax=None, title=None):
     Returns the matplotlib figure."""
     import matplotlib.pyplot as plt
 
-    from .kinematics import kinematics
+    from ..mechanics.kinematics import kinematics
 
     q = np.zeros(model.n_coordinates) if q is None else np.asarray(q, dtype=float)
     kin = kinematics(model, q)

@@ -1,4 +1,4 @@
-"""Config → tree → model: the one place that assembles a :class:`~mfm.model.Model`.
+"""Config → tree → model: the one place that assembles a :class:`~mfm.mechanics.model.Model`.
 
 :func:`load` reads and checks a TOML config (:mod:`mfm.config`), compiles the body tree
 (:func:`compile_tree`), attaches the water's :class:`~hydro.prepare.HydroSpec` when the config has
@@ -14,10 +14,10 @@ from pathlib import Path
 
 
 from .config import load_config
-from .loads.registry import TABLES, load_class
-from .compile import compile_tree
-from .model import Model
-from .tree import ConfigError
+from ..loads.registry import TABLES, load_class
+from ..mechanics.compile import compile_tree
+from ..mechanics.model import Model
+from ..mechanics.tree import ConfigError
 
 def load(path: str | Path, hydro: bool = True, body_coupling: bool | None = None) -> Model:
     """Load a TOML float-tree config and compile it.
@@ -41,7 +41,7 @@ def load(path: str | Path, hydro: bool = True, body_coupling: bool | None = None
         from hydro.database import HydroDatabaseWarning
 
         from .bemgen import database_is_stale
-        from .loads.water import load_hydro_spec
+        from ..loads.water import load_hydro_spec
 
         # a database made from other hulls or BEM settings than the config has now
         try:

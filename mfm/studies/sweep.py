@@ -15,7 +15,7 @@ model is sent to each worker once (``scatter``) and kept there under a hash of i
 so later sweeps of the same model on the same cluster (a resume) do not compile again.
 
 ``level="spectral"`` skips all of that for a model linear over its sea states: the cases are the
-linear frequency-domain response of :func:`mfm.spectral.spectral_sweep` (one linearisation, one RAO
+linear frequency-domain response of :func:`mfm.frequency.spectral.spectral_sweep` (one linearisation, one RAO
 solve on the union of the seas' frequencies), in one call.
 """
 from __future__ import annotations
@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-_simulate = importlib.import_module("mfm.simulate")     # the module (mfm.simulate is the function)
+_simulate = importlib.import_module("mfm.timedomain.simulation")     # the module (mfm.simulate is the function)
 
 # options passed through to simulate_batch (one value for every case, except dt and ramp)
 BATCH_OPTIONS = ("integrator", "radiation", "state_space_options", "memory", "save_every", "t0",
@@ -182,7 +182,7 @@ def sweep(model, seas, *, dt=None, n_steps: int | None = None, chunk_size: int =
     one dataset, the same as one ``simulate_batch`` over every case (to round-off: the vmapped
     width differs) with bounded memory, here or on a Dask cluster.
 
-    model: a :class:`~mfm.model.Model`, or one per case (made with ``equinox.tree_at`` from one
+    model: a :class:`~mfm.mechanics.model.Model`, or one per case (made with ``equinox.tree_at`` from one
         Model: one topology, one hydro spec), as ``simulate_batch`` takes.
     seas: a sea state or one per case (``hydro.waves``; None for still water).
     dt, ramp: s, one number or one per case. n_steps: steps of every case.
@@ -203,7 +203,7 @@ def sweep(model, seas, *, dt=None, n_steps: int | None = None, chunk_size: int =
         may differ (e.g. smaller for the chunks that went non-finite).
     progress: True (default), False, or a dict of tqdm options: a bar over the chunks.
     level: None (default: the time domain, as ``options`` say) or ``"spectral"``: the linear
-        frequency-domain level of the fidelity ladder (:func:`mfm.spectral.spectral_sweep`), for a
+        frequency-domain level of the fidelity ladder (:func:`mfm.frequency.spectral.spectral_sweep`), for a
         model that is linear over the sea states (:func:`mfm.reduce` measures it): linearised
         once, RAOs solved once on the union of the seas' frequencies, every case's statistics
         ``pto_power_mean`` and ``q_rms`` (case, …) in one call, no time stepping. With ``dt`` and
@@ -320,9 +320,9 @@ SPECTRAL_OPTIONS = {"q0": None, "loads": None, "radiation": "database",
 
 
 def _spectral_sweep(model, seas, level, dt, n_steps, parameters, options, unused):
-    """``sweep(..., level="spectral")``: :func:`mfm.spectral.spectral_sweep` over the cases, on the
+    """``sweep(..., level="spectral")``: :func:`mfm.frequency.spectral.spectral_sweep` over the cases, on the
     time domain's saved grid when dt and n_steps are given, labelled as a sweep."""
-    from .spectral import spectral_sweep
+    from ..frequency.spectral import spectral_sweep
 
     if level != "spectral":
         raise ValueError(f"level: {level!r}; accepted: None (the time domain, as the options "

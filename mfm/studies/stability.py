@@ -20,7 +20,7 @@ re-derivation of a scheme on paper:
 
    :func:`amplification_matrix`, :func:`spectral_radius`, :func:`largest_stable_dt` (bisection on
    ρ(G(dt)) ≤ 1). :func:`heave_model` and :func:`measured_stable_dt` measure the same boundary with
-   runs of :func:`mfm.simulate.rollout` on a one-body heave model whose A∞/m is set.
+   runs of :func:`mfm.timedomain.simulation.rollout` on a one-body heave model whose A∞/m is set.
 
 2. **Floquet stability of a periodic run.** A model forced with period T (a regular wave) settles
    on a T-periodic orbit x*(t). Small deviations obey δx(t + T) = Φ δx(t), Φ = ∂F/∂x the jacobian
@@ -48,7 +48,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from . import integrators as _integrators
+from ..timedomain import integrators as _integrators
 
 ADDED_MASS = ("lhs", "rhs")
 
@@ -246,7 +246,7 @@ def heave_model(damping_ratio: float = 0.02, database=None):
     constant force, the water plane a linear spring. Set A∞/m with :func:`heave_loads`."""
     import mfm
 
-    from .simulate import model_loads
+    from ..timedomain.simulation import model_loads
 
     if isinstance(damping_ratio, bool) or not isinstance(damping_ratio, numbers.Real) \
             or not 0 <= damping_ratio < 1:
@@ -289,7 +289,7 @@ def heave_loads(model, mass_ratio, *, dt, n_steps, added_mass="lhs", integrator=
     :class:`~mfm.loads.water.Water`, its ``A_inf`` array replaced)."""
     import equinox as eqx
 
-    from .simulate import model_loads
+    from ..timedomain.simulation import model_loads
 
     if isinstance(mass_ratio, bool) or not isinstance(mass_ratio, numbers.Real) or mass_ratio < 0 \
             or not math.isfinite(mass_ratio):
@@ -304,11 +304,11 @@ def heave_loads(model, mass_ratio, *, dt, n_steps, added_mass="lhs", integrator=
 
 def run_grows(model, mass_ratio, dt, *, integrator, added_mass="lhs", n_steps=2000,
               growth=1e3) -> bool:
-    """Whether a run of ``n_steps`` of :func:`mfm.simulate.rollout` on :func:`heave_model`, from
+    """Whether a run of ``n_steps`` of :func:`mfm.timedomain.simulation.rollout` on :func:`heave_model`, from
     a heave of 1 cm off equilibrium at rest, grows: |q| somewhere in the last quarter above
     ``growth`` × 1 cm, or non-finite. (A stable run decays or stays at 1 cm; an unstable one grows
     as ρⁿ, so with ρ − 1 ≥ ln(growth)/n_steps = 0.35 % it is caught.)"""
-    from .simulate import rollout
+    from ..timedomain.simulation import rollout
 
     integ = _integrator(integrator, added_mass)
     loads = heave_loads(model, mass_ratio, dt=dt, n_steps=n_steps, added_mass=added_mass,
@@ -401,7 +401,7 @@ def _state_names(model, carry, idx):
 
 
 def _one_step(model, lds, integ, dt):
-    from .simulate import _update_memories, dynamics_function
+    from ..timedomain.simulation import _update_memories, dynamics_function
 
     def one(carry, _):
         s, mem = carry
@@ -414,7 +414,7 @@ def _one_step(model, lds, integ, dt):
 @functools.partial(jax.jit, static_argnames=("n0", "integ"))
 def _floquet_start(model, lds, q0, qd0, z0, dt, n0, integ):
     """The rollout's carry after n0 steps from rest (the same step as :func:`mfm.simulate`)."""
-    from .simulate import _init_memories, dynamics_function
+    from ..timedomain.simulation import _init_memories, dynamics_function
 
     mem0 = _init_memories(model, lds, 0.0, q0, qd0, dt)
     s = integ.init(dynamics_function(model, lds, mem0), 0.0, q0, qd0, z0)
@@ -474,7 +474,7 @@ def floquet(model, sea, *, period, dt, t_start, integrator="verlet",
     period must be a whole number of steps; ``t_start`` a whole number of steps. radiation must
     have finitely many states: "state_space", "state_space_exact" or "none" (the convolution's
     memory is its whole velocity history: allowed, but Φ is then as large as that history)."""
-    from .simulate import _as_loads, _initial_vector, model_loads
+    from ..timedomain.simulation import _as_loads, _initial_vector, model_loads
 
     period = _positive(period, "period")
     dt = _positive(dt, "dt")

@@ -22,11 +22,12 @@ import numpy as np
 import xarray as xr
 
 from . import integrators as _integrators
-from . import results, se3
-from .dynamics import energies, evaluate, reaction_loads
-from .kinematics import kinematics
-from .loads.base import Context, Load
-from .model import Model
+from .. import results
+from ..mechanics import se3
+from ..mechanics.dynamics import energies, evaluate, reaction_loads
+from ..mechanics.kinematics import kinematics
+from ..loads.base import Context, Load
+from ..mechanics.model import Model
 
 # How many times each compiled function was traced (a retrace means a recompilation); tests use it.
 TRACES: collections.Counter = collections.Counter()
@@ -59,7 +60,7 @@ def model_loads(model: Model, sea=None, *, dt, duration, t0=0.0, ramp=0.0,
     times of ``integrator``), then the config's loads (``model.loads``: moorings, PTOs, …)."""
     out = []
     if model.hydro is not None:
-        from .loads.water import build_water
+        from ..loads.water import build_water
 
         _check_sea(sea)
         out.append(build_water(model, model.hydro, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
@@ -748,7 +749,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
 
     Parameters
     ----------
-    model: a compiled :class:`~mfm.model.Model` (with its water if the config has ``[hydro]``).
+    model: a compiled :class:`~mfm.mechanics.model.Model` (with its water if the config has ``[hydro]``).
     sea: a sea state from :mod:`hydro.waves` (``Regular``, ``Jonswap``, …), or None (still water,
         or no water at all for a mechanics-only model).
     duration, dt: s. The run has ``round(duration / dt)`` steps.

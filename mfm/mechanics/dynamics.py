@@ -15,7 +15,8 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from . import _xla, se3
+from .. import _xla
+from . import se3
 from .kinematics import Kinematics, kinematics
 from .model import Model
 
