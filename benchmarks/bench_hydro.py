@@ -20,7 +20,8 @@ os.environ.setdefault("MFM_FIT_CACHE", "off")          # fit times measured, not
 import hydro
 import mfm
 from timing import median_time
-from mfm.timedomain.simulation import model_loads, rollout
+from mfm.timedomain.setup import model_loads
+from mfm.timedomain.rollout import rollout
 
 ROOT = Path(__file__).resolve().parents[1]
 warnings.simplefilter("ignore")

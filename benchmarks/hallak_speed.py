@@ -28,7 +28,7 @@ os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured,
 os.environ.setdefault("MFM_FIT_CACHE", "off")          # fit times measured, not read from disk (hydro.fitcache)
 import hydro
 import mfm
-from mfm.timedomain.simulation import model_loads
+from mfm.timedomain.setup import model_loads
 from timing import first_and_warm
 
 warnings.simplefilter("ignore", hydro.database.HydroDatabaseWarning)

@@ -74,7 +74,7 @@ def child_m4(new, repeats, batch):
 
     import hydro
     import mfm
-    from mfm.timedomain.simulation import model_loads
+    from mfm.timedomain.setup import model_loads
 
     res = {}
     sea = hydro.Jonswap(hs=0.04, tp=TP, gamma=3.3, seed=1, omega_range=(1.0, 25.0))
@@ -149,7 +149,7 @@ def child_m4(new, repeats, batch):
         seas = [hydro.Jonswap(hs=h, tp=t, gamma=3.3, seed=1, omega_range=(1.0, 25.0))
                 for h in hss for t in tps]
         res["batch"] = []
-        res["threads"] = sys.modules["mfm.timedomain.simulation"].default_threads()
+        res["threads"] = sys.modules["mfm.timedomain.batch"].default_threads()
         for B in (1, 4, 16, 64, 128):
             ss_b = (seas * 2)[:B]
             dts = np.array([s.tp / 200 for s in ss_b])
@@ -175,7 +175,7 @@ def child_m4(new, repeats, batch):
 def child_rm3(new, repeats):
     import hydro
     import mfm
-    from mfm.timedomain.simulation import model_loads
+    from mfm.timedomain.setup import model_loads
 
     m = mfm.load(ROOT / "configs" / "rm3.toml")
     sea = hydro.Regular(height=2.5, period=8.0)

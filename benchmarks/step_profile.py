@@ -200,7 +200,8 @@ def main():
     import hydro
     import mfm
     from mfm import integrators
-    from mfm.timedomain.simulation import _rollout_jit, model_loads
+    from mfm.timedomain.rollout import rollout_jit
+    from mfm.timedomain.setup import model_loads
 
     tp = 1.2
     dt = tp / 200
@@ -214,7 +215,7 @@ def main():
     q0 = jnp.zeros(m.n_coordinates)
     z0 = jnp.concatenate([ld.initial_state(m) for ld in loads]) if loads else jnp.zeros(0)
     t0 = time.perf_counter()
-    compiled = _rollout_jit.lower(m, loads, q0, q0, z0, jnp.asarray(0.0), jnp.asarray(dt),
+    compiled = rollout_jit.lower(m, loads, q0, q0, z0, jnp.asarray(0.0), jnp.asarray(dt),
                                   n_steps=a.steps, integrator=integrators.get(a.integrator),
                                   save_every=a.steps, record=False).compile()
     t_compile = time.perf_counter() - t0
@@ -244,7 +245,7 @@ def main():
         print(f"| {v} | {k} |")
     if a.trace:
         n_tr = 1000
-        text = _rollout_jit.lower(m, loads, q0, q0, z0, jnp.asarray(0.0), jnp.asarray(dt),
+        text = rollout_jit.lower(m, loads, q0, q0, z0, jnp.asarray(0.0), jnp.asarray(dt),
                                   n_steps=n_tr, integrator=integrators.get(a.integrator),
                                   save_every=n_tr, record=False).compile().as_text()
         _, _, named = step_kernels(text, n_tr)

@@ -46,7 +46,7 @@ os.environ.setdefault("MFM_FIT_CACHE", "off")          # fit times measured, not
 import hydro
 import mfm
 from mfm.loads.catenary import linearise_lines
-from mfm.timedomain.simulation import model_loads
+from mfm.timedomain.setup import model_loads
 from timing import first_and_warm
 
 warnings.simplefilter("ignore", hydro.database.HydroDatabaseWarning)

@@ -288,6 +288,18 @@ def read_netcdf(path) -> xr.Dataset:
         raise ValueError(f"{str(path)!r} is not a readable NetCDF file ({e})") from None
 
 
+def read_netcdf_attrs(path) -> dict:
+    """The global attributes of the NetCDF file at `path`, its variables left undecoded (read from
+    memory as :func:`read_netcdf`, so no HDF5 handle on the path)."""
+    path = Path(path)
+    data = path.read_bytes()
+    try:
+        with xr.open_dataset(data, engine="netcdf4") as ds:
+            return dict(ds.attrs)
+    except (OSError, ValueError) as e:
+        raise ValueError(f"{str(path)!r} is not a readable NetCDF file ({e})") from None
+
+
 def write_netcdf(ds: xr.Dataset, path, **kwargs) -> Path:
     """``ds.to_netcdf`` atomically: written to a temporary file beside `path`, then renamed over it
     (a reader holding the old file keeps it; nobody ever sees a half-written one). `kwargs` go to

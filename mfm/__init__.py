@@ -26,14 +26,18 @@ from .mechanics.dynamics import (coriolis_matrix, energies, evaluate, forward_dy
                                  mass_matrix, reaction_loads)
 from .mechanics.kinematics import b_matrix, b_matrix_dot, body_poses, kinematics  # noqa: E402
 from .mechanics.model import Model  # noqa: E402
-from .timedomain.simulation import (AccuracyWarning, SimulationError, StabilityWarning,  # noqa: E402
-                                    rollout, simulate, simulate_batch)
-from .studies.stability import amplification_matrix, floquet, largest_stable_dt  # noqa: E402
+from .errors import AccuracyWarning, SimulationError, StabilityWarning  # noqa: E402
+from .timedomain.batch import simulate_batch  # noqa: E402
+from .timedomain.rollout import rollout  # noqa: E402
+from .timedomain.setup import model_loads  # noqa: E402
+from .timedomain.simulation import simulate  # noqa: E402
+from .studies.floquet import floquet  # noqa: E402
+from .studies.stability import amplification_matrix, largest_stable_dt  # noqa: E402
 from .frequency.spectral import spectral_response  # noqa: E402
 from .frequency.linear import linear_response  # noqa: E402
 from .studies.fidelity import reduce  # noqa: E402
-from .mechanics.tree import ConfigError  # noqa: E402
-from .studies.sweep import SweepError, sweep  # noqa: E402
+from .errors import ConfigError, SweepError  # noqa: E402
+from .studies.sweep import sweep  # noqa: E402
 from . import _compat  # noqa: E402
 
 _compat.install()
@@ -48,6 +52,6 @@ __all__ = ["AccuracyWarning", "ConfigError", "Model", "PerformanceWarning", "Sim
            "StabilityWarning", "SweepError", "amplification_matrix", "b_matrix", "b_matrix_dot",
            "body_poses", "compile_tree", "coriolis_matrix", "energies", "equilibrium", "evaluate",
            "floquet", "forward_dynamics", "frequency", "frequency_response", "integrators",
-           "kinematics", "largest_stable_dt", "linear_response", "load", "loads", "mass_matrix",
+           "kinematics", "largest_stable_dt", "linear_response", "load", "loads", "mass_matrix", "model_loads",
            "natural_frequencies", "reaction_loads", "reduce", "results", "rollout", "simulate",
            "simulate_batch", "spectral_response", "sweep"]

@@ -26,8 +26,8 @@ class MovedWarning(FutureWarning):
 MOVED_MODULES = {
     "mfm.simulate": ("mfm.timedomain.simulation", "mfm.timedomain.batch",
                      "mfm.timedomain.rollout", "mfm.timedomain.record",
-                     "mfm.timedomain.progress", "mfm.timedomain.assembly",
-                     "mfm.frequency.rest", "mfm.validation", "mfm.errors"),
+                     "mfm.timedomain.progress", "mfm.timedomain.setup", "mfm.timedomain.checks",
+                     "mfm.loads.assembly", "mfm.frequency.rest", "mfm.validation", "mfm.errors"),
     "mfm.se3": ("mfm.mechanics.se3",),
     "mfm.tree": ("mfm.mechanics.tree", "mfm.errors"),
     "mfm.model": ("mfm.mechanics.model",),
@@ -35,9 +35,9 @@ MOVED_MODULES = {
     "mfm.kinematics": ("mfm.mechanics.kinematics",),
     "mfm.dynamics": ("mfm.mechanics.dynamics",),
     "mfm.points": ("mfm.mechanics.points",),
-    "mfm.spectral": ("mfm.frequency.spectral", "mfm.validation"),
+    "mfm.spectral": ("mfm.frequency.spectral",),
     "mfm.linear": ("mfm.frequency.linear",),
-    "mfm.stability": ("mfm.studies.stability",),
+    "mfm.stability": ("mfm.studies.stability", "mfm.studies.floquet"),
     "mfm.sweep": ("mfm.studies.sweep", "mfm.errors"),
     "mfm.fidelity": ("mfm.studies.fidelity",),
     "mfm.wec": ("mfm.studies.wec",),
@@ -50,6 +50,16 @@ MOVED_MODULES = {
     "mfm.water": ("mfm.loads.water", "hydro.prepare"),
     "mfm.ptos": ("mfm.loads.hydraulic_pto",),
 }
+
+# names renamed on the way (private helpers that other modules used: public in their new place)
+RENAMED = {"_rollout_jit": "rollout_jit", "_as_loads": "as_loads", "_initial_vector": "initial_vector",
+           "_number": "finite_number", "_state_offsets": "state_offsets", "_sea_labels": "sea_labels",
+           "_stage_offsets": "stage_offsets", "_check_sea": "check_sea", "_init_memories": "init_memories",
+           "_update_memories": "update_memories", "_progress_options": "progress_options",
+           "_static_jet": "_static_jet", "_water": "water_of", "_record": "sample_outputs"}
+
+# names that left a module that is still there: module -> {name: the module that holds it now}
+MOVED_NAMES = {"mfm.loads.catenary": {"linearise_lines": "mfm.frequency.rest"}}
 
 # front-door names that are the same modules under a shorter name: no warning
 ALIASES = {"mfm.integrators": "mfm.timedomain.integrators"}
@@ -79,14 +89,21 @@ class _Moved(types.ModuleType):
     def __getattr__(self, name: str):
         if name.startswith("__"):
             raise AttributeError(name)
+        new = RENAMED.get(name, name)
         for target in self.__targets:
             try:
                 module = importlib.import_module(target)
             except ImportError:
                 continue
-            if hasattr(module, name):
-                _warn_once(f"{self.__name__}.{name}", f"{target}.{name}")
-                return getattr(module, name)
+            if hasattr(module, new):
+                value = getattr(module, new)
+                # name the module that defines it where that is known (a function, a class)
+                home = getattr(value, "__module__", None)
+                if not (isinstance(home, str) and home.startswith(("mfm.", "hydro."))
+                        and getattr(sys.modules.get(home), new, None) is value):
+                    home = target
+                _warn_once(f"{self.__name__}.{name}", f"{home}.{new}")
+                return value
         raise AttributeError(f"module {self.__name__!r} has no attribute {name!r} (it moved: "
                              f"look in {', '.join(self.__targets)})")
 
@@ -107,6 +124,19 @@ def install():
         sys.modules.setdefault(old, _Moved(old, targets))
     for old, new in ALIASES.items():
         sys.modules.setdefault(old, importlib.import_module(new))
+    for module, names in MOVED_NAMES.items():
+        _forward_names(importlib.import_module(module), names)
+
+
+def _forward_names(module, names: dict):
+    """Give ``module`` a module-level ``__getattr__`` that finds ``names`` where they are now."""
+    def __getattr__(name):
+        if name in names:
+            _warn_once(f"{module.__name__}.{name}", f"{names[name]}.{name}")
+            return getattr(importlib.import_module(names[name]), name)
+        raise AttributeError(f"module {module.__name__!r} has no attribute {name!r}")
+
+    module.__getattr__ = __getattr__
 
 
 def package_attribute(name: str):

@@ -8,11 +8,15 @@ from __future__ import annotations
 
 import datetime
 import functools
+import numbers
 import subprocess
+import time
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
+
+from .loads.pto import absorbed_power, damped_coordinates, mean_absorbed_power
 
 CONVENTIONS = ("inertial frame: origin on the still-water line, z up; body frames at the CoM, "
                "parallel to inertial at q = 0")
@@ -110,26 +114,7 @@ def _coordinate_coords(model):
             "coordinate_unit": ("coordinate", coordinate_units(model))}
 
 
-# ------------------------------------------------------------------------------- PTO power
-def absorbed_power(c, rate):
-    """The power a linear damper absorbs, P = c v² (W): joint dampers (c q̇²) and hydraulic
-    pistons (β ẇ²) alike."""
-    return c * rate**2
-
-
-def mean_absorbed_power(c, omega, amplitude):
-    """Its mean over a period for a harmonic motion of complex amplitude x̂ at ω: ½ c ω² |x̂|²."""
-    return 0.5 * c * omega**2 * np.abs(amplitude) ** 2
-
-
-def damper_power(damping, qd):
-    """The coordinates with a joint damper (c > 0 in any case) and the power c q̇² of each:
-    damping (n_q,) or (case, n_q), qd (…, time, n_q) → (indices, (…, time, n_damped))."""
-    damped = [int(k) for k in np.flatnonzero(np.any(np.atleast_2d(damping) > 0, axis=0))]
-    c = damping[..., damped]
-    return damped, absorbed_power(c[..., None, :] if c.ndim > 1 else c, qd[..., damped])
-
-
+# ------------------------------------------------------------------------------- PTOs
 def add_ptos(ds, names, power, displacement, force=None, dim="time"):
     """Append PTOs (names, power (…, time, P), displacement (…, time, P)) to ``pto_power`` and
     ``pto_displacement`` of ``ds`` (joint dampers first); ``force`` as ``pto_force``."""
@@ -152,12 +137,6 @@ def add_ptos(ds, names, power, displacement, force=None, dim="time"):
     return ds
 
 
-def linear_dampers(loads, kin0) -> list:
-    """The loads' PTOs linearised at ``kin0`` (:meth:`mfm.loads.base.Load.linear_dampers`): the
-    hydraulic pistons the linear levels report beside the joint dampers."""
-    return [d for d in (ld.linear_dampers(kin0) for ld in loads) if d is not None]
-
-
 def add_linear_dampers(ds, dampers, q0, q, qd, dim="time"):
     """Append each linearised PTO's power β (G q̇)² and displacement w₀ + G (q − q₀) (time, pto)."""
     for d in dampers:
@@ -168,9 +147,13 @@ def add_linear_dampers(ds, dampers, q0, q, qd, dim="time"):
 
 
 def _joint_dampers(ds, model, damping, q, qd, dim):
-    damped, power = damper_power(np.asarray(damping), qd)
+    """Append the joint dampers (c q̇², the coordinate as displacement); ``damping`` (n_q,) or
+    (case, n_q)."""
+    damped = damped_coordinates(damping)
     if not damped:
         return ds
+    c = np.asarray(damping)[..., damped]
+    power = absorbed_power(c[..., None, :] if c.ndim > 1 else c, qd[..., damped])
     names = [model.coordinates[k] for k in damped]
     units = coordinate_units(model)
     ds = add_ptos(ds, names, power, q[..., damped], dim=dim)
@@ -180,8 +163,38 @@ def _joint_dampers(ds, model, damping, q, qd, dim):
     return ds
 
 
+def add_load_outputs(ds, load, records: dict):
+    """Add a load's recorded diagnostics (:meth:`~mfm.loads.base.Load.outputs`: dims after time,
+    attrs, coordinates) to a run's dataset, and, for a load that is a PTO
+    (:meth:`~mfm.loads.base.Load.pto_records`), its pistons to ``pto_power``,
+    ``pto_displacement`` and ``pto_force``."""
+    spec = dict(load.outputs())
+    coords = spec.pop("coords", {})
+    if spec:
+        ds = ds.assign_coords({k: v for k, v in coords.items() if k not in ds.coords})
+    for name, (dims, attrs) in spec.items():
+        ds[name] = (("time",) + tuple(dims), records[name], dict(attrs))
+    pto = load.pto_records(records)
+    if pto is not None:
+        ds = add_ptos(ds, list(pto.names), pto.power, pto.displacement, pto.force)
+    return ds
+
+
+def sea_labels(seas) -> dict:
+    """Per-case labels of a batch's sea states (Hs, Tp, H, T, gamma, heading) where every sea has
+    the attribute: name → (values (case,), attrs), for the coordinates on ``case`` of every
+    dataset over cases (:func:`batch`, the spectral sweep's, a sweep's)."""
+    units = {"hs": "m", "tp": "s", "height": "m", "period": "s", "gamma": "1", "heading": "rad"}
+    out = {}
+    for name, u in units.items():
+        vals = [getattr(s, name, None) for s in seas]
+        if all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in vals):
+            out[f"sea_{name}"] = (np.asarray(vals, dtype=float), {"units": u})
+    return out
+
+
 # ------------------------------------------------------------------------------- time domain
-# what every run records per sample besides q, q̇, q̈ (mfm.timedomain.simulation._record): dims after time, attrs
+# what every run records per sample besides q, q̇, q̈ (mfm.timedomain.record.sample_outputs): dims after time, attrs
 RECORD_DIMS = {
     "body_position": (("body", "axis"), {"long_name": "centre of mass position, inertial axes",
                                          "units": "m"}),
@@ -229,14 +242,15 @@ def time_series(model, loads, integ, dt, t, q, qd, qdd, iters, rec, settings) ->
     )
     ds = _joint_dampers(ds, model, model.damping, q, qd, "time")
     for ld in loads:
-        ds = ld.annotate(ds, rec)
+        ds = add_load_outputs(ds, ld, rec)
     return ds
 
 
 def linear_time_series(model, loads, t, q, qd, qdd, q0, eta, settings, source=None,
                        dampers=()) -> xr.Dataset:
     """The dataset of :func:`mfm.frequency.linear.linear_response`: q, q̇, q̈ (time, coordinate), the power
-    of the joint dampers and of the loads' linearised PTOs (``dampers``, :func:`linear_dampers`),
+    of the joint dampers and of the loads' linearised PTOs (``dampers``,
+    :func:`mfm.loads.pto.load_dampers`),
     ``eta`` and the ``equilibrium`` it is linearised about."""
     ds = xr.Dataset(
         {"q": (("time", "coordinate"), q, _coordinate_attrs(model, 0)),
@@ -289,6 +303,47 @@ def batch(model, models, loads, integ, t, q, qd, dts, settings, save_every, labe
     return ds
 
 
+def label_cases(ds, labels: dict, *, as_data=False):
+    """``labels`` (name → (values (case,), attrs)) as coordinates on ``case`` (or, ``as_data``,
+    as data variables)."""
+    for name, (values, attrs) in labels.items():
+        if as_data:
+            ds[name] = ("case", np.asarray(values), attrs)
+        else:
+            ds = ds.assign_coords({name: ("case", values, attrs)})
+    return ds
+
+
+def gather_cases(parts, nan_cases, B, labels, dt, chunk_of, failed, attrs) -> xr.Dataset:
+    """The dataset of :func:`mfm.sweep` over every case, from the datasets of its chunks
+    (``parts``, each over its cases) and NaN for the cases of failed chunks (``nan_cases``: their
+    indices, one array per chunk); ``labels`` the seas' and parameters' per-case values, ``dt``
+    (case,) s, ``chunk_of`` and ``failed`` (case,), ``attrs`` the sweep's own attributes."""
+    template = parts[0]
+    parts = list(parts)
+    for idx in nan_cases:
+        nan = template.isel(case=np.zeros(idx.size, dtype=int)).assign_coords(case=idx)
+        for name, v in nan.data_vars.items():
+            if np.issubdtype(v.dtype, np.floating) or np.issubdtype(v.dtype, np.complexfloating):
+                nan[name] = v.copy(data=np.full(v.shape, np.nan, dtype=v.dtype))
+        parts.append(nan)
+    ds = xr.concat(parts, dim="case", data_vars="minimal", coords="minimal", compat="override",
+                   join="override", combine_attrs="override").sortby("case")
+    ds = ds.assign_coords(case=np.arange(B))
+    # labels and dt from the arguments (a failed chunk's template carries another case's)
+    for name, (values, a) in labels.items():
+        if name in ds.data_vars:        # a load's output of that name: keep both
+            name = f"parameter_{name}"
+        ds = ds.assign_coords({name: ("case", np.asarray(values), a)})
+    ds["dt"] = ("case", dt, ds["dt"].attrs)
+    ds = ds.assign_coords(sweep_chunk=("case", chunk_of,
+                                       {"long_name": "the chunk each case ran in"}))
+    ds["failed"] = ("case", failed, {"long_name": "the case's chunk failed: its data are NaN "
+                                     "(see the attribute sweep_failed_chunks)"})
+    ds.attrs.update(title=f"mfm sweep of {B} runs of {ds.attrs.get('model', '')}", **attrs)
+    return ds
+
+
 # ------------------------------------------------------------------------------- frequency domain
 def frequency(model, loads, omega, x, q0, kin0, heading, settings, extra,
               reactions=None) -> xr.Dataset:
@@ -298,7 +353,7 @@ def frequency(model, loads, omega, x, q0, kin0, heading, settings, extra,
     R = np.asarray(kin0.E[:, :3, :3])
     body = np.concatenate([np.einsum("nai,wi->wna", Bm[:, :3], x),
                            np.einsum("nab,nbi,wi->wna", R, Bm[:, 3:], x)], axis=2)
-    damped = [k for k in range(model.n_coordinates) if float(model.damping[k]) > 0]
+    damped = damped_coordinates(model.damping)
     c = np.asarray(model.damping)[damped]
     ds = xr.Dataset(
         {"rao": (("omega", "coordinate"), x, {"long_name": "coordinate RAO per metre of wave "
@@ -330,6 +385,66 @@ def frequency(model, loads, omega, x, q0, kin0, heading, settings, extra,
             ds[name] = (("omega",) + tuple(dims), values, attrs)
     if reactions is not None:
         ds = add_joint_reactions(ds, *reactions)
+    return ds
+
+
+def spectral(model, loads, q0, q_rms, power, ptos, comps, seas, settings, series=None,
+             start=None) -> xr.Dataset:
+    """The dataset of :func:`mfm.frequency.spectral.spectral_sweep` over ``case``: ``q_rms``,
+    ``pto_power_mean`` of every PTO (``ptos``: :func:`mfm.loads.pto.linear_ptos`),
+    ``n_components`` and ``equilibrium``; with ``series`` = (times, q, qd, eta) the synthesised
+    time series and their PTO power c (G q̇)²; the seas' labels; provenance with ``settings``
+    and the wall time since ``start`` (``time.perf_counter``)."""
+    B = len(seas)
+    data = {
+        "q_rms": (("case", "coordinate"), q_rms,
+                  {"long_name": "standard deviation about the equilibrium",
+                   "units": "m or rad (per coordinate: coordinate_unit)"}),
+        "pto_power_mean": (("case", "pto"), power,
+                           {"long_name": "expected mean power of each joint damper and piston, "
+                            "Σ a² ½ c ω² |G x|²", "units": "W"}),
+        "n_components": (("case",), np.array([len(cm.omega) for cm in comps]),
+                         {"long_name": "wave components of the case's sea"}),
+        "equilibrium": (("coordinate",), q0, {"units": "m or rad"}),
+    }
+    coords = {"case": np.arange(B), **_coordinate_coords(model), "pto": list(ptos.names)}
+    if series is not None:
+        times, q, qd, eta = series
+        data.update(
+            time=(("case", "step"), times, {"units": "s"}),
+            q=(("case", "step", "coordinate"), q,
+               {"long_name": "generalised coordinates",
+                "units": "m or rad (per coordinate: coordinate_unit)"}),
+            qd=(("case", "step", "coordinate"), qd,
+                {"long_name": "generalised velocities", "units": "m/s or rad/s"}),
+            pto_power=(("case", "step", "pto"), absorbed_power(ptos.damping, qd @ ptos.rows.T),
+                       {"long_name": "power absorbed by each joint damper and piston, c (G q̇)²",
+                        "units": "W"}),
+            eta=(("case", "step"), eta,
+                 {"long_name": "undisturbed wave elevation at the origin", "units": "m"}))
+    ds = xr.Dataset(data, coords=coords)
+    for name, (values, attrs) in sea_labels(seas).items():
+        ds = ds.assign_coords({name: ("case", np.asarray(values), attrs)})
+    wall = {} if start is None else {"wall_time_s": time.perf_counter() - start}
+    ds.attrs = {
+        "title": f"mfm spectral response of {model.name} in {B} sea states",
+        **provenance(model, loads, **settings, **wall),
+        "source": model.hydro.source}
+    return ds
+
+
+def spectral_one(ds, sea, t=None) -> xr.Dataset:
+    """The one-case dataset of :func:`spectral` as :func:`mfm.spectral_response` gives it: over
+    ``time`` (the times ``t``) instead of (case, step), the sea in the attributes."""
+    ds = ds.isel(case=0, drop=True)
+    attrs = {**ds.attrs, "title": f"mfm spectral response of {ds.attrs['model']}",
+             "sea": repr(sea), "n_components": int(ds.n_components)}
+    attrs.pop("seas", None)
+    ds = ds.drop_vars("n_components")
+    if t is not None:
+        ds = ds.drop_vars("time").rename_dims(step="time").assign_coords(
+            time=("time", t, {"units": "s"}))
+    ds.attrs = attrs
     return ds
 
 
@@ -386,3 +501,21 @@ def natural(model, loads, freqs, modes, zeta, zeta_rad, min_det, settings,
         coords={"mode": np.arange(n), **_coordinate_coords(model)},
         attrs={"title": f"mfm natural frequencies of {model.name}",
                **provenance(model, loads, **settings)})
+
+
+# ------------------------------------------------------------------------------- the command line
+def with_command(ds, command: str):
+    """``ds`` with the command line that made it (``mfm simulate ...``) in its attributes."""
+    ds.attrs["command"] = command
+    return ds
+
+
+def with_natural_frequencies(ds, nat, config):
+    """A frequency response (``mfm rao``) with the model's natural frequencies beside it: the
+    eigenfrequencies as ``natural_frequency`` (mode), the minima of |det Λ(ω)| and the config's
+    path in the attributes."""
+    ds["natural_frequency"] = (("mode",), nat["eigen"].values, {
+        "units": "rad/s", "long_name": "undamped, generalised eigenproblem"})
+    ds.attrs["natural_frequencies_min_det"] = np.array2string(nat["min_det"].values, precision=5)
+    ds.attrs["config"] = str(config)
+    return ds

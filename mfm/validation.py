@@ -1,10 +1,30 @@
-"""Small checks shared by every config table parser (the body tree and the load tables): each
-raises :class:`~mfm.mechanics.tree.ConfigError` naming the key path, the value and what is accepted."""
+"""Every check of mfm's inputs, in one module.
+
+Config tables (the body tree and every load table): :func:`unknown`, :func:`vector`,
+:func:`number`, :func:`tables`, :func:`body_ref` raise :class:`~mfm.errors.ConfigError` naming the
+key path, the value and what is accepted.
+
+Arguments of the front doors (``simulate``, ``rollout``, ``simulate_batch``, the linear levels,
+the stability and fidelity studies): :func:`finite_number`, :func:`positive`,
+:func:`whole_number`, :func:`positive_seconds`, :func:`initial_vector`, :func:`square_matrix`,
+:func:`check_sea` raise ValueError (TypeError for an object of the wrong kind) naming the argument,
+the value and what is accepted.
+
+Two checkers stay outside, by necessity: :mod:`hydro` never imports mfm (its sea states check
+their own numbers), and the command line's parser (``mfm_cli``) must answer ``--help`` without
+importing the package (and jax), so it checks its numbers as argparse types.
+"""
 from __future__ import annotations
 
+import math
+import numbers
+
+import jax
 import numpy as np
 
-from .mechanics.tree import ConfigError
+from .errors import ConfigError
+
+# ------------------------------------------------------------------------------- config tables
 
 
 def unknown(keys, allowed, where):
@@ -45,3 +65,107 @@ def body_ref(table, key, where, names):
     if table.get(key) not in names:
         raise ConfigError(f"{where}.{key}: {table.get(key)!r} is not a body; known bodies: {names}")
     return table[key]
+
+
+# ------------------------------------------------------------------------------- arguments
+def finite_number(value, what, *, positive=False, nonnegative=False, allow_none=False):
+    """A finite float, with a message naming the argument when it is not."""
+    if value is None and allow_none:
+        return None
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+        raise ValueError(f"{what}: {value!r} is not a finite number")
+    if positive and not value > 0:
+        raise ValueError(f"{what}: {value!r} must be > 0")
+    if nonnegative and not value >= 0:
+        raise ValueError(f"{what}: {value!r} must be ≥ 0")
+    return float(value)
+
+
+def positive(value, what, *, allow_inf=False):
+    """A positive float (finite, or also inf with ``allow_inf``)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not value > 0 \
+            or (not allow_inf and not math.isfinite(value)):
+        raise ValueError(f"{what}: {value!r}; give a positive finite number"
+                         + (" (or inf)" if allow_inf else ""))
+    return float(value)
+
+
+def whole_number(value, minimum: int = 1) -> bool:
+    """Whether ``value`` is a whole number (not a bool) ≥ ``minimum``; the caller's message says
+    what the number is for."""
+    return (not isinstance(value, bool) and isinstance(value, numbers.Integral)
+            and value >= minimum)
+
+
+def positive_seconds(value, what):
+    """A positive finite number of seconds (or an array of them), where the value is known (a jax
+    tracer is let through: it is checked where it was made)."""
+    if isinstance(value, jax.core.Tracer):
+        return
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what}: {value!r} is not a number; give a positive number of seconds") from None
+    if v.size == 0 or not (np.all(np.isfinite(v)) and np.all(v > 0)):
+        raise ValueError(f"{what}: {value!r}; give a positive, finite number of seconds")
+
+
+def initial_vector(model, value, what: str) -> np.ndarray:
+    """Initial coordinates or rates (n_q,) from None (zeros), an array or a dict by coordinate
+    name (the others 0)."""
+    n = model.n_coordinates
+    if value is None:
+        return np.zeros(n)
+    if isinstance(value, dict):
+        out = np.zeros(n)
+        for k, v in value.items():
+            try:
+                out[model.coordinate_index(k)] = float(v)
+            except KeyError:
+                raise ValueError(f"{what}: {k!r} is not a coordinate of {model.name!r}; "
+                                 f"coordinates: {list(model.coordinates)}") from None
+            except (TypeError, ValueError):
+                raise ValueError(f"{what}[{k!r}]: {v!r} is not a number") from None
+    else:
+        try:
+            out = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"{what}: {value!r} is not an array of numbers") from None
+        if out.shape != (n,):
+            raise ValueError(f"{what}: shape {out.shape} does not match the {n} coordinates "
+                             f"{list(model.coordinates)}; give an array of shape ({n},) or a dict")
+    bad = [model.coordinates[k] for k in np.flatnonzero(~np.isfinite(out))]
+    if bad:
+        raise ValueError(f"{what}: not finite for {bad}; give finite numbers (m, rad; m/s, rad/s)")
+    return out
+
+
+def square_matrix(a, what, n=None):
+    """A square float64 matrix from a number or array (a number is a 1×1 matrix)."""
+    try:
+        m = np.atleast_2d(np.asarray(a, dtype=float))
+    except (TypeError, ValueError):
+        raise ValueError(f"{what}: {a!r} is not a number or a square matrix of numbers") from None
+    if m.ndim != 2 or m.shape[0] != m.shape[1] or (n is not None and m.shape[0] != n):
+        raise ValueError(f"{what}: shape {m.shape}; give a square matrix"
+                         + (f" of shape ({n}, {n}) like M" if n is not None else ""))
+    if not np.all(np.isfinite(m)):
+        raise ValueError(f"{what}: {a!r} has non-finite entries; give finite numbers")
+    return m
+
+
+SEAS = ("hydro.Regular(height=, period=), hydro.Jonswap(hs=, tp=), hydro.PiersonMoskowitz(hs=, "
+        "tp=), hydro.UserSpectrum, hydro.MeasuredElevation")
+
+
+def check_sea(sea, what="sea", *, still_water=True):
+    """A sea state of :mod:`hydro.waves` (anything with ``components``), or None for still water
+    where ``still_water``: TypeError for another object, ValueError for None where a sea is
+    needed (the spectral and linear levels)."""
+    if sea is None:
+        if still_water:
+            return
+        raise ValueError(f"{what}: None; this needs a sea state: give one of {SEAS}")
+    if not hasattr(sea, "components"):
+        raise TypeError(f"{what}: {sea!r} is not a sea state; give one of {SEAS}"
+                        + (", or None for still water" if still_water else ""))

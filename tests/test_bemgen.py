@@ -17,7 +17,7 @@ pytest.importorskip("capytaine")
 
 import mfm  # noqa: E402
 from hydro import bem  # noqa: E402
-from mfm import bemgen  # noqa: E402
+from mfm.io import bemgen  # noqa: E402
 from mfm.io.config import load_config  # noqa: E402
 
 from conftest import CONFIGS, ROOT  # noqa: E402

@@ -280,7 +280,7 @@ def test_fairlead_leaving_the_table_is_an_error_naming_the_line():
     model = hull_model()
     ld = CatenaryLines.create(model, wy_lines(table_extent=[3.0, 3.0], table_step=[0.5, 0.5]))
     assert (ld.table_margin(model, np.zeros(3)) > 2.9).all()
-    from mfm.timedomain.simulation import SimulationError
+    from mfm.errors import SimulationError
 
     with pytest.raises(SimulationError, match=r"catenary line 'L\d' (left|was .* from the edge of) its table .*widen table_extent"):
         mfm.simulate(model, None, duration=20.0, dt=0.1, qd0={"hull.surge": 1.0}, loads=ld,
@@ -482,7 +482,7 @@ def wy_platform():
 
 
 def _euler(q):
-    """R = R_z(yaw) R_y(pitch) R_x(roll) (mfm's free joint, mfm/compile.py; MoorPy's
+    """R = R_z(yaw) R_y(pitch) R_x(roll) (mfm's free joint, mfm/mechanics/compile.py; MoorPy's
     rotationMatrix(roll, pitch, yaw) is the same) and E, whose columns map the angle rates
     (roll, pitch, yaw) to the angular velocity in inertial axes: ω = R_z R_y x̂ φ̇ + R_z ŷ θ̇ + ẑ ψ̇."""
     from moorpy.helpers import rotationMatrix

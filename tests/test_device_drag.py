@@ -1,7 +1,7 @@
 """Quadratic drag set by the config keys (drag_coefficient, drag_area per inertial axis), on a float
 pitching about a hinge, against a hand ODE integrated by scipy.
 
-The drag law as documented (mfm/water.py): per inertial axis, on the velocity u of the body's hydro
+The drag law as documented (mfm/loads/water.py): per inertial axis, on the velocity u of the body's hydro
 reference point, F_a = −½ ρ C_D,a A_a |u_a| u_a (a = x, y, z); not the vector form
 −½ ρ C_D A |u| u. The hinge is placed so that the reference point moves along x and z at once, where
 the two forms differ, and away from the CoM, whose velocity differs from the reference point's.

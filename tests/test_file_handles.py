@@ -98,7 +98,7 @@ def test_database_held_open_while_mfm_hydro_rewrites_it(tmp_path):
     r = run_python(f"""
         import xarray as xr, mfm
         from hydro import bem
-        from mfm import bemgen
+        from mfm.io import bemgen
         shipped = bem.load({str(SPHERE_NC)!r})
         bem.solve = lambda *a, **k: shipped.copy()
         ds = xr.open_dataset({str(db)!r})                  # held open

@@ -344,7 +344,7 @@ def test_damped_min_det_of_the_piston_float_is_its_response_peak(piston):
     """With water, the damped minimum of |det| is where the response to a unit force peaks: the
     maximum of |1/Λ(ω)| for the 1-dof float (found here on a fine grid of the same Λ, B(ω) from the
     database, to the grid step 1e-4 rad/s), below the undamped eigenfrequency."""
-    from mfm.frequency import _mass_and_damping_at
+    from mfm.frequency.response import _mass_and_damping_at
 
     nf = mfm.natural_frequencies(piston, omega_grid=np.linspace(1.5, 4.5, 301))
     (w,) = nf.min_det_damped.values

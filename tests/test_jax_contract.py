@@ -8,7 +8,7 @@ from conftest import CONFIGS
 
 from hydro.prepare import HydroSpec
 import mfm
-from mfm.timedomain.simulation import TRACES
+from mfm.timedomain.rollout import TRACES
 
 MODEL = mfm.load(CONFIGS / "m4_111.toml", hydro=False)  # mechanics in vacuum
 Q0 = np.array([0.0, 0.0, 0.05, -0.1])

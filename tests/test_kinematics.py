@@ -5,7 +5,7 @@ import pytest
 from conftest import CONFIGS
 
 import mfm
-from mfm import se3
+from mfm.mechanics import se3
 from mfm.io.config import parse_config
 
 RNG = np.random.default_rng(3)

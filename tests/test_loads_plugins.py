@@ -41,22 +41,41 @@ def _imports(package: str) -> dict[str, set[str]]:
                     target = ".".join(base + ([node.module] if node.module else []))
                 else:
                     target = node.module
-                deps.add(target)
+                # `from pkg import module` imports the module (and runs pkg/__init__ first, as
+                # every import does); `from module import name` imports the module
                 deps |= {f"{target}.{a.name}" for a in node.names}
+                deps.add(target)
         graph[mod] = {d for d in deps if d.split(".")[0] in ("mfm", "hydro")}
     return graph
 
 
+def _module_graph(*packages) -> dict[str, set[str]]:
+    """:func:`_imports` of ``packages`` with every dependency a module of them: an imported name
+    (a class, a function) stands for its module, and ``from pkg import module`` for the module
+    alone (not the package's __init__, which runs for any import of its modules)."""
+    graph = {}
+    for package in packages:
+        graph.update(_imports(package))
+    out = {}
+    for m, deps in graph.items():
+        mods = {d for d in deps if d in graph}
+        named = {d.rsplit(".", 1)[0] for d in deps if d not in graph}
+        # a package that appears only as the parent of modules imported from it
+        parents = {d for d in mods if any(x.startswith(d + ".") for x in mods)
+                   and d not in named}
+        out[m] = ((mods - parents) | (named & set(graph))) - {m}
+    return out
+
+
 def test_import_graph_has_no_cycle_and_hydro_never_imports_mfm():
-    graph = {**_imports("mfm"), **_imports("hydro")}
-    # an imported name that is not a module (a class, a function) is an import of its module
-    graph = {m: {d if d in graph else d.rsplit(".", 1)[0] for d in deps} & set(graph) - {m}
-             for m, deps in graph.items()}
+    graph = _module_graph("mfm", "hydro")
     for m, deps in graph.items():
         if m.startswith("hydro"):
             assert not {d for d in deps if d.startswith("mfm")}, (m, deps)
-    # the package __init__ files re-export everything: leave them out of the cycle search
-    nodes = {m for m in graph if m not in ("mfm", "hydro", "mfm.loads")}
+    # nothing inside imports the front door (mfm/__init__ imports everything): only `python -m mfm`
+    assert not {m for m, deps in graph.items() if "mfm" in deps and m != "mfm.__main__"}
+    # the package __init__ files re-export their modules: leave them out of the cycle search
+    nodes = {m for m in graph if m not in ("mfm", "hydro", "mfm.loads", "mfm.frequency")}
     state = {}
 
     def visit(m, path):
@@ -73,9 +92,26 @@ def test_import_graph_has_no_cycle_and_hydro_never_imports_mfm():
             visit(m, [])
 
 
+def test_a_load_imports_only_the_mechanics_and_the_load_protocol():
+    # the loads sit on the mechanics: what needs more (the model's linearisation for a damping
+    # ratio, lines linearised about the equilibrium, datasets) is done above them (mfm.frequency,
+    # mfm.io.build, mfm.results), never reached up to from a load module
+    graph = _module_graph("mfm")
+    allowed = ("mfm.mechanics", "mfm.loads.base", "mfm.loads.pto", "mfm.loads.radiation",
+               "mfm.validation", "mfm.errors", "mfm._xla")
+    runners = ("mfm.loads", "mfm.loads.registry", "mfm.loads.assembly")
+    for m, deps in graph.items():
+        if m.startswith("mfm.loads") and m not in runners:
+            bad = {d for d in deps if d.startswith("mfm") and not d.startswith(allowed)}
+            assert not bad, f"{m} imports {sorted(bad)}"
+    # and the runner builds the water beside the config's loads: loads only, and the checks
+    assert {d for d in graph["mfm.loads.assembly"] if d.startswith("mfm")} <= {
+        "mfm.loads.base", "mfm.loads.water", "mfm.validation"}
+
+
 def test_model_type_does_not_build():
-    # mfm.model is the type; building (config → tree → model + loads) lives in mfm.build
-    src = (ROOT / "mfm" / "model.py").read_text()
+    # mfm.mechanics.model is the type; building (config → tree → model + loads) lives in mfm.io.build
+    src = (ROOT / "mfm" / "mechanics" / "model.py").read_text()
     assert "load_config" not in src and "def load(" not in src
     assert mfm.load is mfm.io.build.load
 
@@ -268,7 +304,7 @@ def test_integrator_stage_offsets_drive_the_convolution():
     with pytest.raises(TypeError, match="stage_offsets"):
         mfm.simulate(m, None, duration=0.1, dt=0.01, integrator=Silent())
     # RK4 evaluates at 0, dt/2, dt: one weight set per stage
-    from mfm.timedomain.simulation import model_loads
+    from mfm.timedomain.setup import model_loads
 
     ld = model_loads(m, None, dt=0.01, duration=0.1, memory=1.0)[0]
     assert ld.rad.W_lag.shape[0] == 3 and ld.rad.stage_offsets == (0.0, 0.5, 1.0)

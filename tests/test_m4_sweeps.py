@@ -19,7 +19,7 @@ from hydro.prepare import HydroSpec
 import mfm
 from hydro import statespace as S
 from hydro.waves import elevation
-from mfm import wec
+from mfm.studies import wec
 from mfm.studies.fidelity import reduce, variant_model
 from mfm.frequency.spectral import spectral_response
 from hydro.prepare import modal_form

@@ -223,7 +223,7 @@ def _box_stl(path, half):
 def test_edited_stl_is_not_up_to_date(tmp_path, capsys):
     pytest.importorskip("capytaine")
     pytest.importorskip("trimesh")
-    from mfm import bemgen
+    from mfm.io import bemgen
 
     _box_stl(tmp_path / "hull.stl", 0.1)
     cfg = tmp_path / "box.toml"
@@ -519,7 +519,7 @@ def _same_numbers(a, b):
 
 
 def test_chunk_plan_one_length_few_blocks_wasted():
-    from mfm.timedomain.simulation import chunk_plan
+    from mfm.timedomain.progress import chunk_plan
 
     assert chunk_plan(7) == (1, 7)
     for n in (21, 100, 211, 2000, 20000, 99991):
@@ -533,7 +533,7 @@ def test_progress_bar_gives_the_same_numbers_with_one_compilation(capsys):
     the last one past the end, its extra step dropped) and writes the bar to stderr; the results
     equal the unchunked run's to the last bit."""
     import mfm
-    from mfm.timedomain.simulation import TRACES
+    from mfm.timedomain.rollout import TRACES
 
     m = mfm.load(CONFIGS / "double_pendulum.toml")
     kw = dict(duration=2.11, dt=0.01, q0={"upper.angle": 0.5}, integrator="rk4")

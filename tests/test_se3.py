@@ -5,7 +5,7 @@ import pytest
 import scipy.linalg
 from scipy.spatial.transform import Rotation
 
-from mfm import se3
+from mfm.mechanics import se3
 
 RNG = np.random.default_rng(7)
 # Identities of exact algebra evaluated in float64: a few ulps of the O(1) entries.

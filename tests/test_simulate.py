@@ -66,7 +66,7 @@ def test_auto_radiation_takes_the_cheaper_and_says_why():
     # history sum is formed once per step for each stage offset: RK4 3, Verlet 2): M4 134 (24
     # moved dofs, T_K ≈ 39 s) over 100 T_p at T_p/200 with RK4 is 2e11 multiply–adds (minutes):
     # the state space; 200 steps of it (2e9) and RM3's 2000 steps (5e7): the convolution.
-    from mfm.timedomain.simulation import AUTO_CONVOLUTION_LIMIT, choose_radiation
+    from mfm.timedomain.setup import AUTO_CONVOLUTION_LIMIT, choose_radiation
 
     m4 = mfm.load(CONFIGS / "m4_134.toml")
     name, why = choose_radiation(m4, dt=0.006, n_steps=20_000)
@@ -85,19 +85,18 @@ def test_outputs_computed_after_the_loop_equal_those_inside_it(monkeypatch):
     # a recorded run with a small memory evaluates its outputs after the time loop, vmapped over
     # the saved samples; forcing them back into the loop must give the same numbers (to round-off:
     # the vectorised products may sum in another order)
-    import importlib
-
     import jax
 
-    S = importlib.import_module("mfm.timedomain.simulation")   # the module (mfm.simulate is also the function)
+    from mfm.timedomain import record as S
+    from mfm.timedomain.rollout import TRACES
     m = mfm.load(CONFIGS / "double_pendulum.toml")
     kw = dict(duration=1.37, dt=0.01, q0={"upper.angle": 0.8}, save_every=1)
     after = mfm.simulate(m, **kw)
     monkeypatch.setattr(S, "DEFERRED_RECORD_MEMORY", -1)
     jax.clear_caches()                     # the setting is read when the rollout is traced
-    before = S.TRACES["rollout"]
+    before = TRACES["rollout"]
     inside = mfm.simulate(m, **kw)
-    assert S.TRACES["rollout"] == before + 1
+    assert TRACES["rollout"] == before + 1
     assert after.sizes["time"] == 138
     for v in after.data_vars:
         if np.issubdtype(after[v].dtype, np.number):

@@ -13,7 +13,8 @@ import pytest
 
 import mfm
 from hydro.database import HydroDatabaseWarning
-from mfm import stability as st
+from mfm.studies import floquet as fq
+from mfm.studies import stability as st
 from mfm.loads.base import Load, LoadOutput
 
 
@@ -162,7 +163,7 @@ def test_floquet_of_the_damped_mathieu_equation_against_scipy(oscillator):
     model = _osc(oscillator, m, k, c)
     load = _Mathieu(k=k, eps=eps, Omega=2 * w0)
     dt = T / 400
-    r = st.floquet(model, None, period=T, dt=dt, t_start=0.0, integrator="rk4", loads=[load],
+    r = fq.floquet(model, None, period=T, dt=dt, t_start=0.0, integrator="rk4", loads=[load],
                    refine=0)
 
     def rhs(t, y):
@@ -186,7 +187,7 @@ def test_floquet_of_a_time_invariant_system_is_the_step_power(oscillator):
     model = _osc(oscillator, m, k, c)
     T, n = math.pi, 400
     dt = T / n
-    r = st.floquet(model, None, period=T, dt=dt, t_start=0.0, integrator="rk4", refine=0,
+    r = fq.floquet(model, None, period=T, dt=dt, t_start=0.0, integrator="rk4", refine=0,
                    loads=[_Mathieu(k=k, eps=0.0, Omega=2.0)])
     lam = np.roots([m, c, k])
     z = lam * dt
@@ -203,7 +204,7 @@ def test_envelope_growth_rate_of_a_synthetic_run():
     T, sigma = 8.0, 0.01
     t = np.arange(0, 800, 0.2)
     y = 0.03 * np.sin(2 * np.pi * t / T) + 1e-4 * np.exp(sigma * t) * np.cos(np.pi * t / T)
-    s, mids, peaks = st.envelope_growth_rate(t, y, T, 100.0, 500.0)
+    s, mids, peaks = fq.envelope_growth_rate(t, y, T, 100.0, 500.0)
     assert s == pytest.approx(sigma, rel=1e-3)
 
 
@@ -224,10 +225,10 @@ def test_bad_arguments_name_the_argument_value_and_what_is_accepted(oscillator):
     model = _osc(oscillator, 1.0, 1.0, 0.1)
     with pytest.raises(ValueError, match=r"period: 1.05 s is not a whole number of steps of "
                                          r"dt = 0.1 s"):
-        st.floquet(model, None, period=1.05, dt=0.1, t_start=0.0, integrator="rk4")
+        fq.floquet(model, None, period=1.05, dt=0.1, t_start=0.0, integrator="rk4")
     with pytest.raises(ValueError, match=r"radiation='fast'; accepted"):
-        st.floquet(model, None, period=1.0, dt=0.1, t_start=0.0, radiation="fast")
+        fq.floquet(model, None, period=1.0, dt=0.1, t_start=0.0, radiation="fast")
     with pytest.raises(ValueError, match=r"t_start: -1.0; give a time ≥ 0"):
-        st.floquet(model, None, period=1.0, dt=0.1, t_start=-1.0)
+        fq.floquet(model, None, period=1.0, dt=0.1, t_start=-1.0)
     with pytest.raises(ValueError, match=r"mass_ratio: -1.0; give A∞/m ≥ 0"):
         st.heave_loads(model, -1.0, dt=0.1, n_steps=10)

@@ -18,7 +18,7 @@ from conftest import CONFIGS
 
 import hydro
 import mfm
-from mfm import wec
+from mfm.studies import wec
 from mfm.frequency import linear_system
 from mfm.mechanics.kinematics import kinematics
 from mfm.mechanics.points import BodyPoints

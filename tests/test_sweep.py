@@ -79,7 +79,7 @@ def test_threads_and_lanes_give_the_same_cases(rm3, seas, reference):
     """simulate_batch runs its cases in parts from host threads (one per core by default) and in
     groups of ``lanes`` vmapped together: every split must give the reference's numbers (RTOL:
     only the vmapped round-off differs), a padded last part included, once compiled per shape."""
-    trace = sys.modules["mfm.timedomain.simulation"].TRACES
+    trace = sys.modules["mfm.timedomain.rollout"].TRACES
     before = trace["rollout"]
     # 3 cases in 2 threads: parts of 2, the last padded by repeating its case, dropped after;
     # lanes=2 is a shape nothing else here compiles: the two threads share one compilation
@@ -152,7 +152,7 @@ def test_models_of_a_parameter_sweep_reach_their_cases(rm3, monkeypatch):
         got.append(([float(x.damping.sum()) for x in m], kw["dt"].tolist()))
         raise RuntimeError("spy")
 
-    monkeypatch.setattr(sweep_mod._simulate, "simulate_batch", spy)
+    monkeypatch.setattr(sweep_mod, "simulate_batch", spy)
     with pytest.raises(mfm.SweepError, match="every chunk.*spy"):
         mfm.sweep(models, None, dt=[0.1, 0.2, 0.3], n_steps=2, chunk_size=2, progress=False)
     c = float(rm3.damping.sum())
@@ -187,7 +187,7 @@ def test_missing_dask_names_the_extra(rm3, seas, monkeypatch):
 
 
 def _traces():
-    return dict(sys.modules["mfm.timedomain.simulation"].TRACES)
+    return dict(sys.modules["mfm.timedomain.rollout"].TRACES)
 
 
 def test_two_worker_cluster_equals_one_batch_and_compiles_once_per_worker(rm3, seas, reference):

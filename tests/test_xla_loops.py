@@ -12,7 +12,8 @@ import pytest
 import hydro
 import mfm
 from mfm import _xla, integrators
-from mfm.timedomain.simulation import _rollout_jit, model_loads
+from mfm.timedomain.rollout import rollout_jit
+from mfm.timedomain.setup import model_loads
 
 from conftest import CONFIGS, ROOT
 
@@ -35,7 +36,7 @@ def _rm3_rollout_script(n_steps):
     """The rollout both processes run: RM3 in a regular wave, Verlet with exact radiation."""
     return f"""
 import json, jax.numpy as jnp, hydro, mfm
-from mfm.timedomain.simulation import model_loads
+from mfm.timedomain.setup import model_loads
 m = mfm.load({str(CONFIGS / 'rm3.toml')!r})
 q0 = jnp.zeros(m.n_coordinates)
 q, qd = mfm.rollout(m, q0, q0, dt=0.1, n_steps={n_steps}, integrator="verlet",
@@ -64,7 +65,7 @@ def test_the_rollout_loop_is_compiled_whole(rm3):
     m, loads = rm3
     q0 = jnp.zeros(m.n_coordinates)
     z0 = jnp.concatenate([ld.initial_state(m) for ld in loads])
-    txt = _rollout_jit.lower(m, loads, q0, q0, z0, jnp.asarray(0.0), jnp.asarray(0.1),
+    txt = rollout_jit.lower(m, loads, q0, q0, z0, jnp.asarray(0.0), jnp.asarray(0.1),
                              n_steps=N_STEPS, integrator=integrators.get("verlet"),
                              save_every=N_STEPS, record=False).compile().as_text()
     assert "xla_cpu_small_call" in txt
@@ -81,7 +82,7 @@ def test_every_load_keeps_the_loop_whole(config, radiation):
                         ramp=0.5, radiation=radiation, integrator="verlet")
     q0 = jnp.zeros(m.n_coordinates)
     z0 = jnp.concatenate([ld.initial_state(m) for ld in loads])
-    txt = _rollout_jit.lower(m, loads, q0, q0, z0, jnp.asarray(0.0), jnp.asarray(0.05),
+    txt = rollout_jit.lower(m, loads, q0, q0, z0, jnp.asarray(0.0), jnp.asarray(0.05),
                              n_steps=20, integrator=integrators.get("verlet"), save_every=20,
                              record=False).compile().as_text()
     assert "xla_cpu_small_call" in txt

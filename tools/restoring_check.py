@@ -1,7 +1,7 @@
 """`mfm info` and the `mfm simulate` run summary name the same free coordinates, for every
 shipped config: info's line on restoring against the summary line of a one-step run in regular
 waves without a ramp (the excitation at t = 0 must not count as restoring), plus the smallest
-restoring diagonal K_kk / max|K| (the margin of :func:`mfm.timedomain.simulation.free_coordinates`'s 1e-9).
+restoring diagonal K_kk / max|K| (the margin of :func:`mfm.frequency.rest.free_coordinates`'s 1e-9).
 Prints a table; exits 1 if any line differs. Minutes per large config (loading, compiling).
 
     python tools/restoring_check.py [configs/rm3.toml ...]      (default: every configs/**/*.toml)
@@ -37,7 +37,8 @@ def main(paths):
     import mfm
     from mfm.io.cli import _restoring_text
     from mfm_cli import main as cli
-    from mfm.timedomain.simulation import linearised_at_rest, model_loads
+    from mfm.frequency.rest import linearised_at_rest
+    from mfm.timedomain.setup import model_loads
 
     warnings.simplefilter("ignore")
     bad = 0

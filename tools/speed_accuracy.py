@@ -49,8 +49,8 @@ T/25 (every case saves there: the same estimator for all):
 
 Wall time: ``warm_s`` is the median of repeated warm calls (3 when a call is under 2 s, 2 under
 5 s — RM3's rows: 10 s —, else 1; each row has its ``repeats``) of what a run costs once compiled: the loads for this sea and grid
-(:func:`mfm.timedomain.simulation.model_loads`: excitation tables, convolution weights, exact propagators) and
-the compiled rollout (:func:`mfm.timedomain.simulation.rollout`, no per-sample outputs) to its last sample;
+(:func:`mfm.timedomain.setup.model_loads`: excitation tables, convolution weights, exact propagators) and
+the compiled rollout (:func:`mfm.timedomain.rollout.rollout`, no per-sample outputs) to its last sample;
 ``compile_s`` is the first call's excess over it (tracing and XLA compilation; the state-space fit
 is made before and cached). A run that goes non-finite is recorded as ``"non-finite"`` with the
 time it stopped.

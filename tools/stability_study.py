@@ -55,7 +55,7 @@ def _integrator(name):
 def stability_map(n_steps=2000):
     """Largest stable dt/T_min per scheme and A∞/m, predicted (spectral radius of the engine's
     step on the linear heave equation) and measured (rollouts of the heave model)."""
-    from mfm import stability as st
+    from mfm.studies import stability as st
 
     model, p = st.heave_model(0.02)
     m, K, c = p["m"], p["K"], p["c"]
@@ -105,7 +105,7 @@ def mooring(model, k):
 def rm3_runs(which=None):
     import hydro
     import mfm
-    from mfm import stability as st
+    from mfm.studies import floquet as fq
 
     model = rm3()
     sea = hydro.Regular(**RM3_SEA)
@@ -125,10 +125,10 @@ def rm3_runs(which=None):
         # the envelope of the deviation from 8 s periodicity, whole run; σ fitted on its
         # exponential phase (LINEAR_PHASE), from the first period past its lower bound to the
         # first past its upper one
-        _, mids, peaks = st.envelope_growth_rate(t, pitch, 8.0, 0.0, 3990.0)
+        _, mids, peaks = fq.envelope_growth_rate(t, pitch, 8.0, 0.0, 3990.0)
         a = mids[np.argmax((peaks > LINEAR_PHASE[0]) & (mids > 2 * RUN_RAMP))] - 4.0
         b = mids[np.argmax((peaks > LINEAR_PHASE[1]) & (mids > a))] + 4.0
-        sigma, _, _ = st.envelope_growth_rate(t, pitch, 8.0, a, b)
+        sigma, _, _ = fq.envelope_growth_rate(t, pitch, 8.0, a, b)
         key = f"{integ} {rad} dt {dt}"
         win = lambda a, b: (t >= a) & (t < b)  # noqa: E731
         out[key] = dict(sigma=sigma, fit_window=[float(a), float(b)], wall_s=time.time() - t0,
@@ -146,7 +146,7 @@ def rm3_runs(which=None):
 
 def rm3_floquet(which=None):
     import hydro
-    from mfm import stability as st
+    from mfm.studies import floquet as fq
 
     base = rm3()
     cases = {
@@ -177,7 +177,7 @@ def rm3_floquet(which=None):
         model = kw.pop("model", base)
         dt = kw.pop("dt", 0.1)
         t0 = time.time()
-        r = st.floquet(model, hydro.Regular(height=H, period=T), period=T, dt=dt,
+        r = fq.floquet(model, hydro.Regular(height=H, period=T), period=T, dt=dt,
                        t_start=T_START, ramp=RM3_RAMP, **{"integrator": "verlet",
                                                           "radiation": "state_space_exact", **kw})
         mu = r.multipliers

@@ -43,20 +43,15 @@ import jax.numpy as jnp
 import numpy as np
 import xarray as xr
 
-from . import response as _fd
 from .. import results
+from ..loads.pto import load_dampers
 from ..mechanics.model import Model
-from .spectral import _check_sea
+from ..validation import check_sea, finite_number
+from .rest import linear_system, water_of
 
 # the largest condition number of the mode matrix V accepted: the modes' round-off grows as
 # cond(V)·ε (1e10: 1e-6 relative; in the 1-norm RM3 has 4.6e3, M4 134 2.1e4)
 MAX_MODE_CONDITION = 1e10
-
-
-def _number(value, what, **kw):
-    from ..timedomain.simulation import _number as number
-
-    return number(value, what, **kw)
 
 
 def lti_matrices(M, C, K, H0=None, rad=None, free=()):
@@ -218,7 +213,7 @@ def lti_response(M, C, K, f, dt, *, save_every: int = 1, H0=None, rad=None, free
 
 def _free_columns(K):
     """Coordinates nothing depends on the position of: a zero column of K (≤ 1e-9 of its largest
-    entry, the threshold of :func:`mfm.timedomain.simulation.free_coordinates`)."""
+    entry, the threshold of :func:`mfm.frequency.rest.free_coordinates`)."""
     scale = max(float(np.abs(K).max()), 1e-300)
     return [k for k in range(K.shape[1]) if float(np.abs(K[:, k]).max()) <= 1e-9 * scale]
 
@@ -254,10 +249,10 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: linear_response needs a "
                          "config with a [hydro] table")
-    _check_sea(sea)
-    dt = _number(dt, "dt", positive=True)
-    duration = _number(duration, "duration", positive=True)
-    ramp = _number(ramp, "ramp", nonnegative=True)
+    check_sea(sea, still_water=False)
+    dt = finite_number(dt, "dt", positive=True)
+    duration = finite_number(duration, "duration", positive=True)
+    ramp = finite_number(ramp, "ramp", nonnegative=True)
     n_steps = int(round(duration / dt))
     if n_steps < 1:
         raise ValueError(f"duration = {duration} s is shorter than one step dt = {dt} s")
@@ -266,13 +261,13 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
         raise ValueError(f"save_every: {save_every!r} must be a positive divisor of the {n_steps} "
                          "steps")
     start = _time.perf_counter()
-    sys = _fd.linear_system(model, q0, loads=loads)
+    sys = linear_system(model, q0, loads=loads)
     other = [type(ld).__name__ for ld in sys.loads if not isinstance(ld, Water)
              and type(ld).frequency_terms is not Load.frequency_terms]
     if other:
         raise NotImplementedError(f"loads {other} add frequency-dependent terms that have no "
                                   "time-domain realisation in the linear level; use mfm.simulate")
-    water = _fd._water(sys.loads)
+    water = water_of(sys.loads)
     spec = model.hydro
     rad = StateSpace.build(spec, state_space_options)
     H0 = np.asarray(water.geometry.h_matrix(sys.kin0)[0])
@@ -295,4 +290,4 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
                     mode_condition=cond, wall_time_s=wall)
     return results.linear_time_series(model, sys.loads + (rad,), ts, q, qd, qdd, sys.q0, eta,
                                       settings, source=spec.source,
-                                      dampers=results.linear_dampers(sys.loads, sys.kin0))
+                                      dampers=load_dampers(sys.loads, sys.kin0))

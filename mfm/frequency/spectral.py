@@ -26,15 +26,12 @@ import time as _time
 import numpy as np
 import xarray as xr
 
-from . import response as _fd
 from .. import results
+from ..loads.pto import linear_ptos, mean_absorbed_power
 from ..mechanics.model import Model
-
-def _check_sea(sea):
-    if sea is None or not hasattr(sea, "components"):
-        raise ValueError(f"sea: {sea!r}; give a sea state of hydro.waves (Regular, Jonswap, "
-                         "PiersonMoskowitz, UserSpectrum, ...)")
-
+from ..validation import check_sea
+from .response import _amplitudes
+from .rest import linear_system
 
 def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
                       radiation: str = "database", state_space_options: dict | None = None
@@ -58,7 +55,7 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: spectral_response needs a "
                          "config with a [hydro] table")
-    _check_sea(sea)
+    check_sea(sea, still_water=False)
     if t is not None:
         try:
             t = np.asarray(t, dtype=float)
@@ -67,17 +64,9 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
         if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)):
             raise ValueError(f"t: shape {t.shape}; give a non-empty 1-D array of finite times (s)")
     # one sea is the one-case sweep (one place for the synthesis), relabelled over time
-    ds = spectral_sweep(model, [sea], t=t, q0=q0, loads=loads, radiation=radiation,
-                        state_space_options=state_space_options).isel(case=0, drop=True)
-    attrs = {**ds.attrs, "title": f"mfm spectral response of {model.name}", "sea": repr(sea),
-             "n_components": int(ds.n_components)}
-    attrs.pop("seas", None)
-    ds = ds.drop_vars("n_components")
-    if t is not None:
-        ds = ds.drop_vars("time").rename_dims(step="time").assign_coords(
-            time=("time", t, {"units": "s"}))
-    ds.attrs = attrs
-    return ds
+    return results.spectral_one(spectral_sweep(model, [sea], t=t, q0=q0, loads=loads,
+                                               radiation=radiation,
+                                               state_space_options=state_space_options), sea, t)
 
 
 def _union_raos(model, sys, comps_list, options):
@@ -95,7 +84,7 @@ def _union_raos(model, sys, comps_list, options):
     x = np.zeros((len(union), model.n_coordinates), dtype=complex)
     for beta in np.unique(union[:, 0]):
         sel = union[:, 0] == beta
-        x[sel] = _fd._amplitudes(model, sys, union[sel, 1], float(beta), options)
+        x[sel] = _amplitudes(model, sys, union[sel, 1], float(beta), options)
     bounds = np.cumsum([0] + [len(c.omega) for c in comps_list])
     return [x[inverse[bounds[i]:bounds[i + 1]]] for i in range(len(comps_list))], len(union)
 
@@ -168,8 +157,6 @@ def spectral_sweep(model: Model, seas, *, t=None, q0=None, loads=None,
     step). Attributes: provenance, ``level = "spectral"``, the seas, ``n_frequencies_solved`` (the
     union), the wall times of the RAO solve and of the whole call.
     """
-    from ..timedomain.simulation import _sea_labels
-
     start = _time.perf_counter()
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: the spectral level needs a "
@@ -178,67 +165,28 @@ def spectral_sweep(model: Model, seas, *, t=None, q0=None, loads=None,
     if not seas:
         raise ValueError("seas: an empty sequence; give at least one sea state of hydro.waves")
     for i, sea in enumerate(seas):
-        try:
-            _check_sea(sea)
-        except ValueError as e:
-            raise ValueError(f"seas[{i}]: {e}") from None
+        check_sea(sea, f"seas[{i}]", still_water=False)
     B = len(seas)
     times = _times(t, B)
     comps = [s.components(water_depth=model.hydro.water_depth, g=model.hydro.g) for s in seas]
     options = {"radiation": radiation, "state_space_options": state_space_options}
-    sys = _fd.linear_system(model, q0, loads=loads)
+    sys = linear_system(model, q0, loads=loads)
     solve_start = _time.perf_counter()
     xs, n_union = _union_raos(model, sys, comps, options)
     solve_s = _time.perf_counter() - solve_start
     n = model.n_coordinates
-    damped = [k for k in range(n) if float(model.damping[k]) > 0]
     # every PTO as a damping c on a rate G q̇: the joint dampers (rows of the identity), then the
     # loads' pistons linearised at q₀ (the time domain's pto order)
-    dampers = results.linear_dampers(sys.loads, sys.kin0)
-    G = np.concatenate([np.eye(n)[damped]] + [np.asarray(d.rows) for d in dampers])
-    c = np.concatenate([np.asarray(model.damping, dtype=float)[damped]]
-                       + [np.asarray(d.damping, dtype=float) for d in dampers])
+    ptos = linear_ptos(model, sys.loads, sys.kin0)
+    G, c = ptos.rows, ptos.damping
     q_rms = np.empty((B, n))
     power = np.empty((B, len(c)))
     for i, (cm, x) in enumerate(zip(comps, xs)):
         a2 = cm.amplitude[:, None] ** 2
-        power[i] = np.sum(a2 * results.mean_absorbed_power(c, cm.omega[:, None], x @ G.T), axis=0)
+        power[i] = np.sum(a2 * mean_absorbed_power(c, cm.omega[:, None], x @ G.T), axis=0)
         q_rms[i] = np.sqrt(np.sum(0.5 * a2 * np.abs(x) ** 2, axis=0))
-    data = {
-        "q_rms": (("case", "coordinate"), q_rms,
-                  {"long_name": "standard deviation about the equilibrium",
-                   "units": "m or rad (per coordinate: coordinate_unit)"}),
-        "pto_power_mean": (("case", "pto"), power,
-                           {"long_name": "expected mean power of each joint damper and piston, "
-                            "Σ a² ½ c ω² |G x|²", "units": "W"}),
-        "n_components": (("case",), np.array([len(cm.omega) for cm in comps]),
-                         {"long_name": "wave components of the case's sea"}),
-        "equilibrium": (("coordinate",), sys.q0, {"units": "m or rad"}),
-    }
-    coords = {"case": np.arange(B), **results._coordinate_coords(model),
-              "pto": [model.coordinates[k] for k in damped] + [p for d in dampers for p in d.names]}
-    if times is not None:
-        q, qd, eta = _synthesise(comps, xs, times, sys.q0)
-        data.update(
-            time=(("case", "step"), np.array(times), {"units": "s"}),
-            q=(("case", "step", "coordinate"), q,
-               {"long_name": "generalised coordinates",
-                "units": "m or rad (per coordinate: coordinate_unit)"}),
-            qd=(("case", "step", "coordinate"), qd,
-                {"long_name": "generalised velocities", "units": "m/s or rad/s"}),
-            pto_power=(("case", "step", "pto"), results.absorbed_power(c, qd @ G.T),
-                       {"long_name": "power absorbed by each joint damper and piston, c (G q̇)²",
-                        "units": "W"}),
-            eta=(("case", "step"), eta,
-                 {"long_name": "undisturbed wave elevation at the origin", "units": "m"}))
-    ds = xr.Dataset(data, coords=coords)
-    for name, (values, attrs) in _sea_labels(seas).items():
-        ds = ds.assign_coords({name: ("case", np.asarray(values), attrs)})
-    ds.attrs = {
-        "title": f"mfm spectral response of {model.name} in {B} sea states",
-        **results.provenance(model, sys.loads, level="spectral", seas=repr(seas),
-                             n_frequencies_solved=n_union, radiation=radiation,
-                             convention="exp(-i omega t)", rao_solve_s=solve_s,
-                             wall_time_s=_time.perf_counter() - start),
-        "source": model.hydro.source}
-    return ds
+    series = None if times is None else (np.array(times),) + _synthesise(comps, xs, times, sys.q0)
+    settings = dict(level="spectral", seas=repr(seas), n_frequencies_solved=n_union,
+                    radiation=radiation, convention="exp(-i omega t)", rao_solve_s=solve_s)
+    return results.spectral(model, sys.loads, sys.q0, q_rms, power, ptos, comps, seas, settings,
+                            series, start)

@@ -63,8 +63,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .config import load_config
-from ..mechanics.tree import ConfigError
+from .config import load_config, read_config
+from ..errors import ConfigError
 
 BEM_KEYS = {"omega_min", "omega_max", "n_omega", "omega", "headings_deg", "water_depth", "dx",
             "lid", "symmetry", "infinite_frequency", "rho", "g", "deep_water_kh", "notes"}
@@ -310,7 +310,7 @@ def _spec_diff(old: list, new: list) -> list[str]:
     return diffs
 
 
-def database_is_stale(config_path, database=None) -> tuple[bool, str]:
+def database_is_stale(config_path, database=None, *, parsed=None) -> tuple[bool, str]:
     """Whether the hydro database of a config was made from other hulls or BEM settings than the
     config has now (an edited radius, draft, position, STL file or ``[hydro.bem]`` key).
 
@@ -321,13 +321,15 @@ def database_is_stale(config_path, database=None) -> tuple[bool, str]:
     capytaine, no jax).
 
     database: the NetCDF to check (default: the config's ``[hydro] database``).
+    parsed: the config as :func:`mfm.io.config.read_config` gives it, where the caller has read
+    it already (:func:`mfm.io.build.load`: the file is read and parsed once).
 
     Returns ``(stale, reason)``: ``(True, "…")`` names each difference and the fix (``mfm hydro
     CONFIG --force``); ``(False, "…")`` says why it is up to date or why it cannot be checked (a
     WAMIT database, or a config without ``[bodies.geometry]`` tables: nothing recorded to compare).
     """
     config_path = Path(config_path)
-    options, bodies = load_config(config_path)
+    raw, options, bodies = read_config(config_path) if parsed is None else parsed
     hydro = options.get("hydro") or {}
     if database is None:
         if not hydro.get("database"):
@@ -336,15 +338,13 @@ def database_is_stale(config_path, database=None) -> tuple[bool, str]:
     database = Path(database)
     if database.suffix != ".nc":
         return False, f"{database} is not a NetCDF made by `mfm hydro` (WAMIT?): not checked"
-    raw = tomllib.loads(config_path.read_text())
     if not any("geometry" in b for b in raw.get("bodies", [])):
         return False, (f"{config_path} has no [bodies.geometry] table: the database was not made "
                        "from this config's hulls; not checked")
     from hydro.checks import check_netcdf_file
-    from hydro.database import read_netcdf
+    from hydro.database import read_netcdf_attrs
 
-    # read from memory: a file the user holds open must not get a second HDF5 handle
-    attrs = dict(read_netcdf(check_netcdf_file(database)).attrs)
+    attrs = read_netcdf_attrs(check_netcdf_file(database))
     specs = body_specs(config_path, raw, bodies)
     diffs = []
     if "mfm_geometry" in attrs:

@@ -1,6 +1,6 @@
 """Config → tree → model: the one place that assembles a :class:`~mfm.mechanics.model.Model`.
 
-:func:`load` reads and checks a TOML config (:mod:`mfm.config`), compiles the body tree
+:func:`load` reads and checks a TOML config (:mod:`mfm.io.config`), compiles the body tree
 (:func:`compile_tree`), attaches the water's :class:`~hydro.prepare.HydroSpec` when the config has
 a ``[hydro]`` table, and adds the loads of its other tables through the registry
 (:mod:`mfm.loads.registry`): data flow one way, and the model type knows nothing of how it is made.
@@ -12,12 +12,17 @@ import hashlib
 import warnings
 from pathlib import Path
 
+from hydro.database import HydroDatabaseWarning
 
-from .config import load_config
+from ..errors import ConfigError
+from ..frequency.modes import resolve_damping_ratios
 from ..loads.registry import TABLES, load_class
+from ..loads.water import load_hydro_spec
 from ..mechanics.compile import compile_tree
 from ..mechanics.model import Model
-from ..mechanics.tree import ConfigError
+from .bemgen import database_is_stale
+from .config import read_config
+
 
 def load(path: str | Path, hydro: bool = True, body_coupling: bool | None = None) -> Model:
     """Load a TOML float-tree config and compile it.
@@ -33,19 +38,14 @@ def load(path: str | Path, hydro: bool = True, body_coupling: bool | None = None
     if body_coupling is not None and not isinstance(body_coupling, bool):
         raise ValueError(f"body_coupling: {body_coupling!r}; accepted: True, False or None (the "
                          "config's hydro.body_coupling)")
-    options, bodies = load_config(path)
+    raw, options, bodies = read_config(path)
     model = compile_tree(bodies, name=options["name"], gravity=options["gravity"])
     model = dataclasses.replace(model, source=str(path),
                                 source_sha256=hashlib.sha256(Path(path).read_bytes()).hexdigest())
     if hydro and "hydro" in options:
-        from hydro.database import HydroDatabaseWarning
-
-        from .bemgen import database_is_stale
-        from ..loads.water import load_hydro_spec
-
         # a database made from other hulls or BEM settings than the config has now
         try:
-            stale, why = database_is_stale(path)
+            stale, why = database_is_stale(path, parsed=(raw, options, bodies))
         except (ConfigError, ValueError, OSError):
             # a config whose [hydro.bem] table cannot make a database has nothing to compare
             stale, why = False, ""
@@ -58,5 +58,6 @@ def load(path: str | Path, hydro: bool = True, body_coupling: bool | None = None
     for table in TABLES:
         parsed = options.get("loads", {}).get(table)
         if parsed:
-            model = dataclasses.replace(model, loads=model.loads + (load_class(table).from_parsed(parsed, model),))
+            load = resolve_damping_ratios(model, load_class(table).from_parsed(parsed, model))
+            model = dataclasses.replace(model, loads=model.loads + (load,))
     return model

@@ -11,6 +11,16 @@ import sys
 import time
 from pathlib import Path
 
+from .. import results
+from ..errors import SimulationError
+from ..frequency.modes import natural_frequencies
+from ..frequency.response import frequency_response
+from ..frequency.rest import no_restoring
+from ..timedomain.simulation import simulate
+from .bemgen import generate
+from .build import load
+from .config import load_config
+
 
 LENGTH_SUFFIXES = ("surge", "sway", "heave", "stroke")
 
@@ -62,12 +72,10 @@ def _pairs(items, what):
 def cmd_info(args):
     import numpy as np
 
-    import mfm
-    from mfm.io.config import load_config
 
     options, _ = load_config(args.config)
     wet = "hydro" in options and not args.no_hydro
-    model = mfm.load(args.config, hydro=wet)
+    model = load(args.config, hydro=wet)
     print(f"{model.name}: {model.n_bodies} bodies, {model.n_coordinates} coordinates, "
           f"gravity {float(model.gravity)} m/s²")
     print("\ntree:")
@@ -101,7 +109,6 @@ def cmd_info(args):
     print(f"\ntotal mass {float(model.mass.sum()):g} kg")
     if args.no_restoring:
         return
-    from mfm.timedomain.simulation import no_restoring
 
     print("\nrestoring at q0 = 0, where `mfm simulate` starts without --initial (" +
           ("with the water" if wet else "mechanics only: no [hydro] table" if "hydro" not in options
@@ -141,31 +148,30 @@ def cmd_simulate(args):
     if args.ramp > args.duration:
         raise ValueError(f"--ramp {args.ramp:g} s is longer than --duration {args.duration:g} s: "
                          "the waves would never reach full height; shorten the ramp")
-    import mfm
 
-    model = mfm.load(args.config, body_coupling=False if args.no_body_coupling else None)
+    model = load(args.config, body_coupling=False if args.no_body_coupling else None)
     sea = _sea(args)
     from hydro.database import write_netcdf
 
     command = "mfm " + " ".join(sys.argv[1:]) if sys.argv[1:] else "mfm simulate"
     t0 = time.perf_counter()
     try:
-        ds = mfm.simulate(model, sea, duration=args.duration, dt=args.dt, integrator=args.integrator,
+        ds = simulate(model, sea, duration=args.duration, dt=args.dt, integrator=args.integrator,
                           q0=_pairs(args.initial, "--initial"),
                           qd0=_pairs(args.initial_velocity, "--initial-velocity"),
                           save_every=args.save_every, ramp=args.ramp, radiation=args.radiation,
                           progress=args.progress)
-    except mfm.SimulationError as e:
+    except SimulationError as e:
         # keep what was computed: the run up to the last finite sample, marked incomplete
         if e.dataset is not None:
-            e.dataset.attrs["command"] = command
+            results.with_command(e.dataset, command)
             write_netcdf(e.dataset, out)
             print(f"mfm simulate: the run stopped; the {e.dataset.time.size} samples up to "
                   f"t = {float(e.dataset.time[-1]):g} s are in {out} (attribute complete = false)",
                   file=sys.stderr)
         raise
     wall = time.perf_counter() - t0
-    ds.attrs["command"] = command
+    ds = results.with_command(ds, command)
     write_netcdf(ds, out)
     n = int(round(args.duration / args.dt))
     print(f"{model.name}: {n} steps of {args.dt:g} s with {args.integrator} in {wall:.2f} s "
@@ -183,7 +189,7 @@ def cmd_simulate(args):
             print(f"  mean power of {p}: {float(half.pto_power.sel(pto=p).mean()):.6g} W")
     print("  " + _restoring_text(ds.attrs.get("no_restoring", "not checked")))
     if not args.no_plot:
-        from mfm.io.plotting import save_result_plot
+        from .plotting import save_result_plot
 
         save_result_plot(ds, png)
         print(f"  figure -> {png}")
@@ -191,7 +197,7 @@ def cmd_simulate(args):
 
 def _restoring_text(no_restoring: str) -> str:
     """The line on free drift of ``mfm info`` and of the ``mfm simulate`` summary, from the
-    coordinates :func:`mfm.timedomain.simulation.no_restoring` names (comma-separated, as in a result's
+    coordinates :func:`mfm.frequency.rest.no_restoring` names (comma-separated, as in a result's
     ``no_restoring`` attribute)."""
     if no_restoring == "not checked":
         return "restoring not checked (check_stability=False)"
@@ -225,18 +231,14 @@ def cmd_rao(args):
     out = _writable(args.out)
     import numpy as np
 
-    import mfm
     from hydro.database import split_complex
 
-    model = mfm.load(args.config, body_coupling=False if args.no_body_coupling else None)
+    model = load(args.config, body_coupling=False if args.no_body_coupling else None)
     omega = np.linspace(args.omega_min, args.omega_max, args.n)
-    ds = mfm.frequency_response(model, omega, heading=float(np.deg2rad(args.heading)),
+    ds = frequency_response(model, omega, heading=float(np.deg2rad(args.heading)),
                                 radiation=args.radiation)
-    nat = mfm.natural_frequencies(model)
-    ds["natural_frequency"] = (("mode",), nat["eigen"].values, {"units": "rad/s",
-                                                         "long_name": "undamped, generalised eigenproblem"})
-    ds.attrs["natural_frequencies_min_det"] = np.array2string(nat["min_det"].values, precision=5)
-    ds.attrs["config"] = str(args.config)
+    nat = natural_frequencies(model)
+    ds = results.with_natural_frequencies(ds, nat, args.config)
     from hydro.database import write_netcdf
 
     write_netcdf(split_complex(ds), out)
@@ -250,7 +252,6 @@ def cmd_rao(args):
 
 
 def cmd_hydro(args):
-    from mfm.io.bemgen import generate
 
     generate(args.config, out=args.out, force=args.force, n_threads=args.threads)
 
@@ -262,7 +263,7 @@ def cmd_plot(args):
     src = Path(args.config)
     if src.suffix == ".nc":
         out = _writable(args.out or src.with_suffix(".png"), "--out", (".png",))
-        from mfm.io.plotting import save_result_plot
+        from .plotting import save_result_plot
 
         if not src.exists():
             raise FileNotFoundError(f"result file {str(src)!r} not found")
@@ -275,10 +276,9 @@ def cmd_plot(args):
         print(f"{kind} of {src} -> {out}")
         return
     out = _writable(args.out or Path(src.with_suffix(".png").name), "--out", (".png",))
-    import mfm
-    from mfm.io.plotting import plot_layout
+    from .plotting import plot_layout
 
-    model = mfm.load(args.config, hydro=False)
+    model = load(args.config, hydro=False)
     fig = plot_layout(model)
     fig.savefig(out, dpi=args.dpi)
     print(f"layout of {model.name} -> {out}")

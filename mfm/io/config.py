@@ -42,8 +42,9 @@ from ..loads.registry import load_class
 from ..validation import number as _number
 from ..validation import unknown as _unknown
 from ..validation import vector as _vector
-from ..mechanics.tree import (JOINT_KINDS, PLANAR_DOFS, ROOT_DOFS, BodySpec, ConfigError, JointSpec,
-                   check_inertia, tree_order)
+from ..errors import ConfigError
+from ..mechanics.tree import (JOINT_KINDS, PLANAR_DOFS, ROOT_DOFS, BodySpec, JointSpec,
+                              check_inertia, tree_order)
 
 # the tables of loads (moorings, ptos, ...) come from the load registry (mfm.loads.registry)
 TOP_KEYS = {"model", "bodies", "hydro"} | set(LOAD_TABLES)
@@ -272,7 +273,14 @@ def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodyS
 
 
 def load_config(path: str | Path) -> tuple[dict, list[BodySpec]]:
-    """Read and validate a TOML config file."""
+    """Read and validate a TOML config file: (options, bodies)."""
+    _, options, bodies = read_config(path)
+    return options, bodies
+
+
+def read_config(path: str | Path) -> tuple[dict, dict, list[BodySpec]]:
+    """Read and validate a TOML config file: (the TOML as read, options, bodies), the file read
+    and parsed once for every use (:func:`mfm.io.build.load` and its database check)."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -291,4 +299,4 @@ def load_config(path: str | Path) -> tuple[dict, list[BodySpec]]:
         raise ConfigError(f"{path}: not valid TOML: {e}") from None
     options, bodies = parse_config(data, str(path))
     options["source"] = str(path)
-    return options, bodies
+    return data, options, bodies

@@ -3,7 +3,7 @@ tables (:mod:`mfm.loads.registry`). Each load serves the time domain, the equili
 frequency domain from one definition.
 
 - :class:`~mfm.loads.water.Water`: Cummins hydrodynamics (built per sea state by
-  :func:`mfm.timedomain.simulation.model_loads`), radiation as a strategy (:mod:`mfm.loads.radiation`);
+  :func:`mfm.timedomain.setup.model_loads`), radiation as a strategy (:mod:`mfm.loads.radiation`);
 - :class:`PointSprings` (``[[moorings]]``), :class:`HydraulicPTO` (``[[ptos]]``),
   :class:`LinearBodyMatrix` (``[[body_matrices]]``), :class:`JointLoad` (``[[joint_loads]]``),
   :class:`BodyPointOutputs` (``[[points]]``), :class:`WindThrust` (``[[wind_thrust]]``),

@@ -72,10 +72,44 @@ class LinearDampers(NamedTuple):
     offset: Any
 
 
+class PTORecords(NamedTuple):
+    """A PTO load's pistons over a run (:meth:`Load.pto_records`): ``names`` (P,), ``power``,
+    ``displacement`` and ``force`` (time, P) in W, m and N (force may be None)."""
+    names: tuple
+    power: Any
+    displacement: Any
+    force: Any = None
+
+
 class Load(eqx.Module):
-    """Base class. Override :meth:`evaluate` (or, the older form, ``__call__(model, t, q, qd, z,
-    kin, memory=(), qdd_guess=None)``); the rest has defaults for a load without states, memory,
-    outputs or frequency dependence."""
+    """Base class of every load: an immutable pytree (``equinox.Module``).
+
+    **Required** (:data:`REQUIRED`): :meth:`evaluate` — the load at one state, as a
+    :class:`LoadOutput` (or, the older form, ``__call__(model, t, q, qd, z, kin, memory=(),
+    qdd_guess=None)``). A subclass that gives neither is refused when it is defined.
+
+    **Optional** (:data:`OPTIONAL`, each with a default for a load without it):
+
+    - first-order states: :attr:`n_states`, :meth:`initial_state`;
+    - a discrete memory of the step: :meth:`init_memory`, :meth:`update_memory`;
+    - what a run records: :meth:`diagnostics` with :meth:`outputs`, :meth:`batch_outputs`,
+      :meth:`reaction_loads` (acceleration-proportional terms on the bodies), :meth:`pto_records`
+      (a load that is a PTO);
+    - the linearisation: :meth:`static_load` (its part at rest; None: nothing static),
+      :meth:`frequency_terms` with :meth:`frequency_body_loads` and :meth:`frequency_range`,
+      :meth:`frequency_outputs`, :meth:`linear_dampers` (a PTO's damping about q₀);
+    - words: :meth:`provenance`, :meth:`describe_nonfinite`.
+
+    A load that reads a config table also gives ``parse_table`` and ``from_parsed``
+    (:mod:`mfm.loads.registry`).
+    """
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if cls.evaluate is Load.evaluate and cls.__call__ is Load.__call__:
+            raise TypeError(f"load {cls.__name__}: a Load must define evaluate(ctx) -> LoadOutput "
+                            "(or the older __call__(model, t, q, qd, z, kin, memory, qdd_guess)); "
+                            f"the other methods are optional: {', '.join(OPTIONAL)}")
 
     @property
     def n_states(self) -> int:
@@ -93,9 +127,8 @@ class Load(eqx.Module):
         return memory
 
     def evaluate(self, ctx: Context) -> LoadOutput:
-        if type(self).__call__ is Load.__call__:
-            raise NotImplementedError(f"{type(self).__name__} defines neither evaluate(ctx) nor "
-                                      "__call__(model, t, q, qd, z, kin, memory, qdd_guess)")
+        """The load at one state (required: a subclass defines it, or the older ``__call__``,
+        which this then calls)."""
         return self(ctx.model, ctx.t, ctx.q, ctx.qd, ctx.z, ctx.kin, ctx.memory,
                     qdd_guess=ctx.qdd_guess)
 
@@ -116,15 +149,10 @@ class Load(eqx.Module):
         the coordinate values of those dims under the key ``"coords"``."""
         return {}
 
-    def annotate(self, ds, records: dict):
-        """Add this load's recorded diagnostics to a result dataset (default: by :meth:`outputs`)."""
-        spec = dict(self.outputs())
-        coords = spec.pop("coords", {})
-        if spec:
-            ds = ds.assign_coords({k: v for k, v in coords.items() if k not in ds.coords})
-        for name, (dims, attrs) in spec.items():
-            ds[name] = (("time",) + tuple(dims), records[name], dict(attrs))
-        return ds
+    def pto_records(self, records: dict) -> "PTORecords | None":
+        """For a load that is a PTO, its pistons as the time domain reports them, from this load's
+        recorded :meth:`diagnostics` (:mod:`mfm.loads.pto`); None (default): not a PTO."""
+        return None
 
     def batch_outputs(self, save_every: int, n_saved: int) -> dict:
         """Outputs a batched run (no per-sample record) can take from the load itself:
@@ -180,3 +208,11 @@ class Load(eqx.Module):
     def describe_nonfinite(self, model, q, qd) -> str | None:
         """A likely cause specific to this load when a run went non-finite at (q, q̇), or None."""
         return None
+
+
+# the load protocol: what a load must define, and what it may (the base gives a default)
+REQUIRED = ("evaluate",)
+OPTIONAL = ("n_states", "initial_state", "init_memory", "update_memory", "reaction_loads",
+            "diagnostics", "outputs", "batch_outputs", "pto_records", "static_load",
+            "frequency_terms", "frequency_body_loads", "frequency_range", "frequency_outputs",
+            "linear_dampers", "provenance", "describe_nonfinite")

@@ -4,8 +4,9 @@ Config table ``[[body_matrices]]``: ``body``; ``point`` [x, y, z] m at q = 0 (de
 hydro reference point if it is wet, else its centre of mass); ``stiffness`` and ``damping``, each
 a 6×6 matrix or 6 diagonal values, in inertial axes about the point (N/m, N/rad, N m/m, N m/rad;
 N s/m …); ``damping_ratio`` a table of fractions of critical damping per mode, e.g.
-``{heave = 0.2, pitch = 0.4}``, set from the model's own linearisation
-(:func:`mfm.frequency.critical_damping`); optional ``name``. The load on the point is
+``{heave = 0.2, pitch = 0.4}``, set from the model's own linearisation when the model is built
+(:func:`mfm.frequency.resolve_damping_ratios`, which :func:`mfm.load` calls: the linearisation
+is not this module's to make); optional ``name``. The load on the point is
 
     F = −K ξ − D ξ̇,   ξ = (displacement of the point, rotation vector of the body),
 
@@ -13,13 +14,15 @@ so it linearises to Hᵀ K H and Hᵀ D H (H the point's B-like rows).
 """
 from __future__ import annotations
 
+import dataclasses
+
 import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
 from ..validation import body_ref, number, tables
 from ..mechanics.points import BodyPoints
-from ..mechanics.tree import ConfigError
+from ..errors import ConfigError
 from .base import MODES, Load, LoadOutput
 
 KEYS = {"name", "body", "point", "stiffness", "damping", "damping_ratio", "notes"}
@@ -27,13 +30,23 @@ KEYS = {"name", "body", "point", "stiffness", "damping", "damping_ratio", "notes
 
 class LinearBodyMatrix(Load):
     """F = −K ξ − D ξ̇ at body points. ``points`` (BodyPoints, one per matrix), ``stiffness`` and
-    ``damping`` (P, 6, 6) inertial axes about the points; ``names`` static."""
+    ``damping`` (P, 6, 6) inertial axes about the points; ``names`` static. ``damping_ratios``:
+    the fractions of critical damping asked for and not yet added to ``damping``, each
+    (matrix index, body, mode, ratio, point): a load with any cannot be evaluated until
+    :func:`mfm.frequency.resolve_damping_ratios` has set them from the model's linearisation."""
     points: BodyPoints
     stiffness: jnp.ndarray
     damping: jnp.ndarray
     names: tuple[str, ...] = eqx.field(static=True, default=())
+    damping_ratios: tuple = eqx.field(static=True, default=())
 
     def evaluate(self, ctx):
+        if self.damping_ratios:
+            raise ValueError(
+                f"body matrices {list(self.names)}: damping_ratio {self.damping_ratios} is not set "
+                "yet: it is a fraction of critical damping from the model's linearisation; give the "
+                "load to mfm.frequency.resolve_damping_ratios(model, load) first (mfm.load does so "
+                "for [[body_matrices]] tables)")
         xi = self.points.xi(ctx.kin).reshape(-1, 6)
         v, _ = self.points.velocity_and_bias(ctx.kin)
         F = -(jnp.einsum("pab,pb->pa", self.stiffness, xi)
@@ -44,7 +57,8 @@ class LinearBodyMatrix(Load):
     def create(cls, model, body: str, *, point=None, stiffness=None, damping=None,
                damping_ratio: dict | None = None, name: str | None = None) -> "LinearBodyMatrix":
         """One matrix on ``body`` from Python, as a ``[[body_matrices]]`` entry would give it
-        (stiffness/damping 6×6 or 6 diagonal values; damping_ratio e.g. {"heave": 0.2})."""
+        (stiffness/damping 6×6 or 6 diagonal values; damping_ratio e.g. {"heave": 0.2}: then
+        pass the load through :func:`mfm.frequency.resolve_damping_ratios` before use)."""
         entry = {"body": body}
         if point is not None:
             entry["point"] = list(np.asarray(point, dtype=float))
@@ -86,8 +100,6 @@ class LinearBodyMatrix(Load):
 
     @classmethod
     def from_parsed(cls, parsed, model):
-        from ..frequency.response import critical_damping
-
         idx = [model.body_index(t["body"]) for t in parsed]
         pts = []
         for t, i in zip(parsed, idx):
@@ -97,17 +109,22 @@ class LinearBodyMatrix(Load):
                 pts.append(np.asarray(model.hydro.ref0)[model.hydro.body_index.index(i)])
             else:
                 pts.append(np.asarray(model.com[i]))
-        load = cls(points=BodyPoints.on_bodies(model.com, idx, pts),
+        ratios = tuple((p, t["body"], mode, float(ratio), tuple(float(x) for x in pts[p]))
+                       for p, t in enumerate(parsed) for mode, ratio in t["ratios"].items())
+        return cls(points=BodyPoints.on_bodies(model.com, idx, pts),
                    stiffness=jnp.asarray(np.stack([t["stiffness"] for t in parsed])),
                    damping=jnp.asarray(np.stack([t["damping"] for t in parsed])),
-                   names=tuple(t["name"] for t in parsed))
-        D = np.asarray(load.damping).copy()
-        for p, t in enumerate(parsed):
-            for mode, ratio in t["ratios"].items():
-                j = MODES.index(mode)
-                D[p, j, j] += critical_damping(model, t["body"], mode, ratio, point=pts[p],
-                                               loads=(load,))
-        return eqx.tree_at(lambda ld: ld.damping, load, jnp.asarray(D))
+                   names=tuple(t["name"] for t in parsed), damping_ratios=ratios)
+
+    def with_damping(self, p: int, mode: str, c: float) -> "LinearBodyMatrix":
+        """This load with ``c`` (N s/m or N m s/rad) added on the diagonal of matrix ``p`` for
+        ``mode``, and that mode's ratio no longer pending."""
+        j = MODES.index(mode)
+        D = np.asarray(self.damping).copy()
+        D[p, j, j] += c
+        rest = tuple(r for r in self.damping_ratios if not (r[0] == p and r[2] == mode))
+        out = eqx.tree_at(lambda ld: ld.damping, self, jnp.asarray(D))
+        return dataclasses.replace(out, damping_ratios=rest)
 
 
 def _vec3(v, where):

@@ -39,7 +39,7 @@ fairlead out stops as non-finite and :meth:`CatenaryLines.describe_nonfinite` na
 span and the table's bounds (widen ``table_extent``); the equilibrium and the linearisation fail
 likewise. :meth:`CatenaryLines.table_margin` tells how close a configuration is to an edge.
 
-Linearised lines. :meth:`CatenaryLines.linearised` (or :func:`linearise_lines` for every line of
+Linearised lines. :meth:`CatenaryLines.linearised` (or :func:`mfm.frequency.linearise_lines` for every line of
 a model) gives the same lines with the fairlead force and the tensions replaced by their first-order
 expansion in the fairlead positions about a configuration q₀ (the static equilibrium by default):
 
@@ -66,7 +66,7 @@ import numpy as np
 
 from ..validation import body_ref, number, tables, unknown, vector
 from ..mechanics.points import BodyPoints
-from ..mechanics.tree import ConfigError
+from ..errors import ConfigError
 from .base import Load, LoadOutput
 
 LINE_KEYS = {"length", "weight", "mass_per_length", "EA", "seabed_friction"}
@@ -449,21 +449,6 @@ class CatenaryLines(Load):
                    anchors=jnp.asarray(np.stack([t["anchor"] for t in parsed])),
                    coef=jnp.asarray(padded), n=jnp.asarray(n), lo=jnp.asarray(np.array(lo)), step=jnp.asarray(np.array(step)),
                    names=tuple(t["name"] for t in parsed), lines=tuple(lines))
-
-
-def linearise_lines(model, q0=None):
-    """``model`` with each of its :class:`CatenaryLines` loads replaced by
-    :meth:`CatenaryLines.linearised` about ``q0`` (default: the static equilibrium of the model,
-    :func:`mfm.equilibrium`). Raises ValueError when the model has no catenary lines."""
-    from ..frequency.response import equilibrium
-
-    if not any(isinstance(ld, CatenaryLines) for ld in model.loads):
-        raise ValueError(f"model: {model.name!r} has no [[catenary_lines]] to linearise")
-    if q0 is None:
-        q0 = equilibrium(model)[0]
-    loads = tuple(ld.linearised(model, q0) if isinstance(ld, CatenaryLines) and not ld.linear else ld
-                  for ld in model.loads)
-    return dataclasses.replace(model, loads=loads)
 
 
 @eqx.filter_jit

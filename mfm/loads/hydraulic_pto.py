@@ -20,8 +20,9 @@ import numpy as np
 
 from ..validation import body_ref, number, tables, vector
 from ..mechanics.points import BodyPoints
-from ..mechanics.tree import ConfigError
-from .base import LinearDampers, Load, LoadOutput
+from ..errors import ConfigError
+from .base import LinearDampers, Load, LoadOutput, PTORecords
+from .pto import absorbed_power, mean_absorbed_power
 
 PTO_KEYS = {"name", "kind", "body", "point", "anchor_body", "anchor", "mu", "beta", "kappa", "notes"}
 
@@ -81,16 +82,12 @@ class HydraulicPTO(Load):
 
     def diagnostics(self, ctx, out):
         w, wd, force, _ = self._force(ctx)
-        from ..results import absorbed_power
-
         return {"hydraulic_stroke": w, "hydraulic_force": force,
                 "hydraulic_power": absorbed_power(self.beta, wd)}
 
-    def annotate(self, ds, rec):
-        from ..results import add_ptos
-
-        return add_ptos(ds, list(self.names), rec["hydraulic_power"], rec["hydraulic_stroke"],
-                        rec["hydraulic_force"])
+    def pto_records(self, records):
+        return PTORecords(tuple(self.names), records["hydraulic_power"],
+                          records["hydraulic_stroke"], records["hydraulic_force"])
 
     def force_rao(self, omega, stroke):
         """Complex piston force per metre of wave amplitude from the stroke RAO ŵ (n_ω, P):
@@ -112,8 +109,6 @@ class HydraulicPTO(Load):
     def frequency_outputs(self, model, kin0, x, omega):
         """Stroke amplitude ŵ = g x̂, force amplitude f̂ = (κ − ω²μ − iωβ) ŵ (:meth:`force_rao`)
         and mean power ½ β ω² |ŵ|² per unit wave amplitude squared."""
-        from ..results import mean_absorbed_power
-
         _, _, g, _, _ = self._kinematics(kin0)
         stroke = x @ np.asarray(g).T
         return {"hydraulic_pto_rao": (("hydraulic_pto",), stroke,

@@ -12,7 +12,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..validation import number, tables
-from ..mechanics.tree import ConfigError
+from ..errors import ConfigError
 from .base import Load, LoadOutput
 
 

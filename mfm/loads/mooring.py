@@ -11,7 +11,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..mechanics.points import BodyPoints
-from ..mechanics.tree import ConfigError
+from ..errors import ConfigError
 from .base import Load, LoadOutput
 from ..validation import body_ref, tables, vector
 

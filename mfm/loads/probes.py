@@ -14,7 +14,7 @@ import numpy as np
 
 from ..validation import body_ref, tables, vector
 from ..mechanics.points import BodyPoints
-from ..mechanics.tree import ConfigError
+from ..errors import ConfigError
 from .base import Load, LoadOutput
 
 

@@ -215,12 +215,6 @@ class Water(Load):
                                 {"long_name": "hydrodynamic loads on each body's reference point, "
                                  "inertial axes", "units": "N or N m"})}
 
-    def annotate(self, ds, rec):
-        ds = super().annotate(ds, rec)
-        ds.attrs["radiation"] = self.radiation
-        ds.attrs["added_mass"] = self.added_mass
-        return ds
-
     def batch_outputs(self, save_every, n_saved):
         eta = np.asarray(self.eta_values)[::self.grid_m * save_every][:n_saved]
         return {"eta": (eta, {"long_name": "wave elevation at the origin", "units": "m"})}
@@ -254,7 +248,7 @@ class Water(Load):
         """Still water, no memory: buoyancy, water-plane stiffness, A∞ (in the mass). Its tables
         are two rows of zeros (the interpolation clips to them: zero at every t) whatever the
         run's length: the loads at rest of every run of a model have one structure (one compiled
-        linearisation, :func:`mfm.timedomain.simulation.linearised_at_rest`) and hold no table of the run's
+        linearisation, :func:`mfm.frequency.rest.linearised_at_rest`) and hold no table of the run's
         length (M4 134, 10⁶ RK4 steps: 0.8 GB)."""
         def zeros(a):
             return jnp.zeros((2,) + a.shape[1:], a.dtype)
@@ -394,7 +388,7 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
     from hydro.database import HydroDatabaseWarning, select_bodies
     from hydro.prepare import HydroSpec, open_any_database
 
-    from ..mechanics.tree import ConfigError
+    from ..errors import ConfigError
 
     path = Path(options["database"])
     if not path.is_absolute():

@@ -46,7 +46,7 @@ import numpy as np
 
 from ..validation import body_ref, number, tables, vector
 from ..mechanics.points import BodyPoints
-from ..mechanics.tree import ConfigError
+from ..errors import ConfigError
 from .base import Load, LoadOutput
 
 KEYS = {"name", "body", "hub", "rotor_radius", "wind_speed", "thrust_coefficient", "rho_air",

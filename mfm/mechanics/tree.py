@@ -16,13 +16,11 @@ from typing import Sequence
 
 import numpy as np
 
+from ..errors import ConfigError
+
 JOINT_KINDS = ("free", "planar", "revolute", "prismatic", "fixed")
 ROOT_DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
 PLANAR_DOFS = ("surge", "heave", "pitch")
-
-
-class ConfigError(ValueError):
-    """A float tree or config that cannot be built. The message names the key, the value and the fix."""
 
 
 @dataclasses.dataclass(frozen=True)

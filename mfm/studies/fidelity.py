@@ -30,15 +30,17 @@ model, paid once for a scene that is then run long or swept.
 """
 from __future__ import annotations
 
-import importlib
 import numbers
 import time as _time
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..frequency.linear import linear_response
+from ..frequency.spectral import spectral_response
 from ..mechanics.model import Model
-from ..frequency.spectral import _check_sea
+from ..timedomain.simulation import simulate
+from ..validation import check_sea, finite_number
 
 LEVELS = ("spectral", "linear", "fast", "full")
 # the run options each time-domain level gives mfm.simulate
@@ -102,19 +104,16 @@ class Reduction:
         duration = _positive(duration, "duration")
         model = variant_model(model, self.variant)
         if self.level == "spectral":
-            from ..frequency.spectral import spectral_response
             t = self.dt * np.arange(int(round(duration / self.dt)) + 1)
             return spectral_response(model, sea, t=t)
         ramp = self.pilot[1] if ramp is None else ramp
         if self.level == "linear":
-            from ..frequency.linear import linear_response
             return linear_response(model, sea, duration=duration, dt=self.dt, ramp=ramp)
-        simulate = importlib.import_module("mfm.timedomain.simulation").simulate
         return simulate(model, sea, duration=duration, dt=self.dt, ramp=ramp, **self.options)
 
 
 def _positive(value, what):
-    return importlib.import_module("mfm.timedomain.simulation")._number(value, what, positive=True)
+    return finite_number(value, what, positive=True)
 
 
 def _measures(ds, window, coordinates):
@@ -173,7 +172,7 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: the fidelity ladder is that "
                          "of a floating model in a sea")
-    _check_sea(sea)
+    check_sea(sea, still_water=False)
     levels = tuple(levels)
     bad = [lv for lv in levels if lv not in LEVELS]
     if bad or not levels:

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import collections
 import hashlib
-import importlib
 import numbers
 import pickle
 import time
@@ -32,7 +31,14 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-_simulate = importlib.import_module("mfm.timedomain.simulation")     # the module (mfm.simulate is the function)
+from ..errors import SweepError  # noqa: F401  (exported)
+from ..frequency.spectral import spectral_sweep
+from ..results import gather_cases, label_cases, sea_labels
+from ..timedomain import integrators as _integrators
+from ..timedomain.batch import simulate_batch
+from ..timedomain.progress import progress_bar, progress_options
+from ..timedomain.setup import model_loads
+from ..validation import finite_number
 
 # options passed through to simulate_batch (one value for every case, except dt and ramp)
 BATCH_OPTIONS = ("integrator", "radiation", "state_space_options", "memory", "save_every", "t0",
@@ -47,15 +53,6 @@ _WORKER_MODELS_KEPT = 4
 # names of simulate_batch's result and the sweep's own: not parameter names
 RESERVED = ("case", "step", "coordinate", "coordinate_unit", "pto", "time", "q", "qd", "dt",
             "pto_power", "pto_displacement", "eta", "failed", "sweep_chunk")
-
-
-class SweepError(RuntimeError):
-    """Every chunk of a sweep failed: there is nothing to gather. ``errors`` lists each chunk's
-    error (text); the first chunk's exception is the ``__cause__`` where it could be sent back."""
-
-    def __init__(self, message, errors=()):
-        super().__init__(message)
-        self.errors = list(errors)
 
 
 @dataclass
@@ -96,7 +93,7 @@ def _run_chunk(models, token, cases, n_real, seas, dts, ramps, n_steps, options,
                 _WORKER_MODELS.move_to_end(token)
         m = [models[i] for i in cases] if isinstance(models, list) else models
         vl = None if vary_loads is None else (lambda i, loads: vary_loads(int(cases[i]), loads))
-        ds = _simulate.simulate_batch(m, list(seas), dt=np.asarray(dts), ramp=np.asarray(ramps),
+        ds = simulate_batch(m, list(seas), dt=np.asarray(dts), ramp=np.asarray(ramps),
                                       n_steps=n_steps, vary_loads=vl, **options)
         ds = ds.isel(case=slice(0, n_real)).assign_coords(case=np.asarray(cases[:n_real]))
         return ("ok", ds)
@@ -250,7 +247,7 @@ def sweep(model, seas, *, dt=None, n_steps: int | None = None, chunk_size: int =
     if vary_loads is not None and not callable(vary_loads):
         raise ValueError(f"vary_loads: {vary_loads!r}; give a function (case_index, loads) -> "
                          "loads")
-    progress = _simulate._progress_options(progress)
+    progress = progress_options(progress)
     if isinstance(n_steps, bool) or not isinstance(n_steps, numbers.Integral) or n_steps < 1:
         raise ValueError(f"n_steps: {n_steps!r} must be a whole number ≥ 1")
 
@@ -285,7 +282,7 @@ def sweep(model, seas, *, dt=None, n_steps: int | None = None, chunk_size: int =
     c, to_close, scheduler = _open_client(client, n_workers)
     workers = 1
     try:
-        bar = _simulate._progress_bar(None if progress is None else {"unit": "chunk", **progress},
+        bar = progress_bar(None if progress is None else {"unit": "chunk", **progress},
                                       len(todo), f"{m0.name} sweep of {B}")
         results = {}
         args = dict(n_steps=int(n_steps), options=options, vary_loads=vary_loads)
@@ -322,8 +319,6 @@ SPECTRAL_OPTIONS = {"q0": None, "loads": None, "radiation": "database",
 def _spectral_sweep(model, seas, level, dt, n_steps, parameters, options, unused):
     """``sweep(..., level="spectral")``: :func:`mfm.frequency.spectral.spectral_sweep` over the cases, on the
     time domain's saved grid when dt and n_steps are given, labelled as a sweep."""
-    from ..frequency.spectral import spectral_sweep
-
     if level != "spectral":
         raise ValueError(f"level: {level!r}; accepted: None (the time domain, as the options "
                          "say) or 'spectral' (the linear frequency-domain level)")
@@ -358,7 +353,7 @@ def _spectral_sweep(model, seas, level, dt, n_steps, parameters, options, unused
                 or not np.all(np.isfinite(dts) & (dts > 0)):
             raise ValueError(f"dt: {dt!r}; give one positive time step in s, or one per case "
                              f"({B})")
-        t0 = _simulate._number(opts["t0"], "t0")
+        t0 = finite_number(opts["t0"], "t0")
         k = np.arange(int(n_steps) // int(every) + 1)
         t = t0 + np.broadcast_to(dts, (B,))[:, None] * int(every) * k[None]
     params = _parameter_labels(parameters, B)
@@ -366,12 +361,13 @@ def _spectral_sweep(model, seas, level, dt, n_steps, parameters, options, unused
     ds = spectral_sweep(model, seas_l, t=t, q0=opts["q0"], loads=opts["loads"],
                         radiation=opts["radiation"],
                         state_space_options=opts["state_space_options"])
-    for name, (values, attrs) in params.items():
-        ds = ds.assign_coords({name: ("case", values, attrs)})
+    ds = label_cases(ds, params)
+    attrs = {}
     if t is not None:
-        ds["dt"] = ("case", np.broadcast_to(dts, (B,)).copy(), {"units": "s"})
-        ds.attrs.update(save_every=int(opts["save_every"]), n_steps=int(n_steps), t0=float(t0))
-    ds.attrs.update(sweep_scheduler="in-process, one call (spectral level)",
+        ds = label_cases(ds, {"dt": (np.broadcast_to(dts, (B,)).copy(), {"units": "s"})},
+                         as_data=True)
+        attrs.update(save_every=int(opts["save_every"]), n_steps=int(n_steps), t0=float(t0))
+    ds.attrs.update(**attrs, sweep_scheduler="in-process, one call (spectral level)",
                     sweep_wall_s=round(time.perf_counter() - start, 3))
     return ds
 
@@ -385,7 +381,7 @@ def _run_on_cluster(c, models, chunks, todo, seas_l, dts, ramps, args, bar):
         # fit the radiation (or whatever the water caches) once here, so that every worker gets
         # the same fit in the model it receives instead of fitting again
         o = args["options"]
-        _simulate.model_loads(m0, seas_l[0], dt=float(dts[0]), duration=args["n_steps"] * dts[0],
+        model_loads(m0, seas_l[0], dt=float(dts[0]), duration=args["n_steps"] * dts[0],
                               radiation=o.get("radiation", "state_space"),
                               memory=o.get("memory"),
                               state_space_options=o.get("state_space_options"),
@@ -450,13 +446,13 @@ def _chunks_to_resume(resume, chunks, B, seas_l, params, n_steps, options):
         raise ValueError(f"resume: its {resume.sizes['case']} cases in chunks of "
                          f"{resume.attrs['sweep_chunk_size']} are not this sweep's {B} cases in "
                          f"chunks of {chunks[0].cases.size}: give the same cases and chunk_size")
-    labels = dict(_simulate._sea_labels(seas_l), **params)
+    labels = dict(sea_labels(seas_l), **params)
     for name, (values, _) in labels.items():
         if name not in resume.coords or not np.allclose(resume[name].values, values,
                                                         rtol=1e-12, atol=0.0, equal_nan=True):
             raise ValueError(f"resume: its case label {name!r} differs from this sweep's: give "
                              "the same cases")
-    given = {"integrator": _simulate._integrators.get(options.get("integrator", "rk4")).name,
+    given = {"integrator": _integrators.get(options.get("integrator", "rk4")).name,
              "radiation": options.get("radiation", "state_space"), "n_steps": int(n_steps)}
     for k, v in given.items():
         if str(resume.attrs.get(k)) != str(v):
@@ -483,36 +479,15 @@ def _gather(results, chunks, resume, B, seas_l, dts, params, options, ramp, swee
         if first[2] is not None:
             raise err from first[2]
         raise err
-    template = parts[0]
-    for k in sorted(failed):
-        ch = chunks[k]
-        idx = ch.cases[:ch.n_real]
-        nan = template.isel(case=np.zeros(idx.size, dtype=int)).assign_coords(case=idx)
-        for name, v in nan.data_vars.items():
-            if np.issubdtype(v.dtype, np.floating) or np.issubdtype(v.dtype, np.complexfloating):
-                nan[name] = v.copy(data=np.full(v.shape, np.nan, dtype=v.dtype))
-        parts.append(nan)
-    ds = xr.concat(parts, dim="case", data_vars="minimal", coords="minimal", compat="override",
-                   join="override", combine_attrs="override").sortby("case")
-    ds = ds.assign_coords(case=np.arange(B))
-    # labels and dt from the arguments (a failed chunk's template carries another case's)
-    for name, (values, attrs) in {**_simulate._sea_labels(seas_l), **params}.items():
-        if name in ds.data_vars:        # a load's output of that name: keep both
-            name = f"parameter_{name}"
-        ds = ds.assign_coords({name: ("case", np.asarray(values), attrs)})
+    nan_cases = [chunks[k].cases[:chunks[k].n_real] for k in sorted(failed)]
     failed_cases = np.zeros(B, dtype=bool)
-    for k in failed:
-        failed_cases[chunks[k].cases[:chunks[k].n_real]] = True
+    for idx in nan_cases:
+        failed_cases[idx] = True
+    dt = dts
     if resume is not None:
         rerun = np.isin(resume["sweep_chunk"].values, list(results))
-        ds["dt"] = ("case", np.where(rerun, dts, resume["dt"].values), ds["dt"].attrs)
-    else:
-        ds["dt"] = ("case", dts, ds["dt"].attrs)
+        dt = np.where(rerun, dts, resume["dt"].values)
     chunk_of = np.concatenate([np.full(c.n_real, c.index) for c in chunks])
-    ds = ds.assign_coords(sweep_chunk=("case", chunk_of,
-                                       {"long_name": "the chunk each case ran in"}))
-    ds["failed"] = ("case", failed_cases, {"long_name": "the case's chunk failed: its data are NaN "
-                                           "(see the attribute sweep_failed_chunks)"})
     report = []
     for k in sorted(failed):
         ch = chunks[k]
@@ -521,7 +496,7 @@ def _gather(results, chunks, resume, B, seas_l, dts, params, options, ramp, swee
     if resume is not None:
         sweep_attrs["sweep_resumed_chunks"] = sweep_attrs["sweep_chunks_run"]
     ramps = np.atleast_1d(np.asarray(ramp, dtype=float))
-    ds.attrs.update(title=f"mfm sweep of {B} runs of {ds.attrs.get('model', '')}",
-                    seas=repr(seas_l), ramp_s=repr(ramps.tolist()),
-                    sweep_failed_chunks="; ".join(report) if report else "none", **sweep_attrs)
-    return ds
+    attrs = dict(seas=repr(seas_l), ramp_s=repr(ramps.tolist()),
+                 sweep_failed_chunks="; ".join(report) if report else "none", **sweep_attrs)
+    return gather_cases(parts, nan_cases, B, {**sea_labels(seas_l), **params}, dt, chunk_of,
+                        failed_cases, attrs)

@@ -1,0 +1,79 @@
+"""A progress bar over a run or a batch: the run is made in 20 to 100 chunks of one compiled
+function, the bar (tqdm, on stderr) updated between them; the same steps in the same order, so the
+same numbers as the run in one call."""
+from __future__ import annotations
+
+import sys
+
+import jax
+import numpy as np
+
+
+def chunk_plan(n_blocks: int, fewest: int = 20, most: int = 100) -> tuple[int, int]:
+    """(chunk length in saved blocks, number of chunks) for a progress bar: between ``fewest``
+    and ``most`` updates, the length that wastes the fewest blocks past the end (the last chunk
+    has the same length, so one compilation serves every chunk; its extra blocks are dropped)."""
+    if n_blocks <= fewest:
+        return 1, n_blocks
+    lengths = range(-(-n_blocks // most), -(-n_blocks // fewest) + 1)
+    c = min(lengths, key=lambda c: (-(-n_blocks // c) * c - n_blocks, c))
+    return c, -(-n_blocks // c)
+
+
+def progress_options(progress):
+    """The tqdm options of ``progress`` (True, or a dict of tqdm options), or None for no bar."""
+    if progress is None or progress is False:
+        return None
+    if progress is True:
+        return {}
+    if isinstance(progress, dict):
+        return dict(progress)
+    raise ValueError(f"progress: {progress!r}; give False (no bar, the default), True (a bar on "
+                     "stderr) or a dict of tqdm options, e.g. {'delay': 5}")
+
+
+def progress_bar(options, total, desc):
+    """A tqdm bar on stderr with ``options`` (from :func:`progress_options`), or None."""
+    if options is None:
+        return None
+    from tqdm.auto import tqdm
+
+    try:
+        return tqdm(**{"total": total, "unit": "step", "desc": desc, "file": sys.stderr, **options})
+    except (TypeError, KeyError) as e:     # tqdm's TqdmKeyError for an unknown option
+        raise ValueError(f"progress: {options!r} is not a set of tqdm options ({e})") from None
+
+
+def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis):
+    """Run ``start()`` then ``chunk(carry, c)`` (``c`` blocks, from :func:`chunk_plan`) until
+    ``n_blocks`` are done,
+    updating ``bar`` between chunks; stops early once a chunk has a non-finite q or q̇ (the caller
+    finds where). Returns the saved outputs as numpy, the initial state first, as the unchunked
+    rollout does: the same compiled steps in the same order, so the same numbers."""
+    c, n_chunks = chunk_plan(n_blocks)
+    bar.set_postfix_str("compiling")
+    carry, first = start()
+    pieces = [jax.tree_util.tree_map(lambda a: np.expand_dims(np.asarray(a), time_axis), first)]
+    done = 0
+    try:
+        for _ in range(n_chunks):
+            carry, traj = chunk(carry, c)
+            take = min(c, n_blocks - done)
+            cut = (slice(None),) * time_axis + (slice(0, take),)
+            traj = jax.tree_util.tree_map(lambda a: np.asarray(a)[cut], traj)
+            pieces.append(traj)
+            done += take
+            if done == take:
+                # the first chunk compiled: rate, elapsed and ETA count from here, else the
+                # compilation (seconds to a minute) shows as slow steps and a far-off ETA
+                compiled = bar.format_dict["elapsed"]
+                bar.reset(total=bar.total)
+                bar.initial = bar.n = bar.last_print_n = take * save_every
+                bar.set_postfix_str(f"compiled in {compiled:.0f} s")
+            else:
+                bar.update(take * save_every)
+            if not (np.isfinite(traj[1]).all() and np.isfinite(traj[2]).all()):
+                break
+    finally:
+        bar.close()
+    return jax.tree_util.tree_map(lambda *a: np.concatenate(a, axis=time_axis), *pieces)

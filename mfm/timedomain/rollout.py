@@ -1,0 +1,171 @@
+"""The pure core of the time domain: the system f(t, q, q̇, z) → (q̈, ż) of the integrators and
+the rollout, ``lax.scan`` over steps, compiled once per (topology, n_steps, integrator,
+save_every, loads structure); vmap- and grad-friendly."""
+from __future__ import annotations
+
+import collections
+from typing import Sequence
+
+import jax
+import jax.numpy as jnp
+
+from ..loads.assembly import applied_loads, as_loads
+from ..loads.base import Load
+from ..mechanics.dynamics import evaluate
+from ..mechanics.kinematics import kinematics
+from ..mechanics.model import Model
+from ..validation import positive_seconds, whole_number
+from . import integrators as _integrators
+from .progress import run_chunked
+from .record import deferred, outputs_after, saved
+
+
+# How many times each compiled function was traced (a retrace means a recompilation); tests use it.
+TRACES: collections.Counter = collections.Counter()
+
+
+def dynamics_function(model: Model, loads: Sequence[Load] = (), memories=None):
+    """The system ``f(t, q, q̇, z) -> (q̈, ż)`` of the integrators: MFM equations of motion plus the
+    external loads (with their memories of the current step)."""
+
+    def f(t, q, qd, z, qdd_guess=None):
+        kin = kinematics(model, q, qd)
+        body, tau, mass, zd = applied_loads(model, loads, t, q, qd, z, kin, memories,
+                                            qdd_guess=qdd_guess)
+        return evaluate(model, q, qd, tau=tau, body_loads=body, extra_mass=mass, kin=kin).qdd, zd
+
+    return f
+
+
+def init_memories(model, loads, t0, q0, qd0, dt):
+    return tuple(ld.init_memory(model, t0, q0, qd0, dt) for ld in loads)
+
+
+def update_memories(model, loads, s, memories):
+    if not loads:
+        return memories
+    kin = kinematics(model, s.q, s.qd)
+    return tuple(ld.update_memory(model, s.t, s.q, s.qd, kin, mem) for ld, mem in zip(loads, memories))
+
+
+def rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, record):
+    """The initial carry (integrator state, load memories) and its saved outputs (deferred ones
+    by the same vmapped program as the later samples', :func:`outputs_after`)."""
+    mem0 = init_memories(model, loads, t0, q0, qd0, dt)
+    state = integrator.init(dynamics_function(model, loads, mem0), t0, q0, qd0, z0)
+    carry = (state, mem0)
+    if deferred(carry, record):
+        one = outputs_after(model, loads, jax.tree_util.tree_map(lambda a: a[None], carry))
+        return carry, jax.tree_util.tree_map(lambda a: a[0], one)
+    return carry, saved(model, loads, state, mem0, record)
+
+
+def rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, record):
+    """``n_blocks`` blocks of ``save_every`` steps from ``carry``: (carry, the saved outputs of
+    each block's last step, stacked). With ``record is True`` and a small memory (the state
+    space's, not the convolution's history) the loop keeps only the state and memory of each
+    saved step and the outputs are evaluated afterwards in one vmapped pass
+    (:func:`outputs_after`): the serial loop carries the integration alone (RM3: recording
+    every step cost 5× the integration inside it). ``record="carry"``: the saved carries
+    themselves, for that pass to be made by the caller."""
+
+    def one_step(carry, _):
+        s, mem = carry
+        s = integrator.step(dynamics_function(model, loads, mem), s, dt)
+        return (s, update_memories(model, loads, s, mem)), None
+
+    later = record == "carry" or deferred(carry, record)
+
+    def block(carry, _):
+        carry, _ = jax.lax.scan(one_step, carry, None, length=save_every)
+        return carry, (carry if later else saved(model, loads, *carry, record))
+
+    carry, out = jax.lax.scan(block, carry, None, length=n_blocks)
+    if later and record is True:
+        out = outputs_after(model, loads, out)
+    return carry, out
+
+
+def rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_every, record):
+    TRACES["rollout"] += 1
+    n_blocks = n_steps // save_every
+    carry, _ = rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, False)
+    if deferred(carry, record):
+        # the initial sample's outputs in the same pass as the others': one copy of the outputs'
+        # program to compile, not two (M4 134: ~4 s of a first call)
+        _, carries = rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every,
+                                     "carry")
+        stacked = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), carry, carries)
+        return outputs_after(model, loads, stacked)
+    first = saved(model, loads, *carry, record)
+    _, traj = rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, record)
+    return jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), first, traj)
+
+
+rollout_jit = jax.jit(rollout_impl,
+                       static_argnames=("n_steps", "integrator", "save_every", "record"))
+
+
+# The chunked rollout of a progress bar: the same start and blocks, compiled as two functions
+# (the blocks one once for the chunk length), called from the host between bar updates.
+def _chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every, record):
+    TRACES["rollout_chunk"] += 1
+    return rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, record)
+
+
+_start_jit = jax.jit(rollout_start, static_argnames=("integrator", "record"))
+
+
+_chunk_jit = jax.jit(_chunk_impl, static_argnames=("n_blocks", "integrator", "save_every", "record"))
+
+
+def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=None,
+            save_every: int = 1, t0=0.0, z0=None, record: bool = False):
+    """Pure, jit-compiled rollout: returns ``(t, q, qd, qdd, z, iterations)`` arrays with a leading
+    time axis of length ``n_steps // save_every + 1`` (the initial state first).
+
+    Compiled once per (topology, n_steps, integrator, save_every, loads structure): changing any
+    array parameter of ``model`` or ``loads``, ``dt``, ``q0``, ``qd0`` reuses the compiled code, and
+    the function can be ``jax.vmap``-ed over a batched model or ``jax.grad``-ed (RK4, semi-implicit
+    and Newmark; Beeman's while loop is forward-mode only). ``record=True`` appends a dict of
+    per-sample outputs (poses, joint reactions, energies, load diagnostics) as a 7th item; a tuple
+    of output names (e.g. ``("point_acceleration",)``) records only those, and z comes back
+    empty (the batch form: the loads' states are not kept per sample).
+    """
+    args, options = rollout_call(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integrator,
+                                  loads=loads, save_every=save_every, t0=t0, z0=z0, record=record)
+    return rollout_jit(*args, **options)
+
+
+def rollout_call(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0, z0, record):
+    """The arguments and static options of :func:`rollout`'s compiled call, checked."""
+    loads = as_loads(loads)
+    integ = _integrators.get(integrator)
+    if not whole_number(n_steps):
+        raise ValueError(f"n_steps: {n_steps!r}; give a positive whole number of steps")
+    if not whole_number(save_every):
+        raise ValueError(f"save_every: {save_every!r}; give a positive whole number")
+    positive_seconds(dt, "dt")
+    q0 = jnp.asarray(q0, jnp.float64)
+    qd0 = jnp.asarray(qd0, jnp.float64)
+    if z0 is None:
+        parts = [ld.initial_state(model) for ld in loads]
+        z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
+    args = (model, loads, q0, qd0, jnp.asarray(z0, jnp.float64), jnp.asarray(t0, jnp.float64),
+            jnp.asarray(dt, jnp.float64))
+    return args, dict(n_steps=int(n_steps), integrator=integ, save_every=int(save_every),
+                      record=record)
+
+
+def rollout_progress(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0, bar):
+    """:func:`rollout` (``record=True``) in chunks with a progress bar: numpy outputs, the same
+    values; it stops early once the state is non-finite."""
+    parts = [ld.initial_state(model) for ld in loads]
+    z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
+    q0, qd0 = jnp.asarray(q0, jnp.float64), jnp.asarray(qd0, jnp.float64)
+    t0, dt = jnp.asarray(t0, jnp.float64), jnp.asarray(dt, jnp.float64)
+    return run_chunked(
+        lambda: _start_jit(model, loads, q0, qd0, z0, t0, dt, integrator=integrator, record=True),
+        lambda carry, c: _chunk_jit(model, loads, carry, dt, n_blocks=c, integrator=integrator,
+                                    save_every=save_every, record=True),
+        n_steps // save_every, save_every, bar, time_axis=0)
