@@ -1,6 +1,8 @@
-"""Results identical to the bit before and after a change: every shipped config (``configs/*.toml``,
-not ``configs/sensitivity/``) run briefly in two trees, each result saved as NetCDF, every variable,
-coordinate and attribute compared.
+"""Bit-for-bit check of a change: every shipped config run briefly in two trees and compared.
+
+Results identical to the bit before and after each step of a change (a restructuring): every
+shipped config (``configs/*.toml``, not ``configs/sensitivity/``) run briefly in two trees, each
+result saved as NetCDF, every variable, coordinate and attribute compared.
 
 What runs (the probe, one Python subprocess per tree, ``PYTHONPATH`` and working directory the
 tree, so each tree runs its own ``mfm`` and ``hydro``), for each config, each call in try/except (a
@@ -35,13 +37,13 @@ equal to a NaN at the same place; with ``--rtol r``: NaN at the same places and
 max |new − ref| ≤ r · max |ref| per variable (strings and integers always exactly). Attributes of
 the dataset and of every variable are compared too (numbers under the same rule), except:
 
-* excluded by name (:data:`EXCLUDED_ATTRS`): provenance that legitimately changes between commits
-  or trees: ``git_commit`` (the commit, "+dirty" for uncommitted work), ``created`` (the time of
-  the run), ``mfm_version`` and every ``*_version`` (jax, numpy, xarray, MoorPy: the environment,
-  not the code), and the file paths ``config``, ``database``, ``source`` (as given, relative to the
-  working directory; what they name is checked by ``config_sha256`` and ``database_sha256``, which
-  are compared), and wall times (``fit_fit_seconds`` and every ``*_seconds``, ``wall_time_s``,
-  ``rao_solve_s``, ``sweep_wall_s``: how long the machine took, not what it computed);
+* excluded by name (:func:`excluded`): provenance that legitimately changes between commits,
+  trees or runs: ``git_commit`` (the commit, "+dirty" for uncommitted work), ``created`` (the time
+  of the run), ``mfm_version`` and every ``*_version`` (jax, numpy, xarray, MoorPy: the
+  environment, not the code), measured durations (``*_seconds``: the state-space fit's
+  ``fit_fit_seconds``; any ``*wall*``: wall-clock times), and the file paths ``config``,
+  ``database``, ``source`` (as given, relative to the working directory; what they name is checked
+  by ``config_sha256`` and ``database_sha256``, which are compared);
 * masked inside every other string attribute (:func:`normalise`): file paths (``a/b/c.ext``:
   e.g. ``wind_*_ct_source`` names the bundled table under the tree's ``mfm/data/``), dotted module
   paths ``mfm.x.y`` (a class repr that names its module moves with it) and object addresses
@@ -50,10 +52,13 @@ the dataset and of every variable are compared too (numbers under the same rule)
 A config or call that fails in one tree and not in the other is a difference; one that fails in
 both with the same (masked) error string is shown as "same error" and is not.
 
-Runtime (this 2-core machine, measured at 7ace823): the probe takes 8.2 minutes per tree (494 s:
-18 configs, 58 calls; the seven Wu & Yuan configs with 18 coordinates 25–45 s each, the others
-2–25 s; ``--only`` runs a few); the comparison a few seconds. So a check against a commit takes
-~17 minutes, one against a saved reference (``--reference``) ~8.5; the datasets take 3 MB.
+Runtime (this 2-core machine, measured at 7ace823): the probe takes 8–11 minutes per tree (494 s
+on a quiet machine, 626 and 667 s with the test suite and another probe running beside it; 18
+configs, 57 calls; the six Wu & Yuan configs with 18 coordinates 34–53 s each (to 72 s loaded),
+the others 2–35 s; ``--only`` runs a few), the comparison a few seconds. So a check against a
+commit takes ~17–22 minutes, one against a saved reference (``--reference``) half that; the
+datasets take 3 MB. A saved reference compares only under the same environment and machine (the
+jax/XLA versions, the flags and the CPU decide the bits).
 
 Usage (from the repository root, with mfm installed; the script does not touch sys.path):
 
@@ -89,10 +94,10 @@ ROOT = Path(__file__).resolve().parent.parent
 XLA_FLAGS = "--xla_backend_optimization_level=0 --xla_llvm_disable_expensive_passes=true"
 
 # provenance attributes not compared (see the module docstring): they change with the commit, the
-# time, the environment or where the tree lies, not with what the code computes
-EXCLUDED_ATTRS = {"git_commit", "created", "mfm_version", "config", "database", "source",
-                  "wall_time_s", "rao_solve_s", "sweep_wall_s"}
-EXCLUDED_SUFFIXES = ("_version", "_seconds")
+# time, the environment, the machine's load or where the tree lies, not with what the code computes
+EXCLUDED_ATTRS = {"git_commit", "created", "mfm_version", "config", "database", "source"}
+EXCLUDED_SUFFIXES = ("_version", "_seconds")      # versions; measured durations (fit_fit_seconds)
+EXCLUDED_SUBSTRINGS = ("wall",)                   # wall-clock times (wall_time_s, sweep_wall_s)
 
 # configs that also run the state-space radiation (simulate and frequency_response)
 STATE_SPACE_CONFIGS = ("rm3", "m4_111")
@@ -242,7 +247,9 @@ def normalise(s: str) -> str:
 
 
 def excluded(name: str) -> bool:
-    return name in EXCLUDED_ATTRS or name.endswith(EXCLUDED_SUFFIXES)
+    """Whether the attribute ``name`` is left out of the comparison."""
+    return (name in EXCLUDED_ATTRS or name.endswith(EXCLUDED_SUFFIXES)
+            or any(s in name for s in EXCLUDED_SUBSTRINGS))
 
 
 def value_difference(a, b, rtol: float):
@@ -336,7 +343,9 @@ def compare_files(ref_path: Path, new_path: Path, rtol: float):
     return len(common), worst, worst_rel, problems
 
 
-def compare(ref_dir: Path, new_dir: Path, rtol: float, only=None) -> int:
+def compare(ref_dir: Path, new_dir: Path, rtol: float, only=None, label=None) -> int:
+    """Compare the datasets of ``new_dir`` (``label``: how to name it) with ``ref_dir``'s; prints
+    the table, returns the exit status."""
     ref, new = read_summary(ref_dir)["calls"], read_summary(new_dir)["calls"]
     keys = list(ref) + [k for k in new if k not in ref]     # the probe's order
     if only:
@@ -393,7 +402,7 @@ def compare(ref_dir: Path, new_dir: Path, rtol: float, only=None) -> int:
     rule = "bitwise" if rtol == 0 else f"rtol {rtol:g}"
     print(f"\n{n_same} of {len(keys)} calls the same ({rule}), {n_diff} differ: "
           + ("IDENTICAL" if n_diff == 0 else "DIFFERENT")
-          + f"  [reference {ref_dir}, current {new_dir}]")
+          + f"  [reference {ref_dir}, current {label or new_dir}]")
     return 0 if n_diff == 0 else 1
 
 
@@ -453,7 +462,8 @@ def main(argv=None) -> int:
             probe_commit(full, ref_dir, paths)
         new_dir = base / "current"
         probe(ROOT, new_dir, paths)
-        return compare(ref_dir, new_dir, args.rtol, args.only)
+        label = new_dir if args.keep is not None else f"this tree, {ROOT}"
+        return compare(ref_dir, new_dir, args.rtol, args.only, label)
 
 
 if __name__ == "__main__":
