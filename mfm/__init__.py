@@ -26,7 +26,7 @@ from .mechanics.dynamics import (coriolis_matrix, energies, evaluate, forward_dy
                                  mass_matrix, reaction_loads)
 from .mechanics.kinematics import b_matrix, b_matrix_dot, body_poses, kinematics  # noqa: E402
 from .mechanics.model import Model  # noqa: E402
-from .errors import AccuracyWarning, SimulationError, StabilityWarning  # noqa: E402
+from .errors import AccuracyWarning, SeaStateError, SimulationError, StabilityWarning  # noqa: E402
 from .timedomain.batch import simulate_batch  # noqa: E402
 from .timedomain.rollout import rollout  # noqa: E402
 from .timedomain.setup import model_loads  # noqa: E402
@@ -48,10 +48,11 @@ def __getattr__(name):
     return _compat.package_attribute(name)
 
 
-__all__ = ["AccuracyWarning", "ConfigError", "Model", "PerformanceWarning", "SimulationError",
-           "StabilityWarning", "SweepError", "amplification_matrix", "b_matrix", "b_matrix_dot",
-           "body_poses", "compile_tree", "coriolis_matrix", "energies", "equilibrium", "evaluate",
-           "floquet", "forward_dynamics", "frequency", "frequency_response", "integrators",
-           "kinematics", "largest_stable_dt", "linear_response", "load", "loads", "mass_matrix", "model_loads",
+__all__ = ["AccuracyWarning", "ConfigError", "Model", "PerformanceWarning", "SeaStateError",
+           "SimulationError", "StabilityWarning", "SweepError", "amplification_matrix",
+           "b_matrix", "b_matrix_dot", "body_poses", "compile_tree", "coriolis_matrix",
+           "energies", "equilibrium", "evaluate", "floquet", "forward_dynamics", "frequency",
+           "frequency_response", "integrators", "kinematics", "largest_stable_dt",
+           "linear_response", "load", "loads", "mass_matrix", "model_loads",
            "natural_frequencies", "reaction_loads", "reduce", "results", "rollout", "simulate",
            "simulate_batch", "spectral_response", "sweep"]

@@ -11,6 +11,12 @@ class ConfigError(ValueError):
     """A float tree or config that cannot be built. The message names the key, the value and the fix."""
 
 
+class SeaStateError(TypeError, ValueError):
+    """An argument that should be a sea state of :mod:`hydro.waves` is something else. A
+    TypeError (the wrong kind of object) and a ValueError (a bad argument value), as the time and
+    the frequency domains raised before they shared one check."""
+
+
 class SimulationError(RuntimeError):
     """The simulation went non-finite; the message gives the time, the state and the likely cause.
     ``dataset`` holds what was computed up to the last finite sample (attribute

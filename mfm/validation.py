@@ -7,8 +7,8 @@ key path, the value and what is accepted.
 Arguments of the front doors (``simulate``, ``rollout``, ``simulate_batch``, the linear levels,
 the stability and fidelity studies): :func:`finite_number`, :func:`positive`,
 :func:`whole_number`, :func:`positive_seconds`, :func:`initial_vector`, :func:`square_matrix`,
-:func:`check_sea` raise ValueError (TypeError for an object of the wrong kind) naming the argument,
-the value and what is accepted.
+:func:`check_sea` raise ValueError (:class:`~mfm.errors.SeaStateError`, also a TypeError, for
+what is no sea state) naming the argument, the value and what is accepted.
 
 Two checkers stay outside, by necessity: :mod:`hydro` never imports mfm (its sea states check
 their own numbers), and the command line's parser (``mfm_cli``) must answer ``--help`` without
@@ -22,7 +22,7 @@ import numbers
 import jax
 import numpy as np
 
-from .errors import ConfigError
+from .errors import ConfigError, SeaStateError
 
 # ------------------------------------------------------------------------------- config tables
 
@@ -160,12 +160,11 @@ SEAS = ("hydro.Regular(height=, period=), hydro.Jonswap(hs=, tp=), hydro.Pierson
 
 def check_sea(sea, what="sea", *, still_water=True):
     """A sea state of :mod:`hydro.waves` (anything with ``components``), or None for still water
-    where ``still_water``: TypeError for another object, ValueError for None where a sea is
-    needed (the spectral and linear levels)."""
+    where ``still_water``; else :class:`~mfm.errors.SeaStateError` (a TypeError and a ValueError)."""
     if sea is None:
         if still_water:
             return
-        raise ValueError(f"{what}: None; this needs a sea state: give one of {SEAS}")
+        raise SeaStateError(f"{what}: None; this needs a sea state: give one of {SEAS}")
     if not hasattr(sea, "components"):
-        raise TypeError(f"{what}: {sea!r} is not a sea state; give one of {SEAS}"
+        raise SeaStateError(f"{what}: {sea!r} is not a sea state; give one of {SEAS}"
                         + (", or None for still water" if still_water else ""))

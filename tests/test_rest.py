@@ -78,24 +78,27 @@ def test_the_stability_check_warns_past_the_limit_of_the_analytic_period():
         mfm.simulate(model, duration=3.0 / w * 4, dt=3.0 / w, loads=torque_series(model, 5.0))
 
 
-def test_a_damping_ratio_waits_for_the_linearisation(tmp_path):
-    # LinearBodyMatrix.create with damping_ratio: the load cannot set it itself (the linearisation
-    # is the frequency package's); evaluating it before resolve_damping_ratios says so, and the
-    # resolved damping is what mfm.load sets for the same [[body_matrices]] table
+def test_a_damping_ratio_is_set_from_the_linearisation_above_the_loads(tmp_path):
+    # a [[body_matrices]] damping_ratio needs the model's linearisation, which the loads never
+    # import: mfm.load sets it (mfm.frequency.resolve_damping_ratios), LinearBodyMatrix.create
+    # through the resolver mfm.frequency registers; a load with a ratio still unset refuses to run
     cfg = tmp_path / "sphere.toml"
     src = (mfm_root() / "configs" / "sphere.toml").read_text().replace(
         'database = "../hydro/data/sphere.nc"', f'database = "{mfm_root() / "hydro/data/sphere.nc"}"')
     cfg.write_text(src)
     plain = mfm.load(cfg)
-    pending = LinearBodyMatrix.create(plain, "sphere", damping_ratio={"heave": 0.2})
-    with pytest.raises(ValueError, match="resolve_damping_ratios"):
-        mfm.frequency.linear_system(plain, loads=pending)
-    done = mfm.frequency.resolve_damping_ratios(plain, pending)
-    assert done.damping_ratios == ()
-    c = float(done.damping[0, 2, 2])
+    made = LinearBodyMatrix.create(plain, "sphere", damping_ratio={"heave": 0.2})
+    assert made.damping_ratios == ()
+    c = float(made.damping[0, 2, 2])
     cfg.write_text(src + '\n[[body_matrices]]\nbody = "sphere"\ndamping_ratio = {heave = 0.2}\n')
     built = next(ld for ld in mfm.load(cfg).loads if isinstance(ld, LinearBodyMatrix))
     assert c > 0 and float(built.damping[0, 2, 2]) == c
+    table = LinearBodyMatrix.parse_table([{"body": "sphere", "damping_ratio": {"heave": 0.2}}],
+                                         list(plain.body_names))
+    pending = LinearBodyMatrix.from_parsed(table, plain)
+    with pytest.raises(ValueError, match="resolve_damping_ratios"):
+        mfm.frequency.linear_system(plain, loads=pending)
+    assert float(mfm.frequency.resolve_damping_ratios(plain, pending).damping[0, 2, 2]) == c
 
 
 def mfm_root():

@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from .. import results
+from ..loads import body_matrix
 from ..loads.base import MODES
 from ..mechanics.model import Model
 from ..mechanics.points import BodyPoints
@@ -257,3 +258,6 @@ def resolve_damping_ratios(model: Model, load):
                              loads=(base,))
         out = out.with_damping(p, mode, c)
     return out
+
+
+body_matrix.register_resolver(resolve_damping_ratios)

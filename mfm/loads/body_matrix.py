@@ -27,6 +27,17 @@ from .base import MODES, Load, LoadOutput
 
 KEYS = {"name", "body", "point", "stiffness", "damping", "damping_ratio", "notes"}
 
+# What sets a damping ratio's damping: the model's linearisation, which sits above the loads
+# (mfm.frequency.modes registers resolve_damping_ratios here when it is imported, as every
+# `import mfm` does): the inversion that keeps this module from importing upward.
+_RESOLVERS: list = []
+
+
+def register_resolver(resolve):
+    """Give :meth:`LinearBodyMatrix.create` the function ``resolve(model, load) -> load`` that sets
+    the damping of the ratios it asks for (:func:`mfm.frequency.resolve_damping_ratios`)."""
+    _RESOLVERS[:] = [resolve]
+
 
 class LinearBodyMatrix(Load):
     """F = −K ξ − D ξ̇ at body points. ``points`` (BodyPoints, one per matrix), ``stiffness`` and
@@ -57,8 +68,8 @@ class LinearBodyMatrix(Load):
     def create(cls, model, body: str, *, point=None, stiffness=None, damping=None,
                damping_ratio: dict | None = None, name: str | None = None) -> "LinearBodyMatrix":
         """One matrix on ``body`` from Python, as a ``[[body_matrices]]`` entry would give it
-        (stiffness/damping 6×6 or 6 diagonal values; damping_ratio e.g. {"heave": 0.2}: then
-        pass the load through :func:`mfm.frequency.resolve_damping_ratios` before use)."""
+        (stiffness/damping 6×6 or 6 diagonal values; damping_ratio e.g. {"heave": 0.2}, set from
+        the linearisation of ``model`` with this load, :func:`mfm.frequency.resolve_damping_ratios`)."""
         entry = {"body": body}
         if point is not None:
             entry["point"] = list(np.asarray(point, dtype=float))
@@ -69,7 +80,13 @@ class LinearBodyMatrix(Load):
             entry["damping_ratio"] = dict(damping_ratio)
         if name is not None:
             entry["name"] = name
-        return cls.from_parsed(cls.parse_table([entry], list(model.body_names)), model)
+        load = cls.from_parsed(cls.parse_table([entry], list(model.body_names)), model)
+        if load.damping_ratios:
+            if not _RESOLVERS:      # only where mfm.frequency was never imported: not via `mfm`
+                raise RuntimeError("LinearBodyMatrix.create(damping_ratio=...) needs the model's "
+                                   "linearisation: import mfm (or mfm.frequency) first")
+            load = _RESOLVERS[0](model, load)
+        return load
 
     # -- config
     @staticmethod

@@ -17,7 +17,7 @@ from ..loads.assembly import as_loads
 from ..validation import finite_number, initial_vector, whole_number
 from . import integrators as _integrators
 from .progress import progress_bar, progress_options, run_chunked
-from .record import map_in_groups, output_names
+from .record import Recording, map_in_groups, output_names
 from .rollout import TRACES, rollout_blocks, rollout_impl, rollout_start
 from .setup import model_loads
 
@@ -212,6 +212,7 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     parts = [ld.initial_state(m0) for ld in loads[0]]
     z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
 
+    recording = Recording(outputs=outputs, states=False)     # the batch form: no z per sample
     known = set(results.record_specs(m0, loads[0])[0])
     bad = [n for n in outputs if n not in known]
     if bad:
@@ -232,19 +233,19 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     if bar is None:
         out = _join_parts(_in_threads(len(groups), lambda k: _batch_jit(
             args[k][0], args[k][1], q0, qd0, z0, t0_, args[k][2], model_axis=model_axis,
-            n_steps=int(n_steps), integrator=integ, save_every=int(save_every), record=outputs,
+            n_steps=int(n_steps), integrator=integ, save_every=int(save_every), record=recording,
             lanes=lanes)), B)
     else:
         def start():
             res = _in_threads(len(groups), lambda k: _start_batch_jit(
                 args[k][0], args[k][1], q0, qd0, z0, t0_, args[k][2], model_axis=model_axis,
-                integrator=integ, record=outputs, lanes=lanes))
+                integrator=integ, record=recording, lanes=lanes))
             return [r[0] for r in res], _join_parts([r[1] for r in res], B)
 
         def chunk(carries, c):
             res = _in_threads(len(groups), lambda k: _chunk_batch_jit(
                 args[k][0], args[k][1], carries[k], args[k][2], model_axis=model_axis,
-                n_blocks=c, integrator=integ, save_every=int(save_every), record=outputs,
+                n_blocks=c, integrator=integ, save_every=int(save_every), record=recording,
                 lanes=lanes))
             return [r[0] for r in res], _join_parts([r[1] for r in res], B)
 

@@ -1,7 +1,10 @@
-"""What a run records of each saved state: the state itself, and with ``record`` the outputs
-(poses, joint reactions, energies, the loads' diagnostics), computed inside the time loop or, for
-a small load memory, after it in one vmapped pass over the saved samples."""
+"""What a run records of each saved state (:class:`Recording`): the state itself, and the
+outputs (poses, joint reactions, energies, the loads' diagnostics), every one or those named,
+computed inside the time loop or, for a small load memory, after it in one vmapped pass over the
+saved samples."""
 from __future__ import annotations
+
+import dataclasses
 
 import jax
 import jax.numpy as jnp
@@ -38,6 +41,53 @@ def sample_outputs(model, loads, s, mem):
                 joint_moment=m_j, kinetic_energy=T, potential_energy=V, qdd=ev.qdd, **diag)
 
 
+@dataclasses.dataclass(frozen=True)
+class Recording:
+    """What a run keeps of each saved state: a static option (part of the compiled function's
+    key), like diffrax's ``SaveAt``.
+
+    outputs: None for every per-sample output (:func:`sample_outputs`), or a tuple of the names to
+        keep (the compiler drops the work of the others; () none).
+    states: whether the loads' own states z are kept per sample (a batch drops them: a radiation
+        fit has thousands per sample, and a 36-case sweep of one hour would hold gigabytes).
+
+    A rollout gives ``(t, q, qd, qdd, z, iterations)`` per sample, and a dict of the outputs as a
+    7th item unless it keeps none and the states (:attr:`STATE`).
+    """
+    outputs: tuple | None = ()
+    states: bool = True
+
+    @classmethod
+    def of(cls, record) -> "Recording":
+        """The recording of ``rollout``'s ``record=``: False (the state, :attr:`STATE`), True
+        (the state and every output, :attr:`EVERY`), a tuple of output names (the batch form:
+        those outputs, no z), or a Recording."""
+        if isinstance(record, Recording):
+            return record
+        if record is False:
+            return STATE
+        if record is True:
+            return EVERY
+        if isinstance(record, tuple) and all(isinstance(n, str) for n in record):
+            return cls(outputs=record, states=False)
+        raise ValueError(f"record: {record!r}; give False (the state), True (every output), a "
+                         "tuple of output names (those only, without the loads' states) or a "
+                         "mfm.timedomain.record.Recording")
+
+    @property
+    def every(self) -> bool:
+        return self.outputs is None
+
+    @property
+    def with_outputs(self) -> bool:
+        """Whether a sample carries a dict of outputs (a 7th item)."""
+        return self.outputs is None or bool(self.outputs) or not self.states
+
+
+STATE = Recording((), True)
+EVERY = Recording(None, True)
+
+
 def output_names(outputs) -> tuple:
     if isinstance(outputs, str):
         outputs = (outputs,)
@@ -50,17 +100,14 @@ def output_names(outputs) -> tuple:
     return tuple(dict.fromkeys(names))
 
 
-def saved(model, loads, s, mem, record):
-    """The outputs kept of one saved state. ``record``: False (the state), True (the state and
-    every per-sample output), or a tuple of output names: a batch's form, the state without the
-    loads' own states z (a radiation fit has thousands per sample: a 36-case sweep of one hour
-    would hold gigabytes of them) and a dict of the named outputs only (the compiler drops the
-    work of the others)."""
-    if isinstance(record, tuple):
-        rec = sample_outputs(model, loads, s, mem) if record else {}
-        return (s.t, s.q, s.qd, s.qdd, jnp.zeros(0), s.iterations, {k: rec[k] for k in record})
-    out = (s.t, s.q, s.qd, s.qdd, s.z, s.iterations)
-    return out + ((sample_outputs(model, loads, s, mem),) if record else ())
+def saved(model, loads, s, mem, recording: Recording):
+    """What ``recording`` keeps of one saved state: (t, q, q̇, q̈, z or an empty z, iterations)
+    and, where it has outputs, their dict."""
+    out = (s.t, s.q, s.qd, s.qdd, s.z if recording.states else jnp.zeros(0), s.iterations)
+    if not recording.with_outputs:
+        return out
+    rec = sample_outputs(model, loads, s, mem) if (recording.every or recording.outputs) else {}
+    return out + (rec if recording.every else {k: rec[k] for k in recording.outputs},)
 
 
 # per-sample memory (floats) up to which the outputs of a recorded run are computed after the
@@ -71,18 +118,19 @@ DEFERRED_RECORD_MEMORY = 10_000
 DEFERRED_RECORD_WIDTH = 32
 
 
-def deferred(carry, record) -> bool:
-    """Whether a recorded run evaluates its outputs after the time loop (:func:`rollout_blocks`):
-    ``record is True`` and a memory of at most :data:`DEFERRED_RECORD_MEMORY` floats."""
+def deferred(carry, recording: Recording) -> bool:
+    """Whether a recorded run evaluates its outputs after the time loop
+    (:func:`~mfm.timedomain.rollout.rollout_blocks`): every output is recorded and the loads'
+    memory is at most :data:`DEFERRED_RECORD_MEMORY` floats."""
     mem_size = sum(int(np.prod(np.shape(a))) for a in jax.tree_util.tree_leaves(carry[1]))
-    return record is True and mem_size <= DEFERRED_RECORD_MEMORY
+    return recording == EVERY and mem_size <= DEFERRED_RECORD_MEMORY
 
 
 def outputs_after(model, loads, carries):
-    """The outputs (:func:`saved`, ``record=True``) of stacked carries, in groups of a fixed
+    """The outputs (:func:`saved`, :data:`EVERY`) of stacked carries, in groups of a fixed
     width: every sample is computed by the same vmapped program whatever their number, so a run
     in chunks (progress bar) gives the same bits."""
-    return map_in_groups(lambda sm: saved(model, loads, *sm, True), carries,
+    return map_in_groups(lambda sm: saved(model, loads, *sm, EVERY), carries,
                           DEFERRED_RECORD_WIDTH)
 
 

@@ -17,7 +17,7 @@ from ..mechanics.model import Model
 from ..validation import positive_seconds, whole_number
 from . import integrators as _integrators
 from .progress import run_chunked
-from .record import deferred, outputs_after, saved
+from .record import EVERY, STATE, Recording, deferred, outputs_after, saved
 
 
 # How many times each compiled function was traced (a retrace means a recompilation); tests use it.
@@ -48,57 +48,59 @@ def update_memories(model, loads, s, memories):
     return tuple(ld.update_memory(model, s.t, s.q, s.qd, kin, mem) for ld, mem in zip(loads, memories))
 
 
-def rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, record):
+def rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, recording: Recording):
     """The initial carry (integrator state, load memories) and its saved outputs (deferred ones
     by the same vmapped program as the later samples', :func:`outputs_after`)."""
     mem0 = init_memories(model, loads, t0, q0, qd0, dt)
     state = integrator.init(dynamics_function(model, loads, mem0), t0, q0, qd0, z0)
     carry = (state, mem0)
-    if deferred(carry, record):
+    if deferred(carry, recording):
         one = outputs_after(model, loads, jax.tree_util.tree_map(lambda a: a[None], carry))
         return carry, jax.tree_util.tree_map(lambda a: a[0], one)
-    return carry, saved(model, loads, state, mem0, record)
+    return carry, saved(model, loads, state, mem0, recording)
 
 
-def rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, record):
-    """``n_blocks`` blocks of ``save_every`` steps from ``carry``: (carry, the saved outputs of
-    each block's last step, stacked). With ``record is True`` and a small memory (the state
-    space's, not the convolution's history) the loop keeps only the state and memory of each
-    saved step and the outputs are evaluated afterwards in one vmapped pass
-    (:func:`outputs_after`): the serial loop carries the integration alone (RM3: recording
-    every step cost 5× the integration inside it). ``record="carry"``: the saved carries
-    themselves, for that pass to be made by the caller."""
+def rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every,
+                   recording: Recording, keep_carries: bool = False):
+    """``n_blocks`` blocks of ``save_every`` steps from ``carry``: (carry, what ``recording``
+    keeps of each block's last step, stacked). With every output recorded and a small memory (the
+    state space's, not the convolution's history) the loop keeps only the state and memory of
+    each saved step and the outputs are evaluated afterwards in one vmapped pass
+    (:func:`outputs_after`): the serial loop carries the integration alone (RM3: recording every
+    step cost 5× the integration inside it). ``keep_carries``: the saved carries themselves, for
+    that pass to be made by the caller."""
 
     def one_step(carry, _):
         s, mem = carry
         s = integrator.step(dynamics_function(model, loads, mem), s, dt)
         return (s, update_memories(model, loads, s, mem)), None
 
-    later = record == "carry" or deferred(carry, record)
+    later = keep_carries or deferred(carry, recording)
 
     def block(carry, _):
         carry, _ = jax.lax.scan(one_step, carry, None, length=save_every)
-        return carry, (carry if later else saved(model, loads, *carry, record))
+        return carry, (carry if later else saved(model, loads, *carry, recording))
 
     carry, out = jax.lax.scan(block, carry, None, length=n_blocks)
-    if later and record is True:
+    if later and not keep_carries:
         out = outputs_after(model, loads, out)
     return carry, out
 
 
 def rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_every, record):
     TRACES["rollout"] += 1
+    recording = Recording.of(record)
     n_blocks = n_steps // save_every
-    carry, _ = rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, False)
-    if deferred(carry, record):
+    carry, _ = rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, STATE)
+    if deferred(carry, recording):
         # the initial sample's outputs in the same pass as the others': one copy of the outputs'
         # program to compile, not two (M4 134: ~4 s of a first call)
         _, carries = rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every,
-                                     "carry")
+                                    recording, keep_carries=True)
         stacked = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), carry, carries)
         return outputs_after(model, loads, stacked)
-    first = saved(model, loads, *carry, record)
-    _, traj = rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, record)
+    first = saved(model, loads, *carry, recording)
+    _, traj = rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, recording)
     return jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), first, traj)
 
 
@@ -108,19 +110,20 @@ rollout_jit = jax.jit(rollout_impl,
 
 # The chunked rollout of a progress bar: the same start and blocks, compiled as two functions
 # (the blocks one once for the chunk length), called from the host between bar updates.
-def _chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every, record):
+def _chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every, recording):
     TRACES["rollout_chunk"] += 1
-    return rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, record)
+    return rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, recording)
 
 
-_start_jit = jax.jit(rollout_start, static_argnames=("integrator", "record"))
+_start_jit = jax.jit(rollout_start, static_argnames=("integrator", "recording"))
 
 
-_chunk_jit = jax.jit(_chunk_impl, static_argnames=("n_blocks", "integrator", "save_every", "record"))
+_chunk_jit = jax.jit(_chunk_impl, static_argnames=("n_blocks", "integrator", "save_every",
+                                                   "recording"))
 
 
 def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=None,
-            save_every: int = 1, t0=0.0, z0=None, record: bool = False):
+            save_every: int = 1, t0=0.0, z0=None, record=False):
     """Pure, jit-compiled rollout: returns ``(t, q, qd, qdd, z, iterations)`` arrays with a leading
     time axis of length ``n_steps // save_every + 1`` (the initial state first).
 
@@ -130,7 +133,8 @@ def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=
     and Newmark; Beeman's while loop is forward-mode only). ``record=True`` appends a dict of
     per-sample outputs (poses, joint reactions, energies, load diagnostics) as a 7th item; a tuple
     of output names (e.g. ``("point_acceleration",)``) records only those, and z comes back
-    empty (the batch form: the loads' states are not kept per sample).
+    empty (the batch form: the loads' states are not kept per sample); or a
+    :class:`~mfm.timedomain.record.Recording`, which these stand for.
     """
     args, options = rollout_call(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integrator,
                                   loads=loads, save_every=save_every, t0=t0, z0=z0, record=record)
@@ -154,7 +158,7 @@ def rollout_call(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, 
     args = (model, loads, q0, qd0, jnp.asarray(z0, jnp.float64), jnp.asarray(t0, jnp.float64),
             jnp.asarray(dt, jnp.float64))
     return args, dict(n_steps=int(n_steps), integrator=integ, save_every=int(save_every),
-                      record=record)
+                      record=Recording.of(record))
 
 
 def rollout_progress(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0, bar):
@@ -165,7 +169,8 @@ def rollout_progress(model, q0, qd0, *, dt, n_steps, integrator, loads, save_eve
     q0, qd0 = jnp.asarray(q0, jnp.float64), jnp.asarray(qd0, jnp.float64)
     t0, dt = jnp.asarray(t0, jnp.float64), jnp.asarray(dt, jnp.float64)
     return run_chunked(
-        lambda: _start_jit(model, loads, q0, qd0, z0, t0, dt, integrator=integrator, record=True),
+        lambda: _start_jit(model, loads, q0, qd0, z0, t0, dt, integrator=integrator,
+                           recording=EVERY),
         lambda carry, c: _chunk_jit(model, loads, carry, dt, n_blocks=c, integrator=integrator,
-                                    save_every=save_every, record=True),
+                                    save_every=save_every, recording=EVERY),
         n_steps // save_every, save_every, bar, time_axis=0)
