@@ -121,3 +121,30 @@ def test_batch_cases_are_labelled(rm3):
     ds = mfm.simulate_batch(rm3, seas, dt=0.2, n_steps=20, radiation="none")
     assert list(ds.sea_period.values) == [7.0, 9.0] and ds.sea_period.attrs["units"] == "s"
     assert "config_sha256" in ds.attrs
+
+
+def test_a_run_that_cannot_fit_is_refused_before_any_work(rm3, monkeypatch):
+    # duration = 1e15 s at dt = 0.1 s used to allocate until the machine gave up; now the memory
+    # the run would hold before its first step (saved samples, wave tables) is estimated from the
+    # model and refused at once, with the estimate and the ways out
+    import time
+
+    from mfm.timedomain import checks
+
+    start = time.perf_counter()
+    with pytest.raises(ValueError, match=r"duration: 1e\+16 steps would hold about .* GB before "
+                                         r"the first step .*save_every=k"):
+        mfm.simulate(rm3, SEA, duration=1e15, dt=0.1)
+    with pytest.raises(ValueError, match=r"n_steps: 1e\+13 steps × 4 cases"):
+        mfm.simulate_batch(rm3, [SEA] * 4, dt=0.1, n_steps=10**13)
+    assert time.perf_counter() - start < 5.0          # before the water, the fit, any compile
+    # the estimate is the dataset's size to a few per cent (here the run's own: coordinates and
+    # attributes aside, 2 % on RM3), the wave tables on top
+    ds = mfm.simulate(rm3, SEA, duration=20.0, dt=0.1, check_stability=False)
+    n, dofs = 200, 6 * len(rm3.hydro.body_index)
+    est = checks.run_bytes(rm3, rm3.loads, n, 1) - 8 * (2 * n + 1) * (dofs + 1)
+    assert abs(est / ds.nbytes - 1) < 0.05
+    # and the limit is the machine's memory: a machine of 100 kB refuses that run (~0.25 MB) too
+    monkeypatch.setattr(checks, "machine_memory", lambda: 100_000)
+    with pytest.raises(ValueError, match="more than this machine's 0.0001 GB"):
+        mfm.simulate(rm3, SEA, duration=20.0, dt=0.1)

@@ -16,6 +16,7 @@ from ..errors import SimulationError
 from ..loads.assembly import as_loads
 from ..validation import finite_number, initial_vector, whole_number
 from . import integrators as _integrators
+from .checks import refuse_impossible
 from .progress import progress_bar, progress_options, run_chunked
 from .record import Recording, map_in_groups, output_names
 from .rollout import TRACES, rollout_blocks, rollout_impl, rollout_start
@@ -190,6 +191,8 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     integ = _integrators.get(integrator)
     outputs = output_names(outputs)
     extra = as_loads(loads)
+    refuse_impossible(models[0], extra + tuple(models[0].loads), int(n_steps), int(save_every),
+                      cases=B, every_output=False, names=outputs, what="n_steps")
     loads = [model_loads(pick(models, i), pick(seas, i), dt=float(pick(dts, i)),
                          duration=n_steps * float(pick(dts, i)), t0=t0, ramp=float(pick(ramps, i)),
                          radiation=radiation, memory=memory,

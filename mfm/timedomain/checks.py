@@ -1,9 +1,11 @@
-"""The checks of a run, before it (dt against the stability limit at the shortest natural period
-of the model at rest, against the periods the sea excites; Verlet on coordinates nothing pulls
-back) and after it (where and why the state went non-finite)."""
+"""The checks of a run, before it (a request whose memory cannot fit; dt against the stability
+limit at the shortest natural period of the model at rest, against the periods the sea excites;
+Verlet on coordinates nothing pulls back) and after it (where and why the state went
+non-finite)."""
 from __future__ import annotations
 
 import math
+import os
 import warnings
 
 import numpy as np
@@ -11,6 +13,56 @@ import numpy as np
 from ..errors import AccuracyWarning, StabilityWarning
 from ..frequency.rest import shortest_natural_period
 from . import integrators as _integrators
+
+
+def machine_memory() -> int:
+    """Bytes of memory this machine has (0 where the system does not say)."""
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
+    except (AttributeError, ValueError, OSError):
+        return 0
+
+
+def run_bytes(model, loads, n_steps: int, save_every: int, *, cases: int = 1,
+              every_output: bool = True, names=()) -> float:
+    """An estimate (bytes, float64) of what a run of ``n_steps`` holds before it starts stepping:
+    the saved samples (t, q, q̇, q̈, the loads' states and, with ``every_output``, every recorded
+    output: poses, reactions, energies and the loads' diagnostics; else only ``names``) and the
+    water's excitation and elevation tables on the integrator's grid (two points a step, RK4's),
+    for ``cases`` runs. ``loads`` are those known before the water is built (the config's and the
+    extra ones): the water's share comes from the model's hydro bodies."""
+    from .. import results
+
+    n = model.n_coordinates
+    n_saved = n_steps // max(int(save_every), 1) + 1
+    specs, coords = results.record_specs(model, loads)
+    size = lambda dims: math.prod(len(coords.get(d, ())) or 1 for d in dims)  # noqa: E731
+    per_sample = 3 * n + 2 + sum(ld.n_states for ld in loads)
+    per_sample += sum(size(dims) for name, (dims, _) in specs.items()
+                      if every_output or name in names)
+    tables = 0
+    if model.hydro is not None:
+        dofs = 6 * len(model.hydro.body_index)
+        if every_output:
+            per_sample += 1 + dofs + 6 * dofs          # eta, xi, hydro_force (6 components)
+        tables = (2 * n_steps + 1) * (dofs + 1)
+    return 8.0 * cases * (n_saved * per_sample + tables)
+
+
+def refuse_impossible(model, loads, n_steps, save_every, *, cases=1, every_output=True, names=(),
+                      what="duration"):
+    """Raise a ValueError before any work when the run's memory (:func:`run_bytes`) is more than
+    this machine has: a run that would otherwise allocate until it fails or hangs (a duration of
+    1e15 s). The message gives the estimate and how to proceed."""
+    need, have = run_bytes(model, loads, n_steps, save_every, cases=cases,
+                           every_output=every_output, names=names), machine_memory()
+    if have and need > have:
+        raise ValueError(
+            f"{what}: {n_steps:.4g} steps{f' × {cases} cases' if cases > 1 else ''} would hold "
+            f"about {need / 1e9:.3g} GB before the first step (the saved samples and the wave "
+            f"tables), more than this machine's {have / 1e9:.3g} GB: shorten the run, keep fewer "
+            f"samples (save_every=k keeps every k-th), split it into runs from the last state "
+            f"(q0=, qd0=, t0=), or record fewer outputs (simulate_batch(outputs=...))")
 
 
 def nonfinite_message(model, integ, t, q, qd, dt, loads, k):

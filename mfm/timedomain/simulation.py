@@ -18,7 +18,8 @@ from ..mechanics.model import Model
 from ..validation import finite_number, initial_vector, whole_number
 from . import integrators as _integrators
 from .batch import simulate_batch  # noqa: F401  (exported)
-from .checks import nonfinite_message, warn_accuracy, warn_stability, warn_verlet_drift
+from .checks import (nonfinite_message, refuse_impossible, warn_accuracy, warn_stability,
+                     warn_verlet_drift)
 from .progress import progress_bar, progress_options
 from .rollout import rollout, rollout_call, rollout_jit, rollout_progress  # noqa: F401  (exported)
 from .setup import choose_radiation, model_loads, stage_offsets
@@ -93,6 +94,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     if not whole_number(save_every) or n_steps % save_every:
         raise ValueError(f"save_every: {save_every!r} must be a positive divisor of the {n_steps} "
                          "steps")
+    refuse_impossible(model, as_loads(loads) + tuple(model.loads), n_steps, save_every)
     integ = _integrators.get(integrator)
     if added_mass not in ("lhs", "rhs"):
         raise ValueError(f"added_mass={added_mass!r}; accepted: 'lhs' (A∞ in M*), 'rhs' (seed 001)")
