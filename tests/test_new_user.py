@@ -545,6 +545,11 @@ def test_progress_bar_gives_the_same_numbers_with_one_compilation(capsys):
     _same_numbers(plain, shown)
     err = capsys.readouterr().err
     assert "double pendulum" in err and "211/211" in err and "step" in err
+    # every phase before the steps says what it is (issue 34: a minute's radiation fit used to
+    # run under "compiling"); the compile time counts from the compile, not from the bar
+    for said in ("preparing the loads", "linearising at q0 for the checks", "compiling",
+                 "compiled in"):
+        assert said in err, said
     with pytest.raises(ValueError, match=r"progress: 'yes'; give False .*True .*dict of tqdm"):
         mfm.simulate(m, progress="yes", **kw)
     with pytest.raises(ValueError, match=r"progress: \{'colour_of_bar': 1\} is not a set of tqdm"):

@@ -4,6 +4,7 @@ same numbers as the run in one call."""
 from __future__ import annotations
 
 import sys
+import time
 
 import jax
 import numpy as np
@@ -44,6 +45,12 @@ def progress_bar(options, total, desc):
         raise ValueError(f"progress: {options!r} is not a set of tqdm options ({e})") from None
 
 
+def phase(bar, what: str):
+    """Say on ``bar`` (or nowhere, for None) which phase of the preparation is under way."""
+    if bar is not None:
+        bar.set_postfix_str(what)
+
+
 def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis):
     """Run ``start()`` then ``chunk(carry, c)`` (``c`` blocks, from :func:`chunk_plan`) until
     ``n_blocks`` are done,
@@ -52,6 +59,7 @@ def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis):
     rollout does: the same compiled steps in the same order, so the same numbers."""
     c, n_chunks = chunk_plan(n_blocks)
     bar.set_postfix_str("compiling")
+    began = time.perf_counter()
     carry, first = start()
     pieces = [jax.tree_util.tree_map(lambda a: np.expand_dims(np.asarray(a), time_axis), first)]
     done = 0
@@ -66,7 +74,7 @@ def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis):
             if done == take:
                 # the first chunk compiled: rate, elapsed and ETA count from here, else the
                 # compilation (seconds to a minute) shows as slow steps and a far-off ETA
-                compiled = bar.format_dict["elapsed"]
+                compiled = time.perf_counter() - began
                 bar.reset(total=bar.total)
                 bar.initial = bar.n = bar.last_print_n = take * save_every
                 bar.set_postfix_str(f"compiled in {compiled:.0f} s")

@@ -20,7 +20,7 @@ from . import integrators as _integrators
 from .batch import simulate_batch  # noqa: F401  (exported)
 from .checks import (nonfinite_message, refuse_impossible, warn_accuracy, warn_stability,
                      warn_verlet_drift)
-from .progress import progress_bar, progress_options
+from .progress import phase, progress_bar, progress_options
 from .rollout import rollout, rollout_call, rollout_jit, rollout_progress  # noqa: F401  (exported)
 from .setup import choose_radiation, model_loads, stage_offsets
 
@@ -116,6 +116,12 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     # compiles on a second thread while this one builds the run's water (its radiation fit, in
     # numpy) and compiles the run. An error here returns at once: that compilation finishes on
     # its own.
+    # the bar from the start, so that a long preparation shows its phase: the radiation fit
+    # (seconds to a minute for 90 dofs) used to run under a bar that said "compiling"
+    bar = progress_bar(progress, n_steps, model.name)
+    fit = model.hydro is not None and radiation.startswith("state_space")
+    phase(bar, "preparing the loads" + (" (the radiation's state-space fit: up to a minute)"
+                                        if fit else ""))
     pool = concurrent.futures.ThreadPoolExecutor(1)
     try:
         if check_stability:
@@ -136,11 +142,16 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
         if run is not None:
             rollout_jit.lower(*run[0], **run[1]).compile()
         if check_stability:
+            phase(bar, "linearising at q0 for the checks")
             ahead.result()
             # one linearisation at q0 gives the shortest period and the coordinates that nothing
             # pulls back (those of no_restoring(model, q0, loads=<the extra loads>), `mfm info`'s)
             J, K = rest.linearised_at_rest(model, q0, loads)
             free = rest.free_coordinates(model, K)
+    except BaseException:
+        if bar is not None:
+            bar.close()
+        raise
     finally:
         pool.shutdown(wait=False)
     if check_stability:
@@ -148,7 +159,6 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     if sea is not None:
         warn_accuracy(model, sea, dt, integ)
     warn_verlet_drift(integ, free)
-    bar = progress_bar(progress, n_steps, model.name)
     if bar is None:
         out = rollout_jit(*run[0], **run[1])
     else:
