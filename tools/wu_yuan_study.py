@@ -7,7 +7,7 @@ The regular-wave steady states of the linearised system (moorings linearised at 
 equilibrium, hinge preloads included): mfm.frequency_response, per hinge
 P = ½ c ω² |θ̂|² (H/2)². Interaction factors (seed eqs. 31–33, the upper limit "2a" of eq. 33
 read as 12): q_s = P_m^i / P_s^i, q_r = Σ_row P_m / Σ_row P_s, q_a = Σ P_m / Σ P_s, with P_s from
-the lone WEC (tools/wu_yuan.py, an ASSUMED definition). CWR by eq. 34 as printed: the array's
+the lone WEC (mfm/studies/wu_yuan.py, an ASSUMED definition). CWR by eq. 34 as printed: the array's
 power over the deep-water flux ρ g² H² T / (32 π) times 8 m × 12.
 
     python tools/wu_yuan_study.py [--models 1 2 3 4 5] [--out out/wu_yuan_fd.nc]
@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import argparse
 import functools
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -30,7 +29,6 @@ import numpy as np
 import xarray as xr
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tools"))
 H_AVERAGE = 3.8              # m, the seed's average wave height
 SEVERE = (8.1, 11.4)         # m, s: the seed's severe sea (hinges locked)
 ROWS = {1: [f"wec{k}" for k in range(1, 5)], 2: [f"wec{k}" for k in range(5, 9)],
@@ -74,7 +72,7 @@ def fd_study(models=(1, 2, 3, 4, 5), periods=None, H: float = H_AVERAGE, *,
     settings and provenance in the attributes.
     """
     import mfm
-    import wu_yuan
+    from mfm.studies import wu_yuan
     from hydro.database import HydroDatabaseWarning
 
     T = seed_periods() if periods is None else np.sort(np.atleast_1d(np.asarray(periods, float)))
@@ -134,13 +132,13 @@ def fd_study(models=(1, 2, 3, 4, 5), periods=None, H: float = H_AVERAGE, *,
 
 def severe_study(models=(1, 2, 3, 4, 5), H: float = SEVERE[0], T: float = SEVERE[1], periods=None, *,
                  verbose: bool = False) -> xr.Dataset:
-    """The severe sea of the seed (H 8.1 m, T 11.4 s), every hinge locked (tools/wu_yuan.py
+    """The severe sea of the seed (H 8.1 m, T 11.4 s), every hinge locked (mfm.studies.wu_yuan
     ``platform_model(m, locked=True)``): the platform's RAOs and each line's tension RAO per model
     at ``periods`` (s; default the seed's ten, which include T) — Fig. 14 reads them at T; the
     curves show where the locked platform's resonances sit — and the motions' and tensions'
     amplitudes at (H, T) (linear: RAO × H/2)."""
     import mfm
-    import wu_yuan
+    from mfm.studies import wu_yuan
     from hydro.database import HydroDatabaseWarning
 
     Ts = seed_periods() if periods is None else np.sort(np.atleast_1d(np.asarray(periods, float)))

@@ -1,11 +1,9 @@
 """Wu & Yuan (seed 004) study helpers: the power of each WEC operating alone, P_s of the
 interaction factors (eqs. 31–33: q_s = P_m^i / P_s^i, q_r and q_a their sums over a row or the
-array), from the lone-WEC model configs/wu_yuan_wec.toml (written by tools/wu_yuan_configs.py).
+array), from the lone-WEC model configs/wu_yuan_wec.toml (written from
+:mod:`mfm.studies.wu_yuan_layout`). Needs a checkout (the configs in configs/)::
 
-Seed-specific, so outside the mfm package. From a notebook or script::
-
-    import sys; sys.path.insert(0, "<repository>/tools")
-    import wu_yuan
+    from mfm.studies import wu_yuan
     Ps = wu_yuan.wec_alone_power(3.8)      # DataArray (wec: 12, period: 10), W, H = 3.8 m
 
 P_s (an ASSUMED definition: the seed does not say how it computed a WEC "operating alone"; see
@@ -15,8 +13,8 @@ preload, in the same regular wave. Its hull is axisymmetric, so WEC i, whose arm
 horizontal) points at the angle α_i from +x, absorbs in a wave of heading β what the lone row-3
 WEC (arm along +x, α = 0) absorbs in heading β − α_i: turning the whole scene by −α_i about z
 turns WEC i into the row-3 WEC and the wave into heading β − α_i. With the layout of
-tools/wu_yuan_configs.py (row 1 = row 3 turned by +120°, row 2 by −120°) and β = 0: row 1 →
-−120°, row 2 → +120°, row 3 → 0, the three headings of hydro/data/wu_yuan_wec.nc.
+:mod:`mfm.studies.wu_yuan_layout` (row 1 = row 3 turned by +120°, row 2 by −120°) and β = 0:
+row 1 → −120°, row 2 → +120°, row 3 → 0, the three headings of hydro/data/wu_yuan_wec.nc.
 
 For a regular wave of height H (amplitude a = H/2) the mean power is
 P = pto_power · a², pto_power = ½ c ω² |θ̂|² per m² of amplitude (mfm.frequency_response).
@@ -24,32 +22,27 @@ P = pto_power · a², pto_power = ½ c ω² |θ̂|² per m² of amplitude (mfm.f
 from __future__ import annotations
 
 import functools
-import importlib.util
 import math
+import tempfile
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
-ROOT = Path(__file__).resolve().parents[1]
+from ..frequency.response import frequency_response
+from ..io.build import load
+from . import wu_yuan_layout as layout
+
+ROOT = Path(__file__).resolve().parents[2]      # the repository (configs/), in a checkout
 WEC_CONFIG = ROOT / "configs" / "wu_yuan_wec.toml"
-
-
-def _generator():
-    """tools/wu_yuan_configs.py (the single source of the layout and the WEC's data)."""
-    spec = importlib.util.spec_from_file_location("wu_yuan_configs", ROOT / "tools" / "wu_yuan_configs.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
 
 
 def arm_angles() -> dict[str, float]:
     """{"wec1": α_1, …, "wec12": α_12}: the direction (deg, from +x towards +y) of each WEC's arm
     from its CoG to its hinge in the platform configs (the same in every model: only the
     positions along a row change with the spacing). Row 3: 0; row 1: +120; row 2: −120."""
-    gen = _generator()
     out = {}
-    for name, _row, centre, hinge, _axis, _x in gen.wecs(gen.SPACINGS[0] * gen.D_WEC):
+    for name, _row, centre, hinge, _axis, _x in layout.wecs(layout.SPACINGS[0] * layout.D_WEC):
         d = np.asarray(hinge) - np.asarray(centre)
         out[name] = math.degrees(math.atan2(d[1], d[0]))
     return out
@@ -70,32 +63,27 @@ def lone_headings(heading_deg: float = 0.0) -> dict[str, float]:
 def platform_model(m: int, locked: bool = False):
     """Model ``m`` (1–5) of the platform: configs/wu_yuan_m<m>.toml, or with ``locked`` its
     severe-sea variant (every hinge locked: no PTO, no preload; 6 coordinates), written by
-    tools/wu_yuan_configs.py into a temporary file that reads the same database. Loaded once per
-    process (a model keeps its compiled linearisation: a second study of it is cheap)."""
-    import tempfile
-
-    import mfm
-
+    :func:`mfm.studies.wu_yuan_layout.config_text` into a temporary file that reads the same
+    database. Loaded once per process (a model keeps its compiled linearisation: a second study
+    of it is cheap)."""
     if m not in (1, 2, 3, 4, 5):
         raise ValueError(f"m: {m!r}; the seed's models are 1, 2, 3, 4, 5")
     if not locked:
-        return mfm.load(ROOT / "configs" / f"wu_yuan_m{m}.toml")
-    text = _generator().config_text(m, locked=True)
+        return load(ROOT / "configs" / f"wu_yuan_m{m}.toml")
+    text = layout.config_text(m, locked=True)
     rel = f'"../hydro/data/wu_yuan_m{m}.nc"'
     if rel not in text:
-        raise RuntimeError(f"tools/wu_yuan_configs.py no longer names the database as {rel}")
+        raise RuntimeError(f"mfm.studies.wu_yuan_layout no longer names the database as {rel}")
     text = text.replace(rel, '"' + (ROOT / "hydro" / "data" / f"wu_yuan_m{m}.nc").as_posix() + '"')
     path = Path(tempfile.mkdtemp(prefix="wu_yuan_locked_")) / f"wu_yuan_m{m}_locked.toml"
     path.write_text(text)
-    return mfm.load(path)
+    return load(path)
 
 
 @functools.lru_cache(maxsize=1)
 def wec_alone_model():
     """The lone WEC (configs/wu_yuan_wec.toml with its database), loaded once per process."""
-    import mfm
-
-    return mfm.load(WEC_CONFIG)
+    return load(WEC_CONFIG)
 
 
 def wec_alone_power(H, periods=None, *, heading_deg: float = 0.0, model=None, q0=None,
@@ -116,8 +104,6 @@ def wec_alone_power(H, periods=None, *, heading_deg: float = 0.0, model=None, q0
     Returns a DataArray (wec: "wec1" … "wec12", period: T), W, with coordinates ``omega``
     (period) and ``lone_heading_deg`` (wec).
     """
-    import mfm
-
     H = float(H)
     if not math.isfinite(H) or H <= 0:
         raise ValueError(f"H: {H!r} m; give a positive wave height")
@@ -139,9 +125,9 @@ def wec_alone_power(H, periods=None, *, heading_deg: float = 0.0, model=None, q0
         if not np.any(np.abs(((have - h + 180.0) % 360.0) - 180.0) < 1e-6):
             raise ValueError(f"heading_deg: {heading_deg!r} needs the lone WEC in heading {h:g}°, "
                              f"which the lone WEC's database does not hold (headings {np.round(have, 6).tolist()}°); add it to "
-                             f"headings_deg in tools/wu_yuan_configs.py and regenerate")
-        fr = mfm.frequency_response(model, omega, math.radians(h), q0=q0, radiation=radiation,
-                                    joint_reactions=False)
+                             f"WEC_HEADINGS in mfm/studies/wu_yuan_layout.py and regenerate")
+        fr = frequency_response(model, omega, math.radians(h), q0=q0, radiation=radiation,
+                                joint_reactions=False)
         power[h] = np.asarray(fr["pto_power"].sel(pto="wec.angle").values) * (H / 2.0) ** 2
     names = list(heads)
     data = np.stack([power[heads[n]] for n in names])

@@ -1,14 +1,20 @@
-"""Write configs/wu_yuan_m1.toml … wu_yuan_m5.toml: the Wu & Yuan semi-sub energy platform with 12
-hinged WECs (seed 004; GEOMETRY.md §4) at the five WEC spacings L = 2D … 3D of the seed's Table 4;
-configs/wu_yuan_m1_td.toml, model 1 with a band database for the time domain (K(t)); and
-configs/wu_yuan_wec.toml, one WEC alone hinged at a fixed point (P_s of the interaction factors).
+"""The Wu & Yuan semi-sub energy platform with 12 hinged WECs (seed 004; GEOMETRY.md §4): its layout
+and data, and the configs written from them: configs/wu_yuan_m1.toml … wu_yuan_m5.toml at the
+five WEC spacings L = 2D … 3D of the seed's Table 4; configs/wu_yuan_m1_td.toml, model 1 with a
+band database for the time domain (K(t)); and configs/wu_yuan_wec.toml, one WEC alone hinged at
+a fixed point (P_s of the interaction factors, :mod:`mfm.studies.wu_yuan`).
 
 The five files are identical except the spacing-dependent positions (WEC centres, hinge points,
 the model's name and its database); the loader has no way to share tables between configs, so
-this script is their single source (values tagged as docs/GEOMETRY.md §4). Run from the repository root:
+this module is their single source (values tagged as docs/GEOMETRY.md §4). From the repository
+root (the configs' headers name the command)::
 
     python tools/wu_yuan_configs.py          # (re)writes the configs
     python tools/wu_yuan_configs.py --check  # exits 1 if a config differs from what it would write
+
+(or ``python -m mfm.studies.wu_yuan_layout [--check]``, the same :func:`main`). Writing and
+checking need a checkout (configs/ is not installed with the package); the layout and the texts
+(:func:`wecs`, :func:`columns`, :func:`config_text`, :func:`wec_config_text`) do not.
 
 Layout (heading 0 = waves travelling to +x):
 - three columns at radius 47 m, column 1 (apex) on +x, columns 2 and 3 at ±120°;
@@ -27,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]      # the repository (configs/), in a checkout
 
 # ---- values (tags as GEOMETRY.md §4) -----------------------------------------------------------
 D_WEC = 8.0                 # m WEC diameter [S]
@@ -375,7 +381,8 @@ def config_text(m: int, td: bool = False, locked: bool = False) -> str:
     database ``wu_yuan_m<m>_td.nc``); ``locked``: the severe-sea variant (seed §4.3: every hinge
     locked, so no PTO damper and no preload: each WEC rigid on the platform at its design
     position, the platform carrying its excess weight). Not written to configs/ (the same hulls
-    and database as model m): tools/wu_yuan.py ``platform_model(m, locked=True)`` loads it."""
+    and database as model m): :func:`mfm.studies.wu_yuan.platform_model` ``(m, locked=True)``
+    loads it."""
     ld = SPACINGS[m - 1]
     L = ld * D_WEC
     cw, ww = clearances(L)
@@ -511,22 +518,27 @@ def wec_config_text(alpha_deg: float = 0.0, database: str = "../hydro/data/wu_yu
         preload=f"{PRELOAD:.1f}", alpha_note=note)
 
 
-def outputs() -> dict:
-    """{path: text} of every config this script writes."""
-    out = {ROOT / "configs" / f"wu_yuan_m{m}.toml": config_text(m) for m in range(1, 6)}
-    out.update({ROOT / "configs" / f"wu_yuan_m{m}_td.toml": config_text(m, td=True)
+def outputs(root=ROOT) -> dict:
+    """{path: text} of every config this module writes, under ``root`` (the repository)."""
+    root = Path(root)
+    out = {root / "configs" / f"wu_yuan_m{m}.toml": config_text(m) for m in range(1, 6)}
+    out.update({root / "configs" / f"wu_yuan_m{m}_td.toml": config_text(m, td=True)
                 for m in TD_MODELS})
-    out[ROOT / "configs" / "wu_yuan_wec.toml"] = wec_config_text()
+    out[root / "configs" / "wu_yuan_wec.toml"] = wec_config_text()
     return out
 
 
 def main(argv):
+    """Write the configs into configs/ (printing each path), or with ``--check`` in ``argv``
+    write nothing and print each config that differs from what it would write; returns the exit
+    status (1 if one differs)."""
     check = "--check" in argv
     bad = 0
     for path, text in outputs().items():
         if check:
             if not path.exists() or path.read_text() != text:
-                print(f"{path} differs from tools/wu_yuan_configs.py's output")
+                print(f"{path} differs from mfm.studies.wu_yuan_layout's output "
+                      "(python tools/wu_yuan_configs.py rewrites it)")
                 bad += 1
         else:
             path.write_text(text)
