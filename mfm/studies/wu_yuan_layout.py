@@ -528,13 +528,21 @@ def outputs(root=ROOT) -> dict:
     return out
 
 
-def main(argv):
-    """Write the configs into configs/ (printing each path), or with ``--check`` in ``argv``
-    write nothing and print each config that differs from what it would write; returns the exit
-    status (1 if one differs)."""
-    check = "--check" in argv
+def main(argv=None, root=ROOT):
+    """The command line: write the configs into ``root``/configs (printing each path), or with
+    ``--check`` write nothing and print each config that differs from what it would write;
+    returns the exit status (1 if one differs). ``root``: the repository (default this module's
+    checkout; tools/wu_yuan_configs.py passes its own)."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description="Write configs/wu_yuan_m1..m5.toml, wu_yuan_m1_td.toml "
+                                             "and wu_yuan_wec.toml (Wu & Yuan, seed 004) from "
+                                             "mfm.studies.wu_yuan_layout")
+    ap.add_argument("--check", action="store_true",
+                    help="write nothing; exit 1 if a config differs from what would be written")
+    check = ap.parse_args(argv).check
     bad = 0
-    for path, text in outputs().items():
+    for path, text in outputs(root).items():
         if check:
             if not path.exists() or path.read_text() != text:
                 print(f"{path} differs from mfm.studies.wu_yuan_layout's output "
