@@ -1,16 +1,21 @@
 """The speed–accuracy chart of the engine (issue 14 item 1): for three systems, every integrator ×
 time step, radiation models and fidelity levels, the error against a reference solution against
-the warm wall time, with the Pareto front.
+the warm wall time, with the Pareto front. The study (:func:`study`, a case at a time with
+:func:`run_case`, :func:`spectral_case`, :func:`linear_case`, measured by :func:`measures` and
+:func:`errors`), its figures and tables (:func:`figure`, :func:`table`, :func:`front_table`,
+:func:`cheapest`). Needs a checkout (the configs in configs/). The command line is
+tools/speed_accuracy.py:
 
-    PYTHONPATH=. python tools/speed_accuracy.py rm3          # 28 min on 2 shared cores (load 5–6)
-    PYTHONPATH=. python tools/speed_accuracy.py m4_134       # 44 min (10 of them the convolution)
-    PYTHONPATH=. python tools/speed_accuracy.py stansby_li   # ≈ 30 min
-    PYTHONPATH=. python tools/speed_accuracy.py figures      # the PNGs from the stored numbers
-    PYTHONPATH=. python tools/speed_accuracy.py stansby_li --slices integrators   # one slice
+    python tools/speed_accuracy.py rm3          # 28 min on 2 shared cores (load 5–6)
+    python tools/speed_accuracy.py m4_134       # 44 min (10 of them the convolution)
+    python tools/speed_accuracy.py stansby_li   # ≈ 30 min
+    python tools/speed_accuracy.py figures      # the PNGs from the stored numbers
+    python tools/speed_accuracy.py stansby_li --slices integrators   # one slice
 
 Each system's cases go to notebooks/figures/speed_accuracy/<system>.json as they finish (a rerun
 skips the cases already there: delete the file to start afresh), the figures to
-notebooks/figures/speed_accuracy/<system>.png. notebooks/speed_accuracy.ipynb reads them.
+notebooks/figures/speed_accuracy/<system>.png. notebooks/speed_accuracy.ipynb reads them and
+reruns a small live slice through the same functions.
 
 The grid (each distinct integrator, number of steps and radiation structure is a compilation of
 10–60 s, so the grid is a sum of three slices rather than a product):
@@ -22,11 +27,11 @@ The grid (each distinct integrator, number of steps and radiation structure is a
 - ``radiation``: at RK4, dt = T/100: the convolution with memory windows of a few periods (T, 3T,
   10T) and the full T_K (from the decay of K), and the state space integrated by RK4
   (``state_space``) at two or three orders and the default (``order="auto"``);
-- ``fidelity``: the levels of :mod:`mfm.fidelity` at dt = T/200: spectral (no time stepping;
-  statistics only, and the series on the run's grid), linear (:func:`mfm.linear_response`: the
-  linearised model with the state-space fit, its modes stepped exactly), fast (verlet,
-  ``state_space_exact``), full (rk4, ``radiation="auto"``). A level that refuses a system (an
-  error naming why) is recorded as ``"refused"`` with the message.
+- ``fidelity``: the levels of :mod:`mfm.studies.fidelity` at dt = T/200: spectral (no time
+  stepping; statistics only, and the series on the run's grid), linear
+  (:func:`mfm.linear_response`: the linearised model with the state-space fit, its modes stepped
+  exactly), fast (verlet, ``state_space_exact``), full (rk4, ``radiation="auto"``). A level that
+  refuses a system (an error naming why) is recorded as ``"refused"`` with the message.
 
 The reference: RK4 at dt = T/800 with the state space integrated by RK4 (``state_space``, the
 default fit). RK4 is the highest-order integrator; with the state space its radiation is
@@ -57,19 +62,23 @@ time it stopped.
 """
 from __future__ import annotations
 
-import importlib
 import json
 import math
 import statistics
-import sys
 import time
 import warnings
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-OUT = ROOT / "notebooks" / "figures" / "speed_accuracy"
+from .. import results
+from ..frequency import linear as _linear
+from ..frequency.spectral import spectral_response
+from ..io.build import load
+from ..timedomain.rollout import rollout
+from ..timedomain.setup import choose_radiation, model_loads
+
+ROOT = Path(__file__).resolve().parents[2]      # the repository (configs/), in a checkout
 
 INTEGRATORS = ("rk4", "beeman", "semi_implicit", "newmark", "verlet")
 STEPS_PER_PERIOD = (25, 50, 100, 200, 400)
@@ -120,18 +129,12 @@ SYSTEMS = {
 }
 
 
-def _sim():
-    return importlib.import_module("mfm.timedomain.simulation")
-
-
 def load_system(system, **overrides):
     """(model, sea, settings) of a system; ``overrides`` change the settings (a short run)."""
-    import mfm
-
     if system not in SYSTEMS:
         raise ValueError(f"system: {system!r}; accepted: {sorted(SYSTEMS)}")
     cfg = dict(SYSTEMS[system], **overrides)
-    model = mfm.load(ROOT / "configs" / cfg["config"])
+    model = load(ROOT / "configs" / cfg["config"])
     return model, _sea(system), cfg
 
 
@@ -160,7 +163,6 @@ def run_case(model, sea, cfg, *, integrator, n_per_T, radiation, option=None, ti
     ``first_s``, ``warm_s``, ``compile_s``, ``repeats``; series is (t, q, qd) or None."""
     import jax
 
-    sim = _sim()
     T = cfg["T"]
     dt = T / n_per_T
     duration = cfg["periods"] * T
@@ -168,16 +170,16 @@ def run_case(model, sea, cfg, *, integrator, n_per_T, radiation, option=None, ti
     save_every = n_per_T // SAVE_PER_PERIOD
     rad = radiation
     if radiation == "auto":
-        rad = sim.choose_radiation(model, dt=dt, n_steps=n_steps, integrator=integrator)[0]
+        rad = choose_radiation(model, dt=dt, n_steps=n_steps, integrator=integrator)[0]
     kw = _options(rad, option, T)
     q0 = np.zeros(model.n_coordinates)
 
     def go():
-        loads = sim.model_loads(model, sea, dt=dt, duration=duration, ramp=5 * T, radiation=rad,
-                                integrator=integrator, **kw)
-        return jax.block_until_ready(sim.rollout(model, q0, q0, dt=dt, n_steps=n_steps,
-                                                 integrator=integrator, loads=loads,
-                                                 save_every=save_every))
+        loads = model_loads(model, sea, dt=dt, duration=duration, ramp=5 * T, radiation=rad,
+                            integrator=integrator, **kw)
+        return jax.block_until_ready(rollout(model, q0, q0, dt=dt, n_steps=n_steps,
+                                             integrator=integrator, loads=loads,
+                                             save_every=save_every))
 
     rec = dict(integrator=integrator, n_per_T=n_per_T, radiation=radiation, option=option,
                radiation_used=rad, dt=dt, n_steps=n_steps)
@@ -206,19 +208,17 @@ def run_case(model, sea, cfg, *, integrator, n_per_T, radiation, option=None, ti
 def spectral_case(model, sea, cfg, t, time_it=True):
     """The spectral level (:func:`mfm.spectral_response`) on the time grid t, timed with the
     series and statistics only."""
-    import mfm
-
     rec = dict(integrator="spectral", n_per_T=None, radiation="database", option=None,
                radiation_used="database", status="ok")
     start = time.perf_counter()
-    ds = mfm.spectral_response(model, sea, t=t)
+    ds = spectral_response(model, sea, t=t)
     rec["first_s"] = time.perf_counter() - start
     if time_it:
         for name, kw in (("warm_s", dict(t=t)), ("stats_s", {})):
             times = []
             for _ in range(3):
                 s = time.perf_counter()
-                mfm.spectral_response(model, sea, **kw)
+                spectral_response(model, sea, **kw)
                 times.append(time.perf_counter() - s)
             rec[name] = statistics.median(times)
         rec.update(repeats=3, compile_s=max(rec["first_s"] - rec["warm_s"], 0.0))
@@ -233,9 +233,6 @@ def linear_case(model, sea, cfg, *, n_per_T, time_it=True):
     with that cache emptied (what a new dt or model adds: the eigendecomposition). A load the
     level cannot realise (NotImplementedError) or ill-conditioned modes (ValueError) give
     ``status = "refused"`` and the ``reason``."""
-    import mfm
-
-    lin = importlib.import_module("mfm.frequency.linear")
     T = cfg["T"]
     kw = dict(duration=cfg["periods"] * T, dt=T / n_per_T, ramp=5 * T,
               save_every=n_per_T // SAVE_PER_PERIOD)
@@ -243,7 +240,7 @@ def linear_case(model, sea, cfg, *, n_per_T, time_it=True):
                radiation_used="state_space", dt=kw["dt"], n_steps=int(round(kw["duration"] / kw["dt"])))
     start = time.perf_counter()
     try:
-        ds = mfm.linear_response(model, sea, **kw)
+        ds = _linear.linear_response(model, sea, **kw)
     except (NotImplementedError, ValueError) as err:
         rec.update(status="refused", reason=f"{type(err).__name__}: {err}",
                    first_s=time.perf_counter() - start)
@@ -254,13 +251,13 @@ def linear_case(model, sea, cfg, *, n_per_T, time_it=True):
         times = []
         while True:
             s = time.perf_counter()
-            mfm.linear_response(model, sea, **kw)
+            _linear.linear_response(model, sea, **kw)
             times.append(time.perf_counter() - s)
             if len(times) >= (3 if times[0] < 2 else 2 if times[0] < 5 else 1):
                 break
-        lin._MODES_CACHE.clear()
+        _linear._MODES_CACHE.clear()
         s = time.perf_counter()
-        mfm.linear_response(model, sea, **kw)
+        _linear.linear_response(model, sea, **kw)
         rec.update(warm_s=statistics.median(times), repeats=len(times),
                    modes_s=time.perf_counter() - s,
                    compile_s=max(rec["first_s"] - statistics.median(times), 0.0))
@@ -321,8 +318,6 @@ def study(system, *, path=None, slices=None, cases=None, reference=None, time_it
     settings (e.g. a short smoke run); ``time_it`` False runs each case once, untimed; ``path``
     None writes nothing."""
     reference = dict(REFERENCE if reference is None else reference)
-    import mfm
-
     warnings.simplefilter("ignore")
     model, sea, cfg = load_system(system, **overrides)
     data = dict(system=system, settings=dict(cfg, reference=_key(reference)), sea=repr(sea),
@@ -336,12 +331,12 @@ def study(system, *, path=None, slices=None, cases=None, reference=None, time_it
     model.hydro.state_space()          # the default fit, cached, outside every timing
     data.setdefault("fit_s", time.perf_counter() - fit_start)
     data["memory_T_K_s"] = model.hydro.memory()
-    data["mfm_version"] = getattr(mfm, "__version__", "")
+    data["mfm_version"] = results.version()
     cache = {}
 
     def series_of(case, time_it=time_it):
         if case["radiation"] == "auto":    # the strategy auto takes: the same run as that case's
-            case = dict(case, radiation=_sim().choose_radiation(
+            case = dict(case, radiation=choose_radiation(
                 model, dt=cfg["T"] / case["n_per_T"], n_steps=cfg["periods"] * case["n_per_T"],
                 integrator=case["integrator"])[0])
         k = _key(case)
@@ -544,31 +539,3 @@ def front_table(data, metric):
     lines += [f"| {label(ok[i])} | {ok[i]['warm_s']:.3g} | {ok[i]['errors'][metric]:.2e} |"
               for i in front]
     return "\n".join(lines)
-
-
-def main(argv):
-    if not argv or argv[0] not in tuple(SYSTEMS) + ("figures",):
-        print(__doc__)
-        return 2
-    OUT.mkdir(parents=True, exist_ok=True)
-    if argv[0] == "figures":
-        import matplotlib
-        matplotlib.use("Agg")
-        for system in SYSTEMS:
-            p = OUT / f"{system}.json"
-            if p.exists():
-                figure(json.loads(p.read_text()), OUT / f"{system}.png")
-                print("wrote", OUT / f"{system}.png")
-        return 0
-    slices = None
-    if "--slices" in argv:       # e.g. --slices integrators,radiation: only these (and the reference)
-        slices = tuple(argv[argv.index("--slices") + 1].split(","))
-    start = time.perf_counter()
-    study(argv[0], path=OUT / f"{argv[0]}.json", slices=slices, log=lambda s: print(s, flush=True))
-    print(f"{argv[0]}: {time.perf_counter() - start:.0f} s")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.path.insert(0, str(ROOT))
-    sys.exit(main(sys.argv[1:]))
