@@ -6,6 +6,9 @@ scene's outputs against the full model with default options, at the levels where
     PYTHONPATH=. python tools/fidelity_options.py stansby_li   # 20 min
     PYTHONPATH=. python tools/fidelity_options.py table        # the markdown tables from the JSON
 
+(from the repository root; the script does not touch sys.path: ``PYTHONPATH=.`` runs this
+checkout's mfm, or leave it out with mfm installed from here).
+
 Each system's rows go to notebooks/figures/fidelity_options/<system>.json as they finish (a rerun
 skips the rows already there; delete the file to start afresh).
 
@@ -58,7 +61,6 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 OUT = ROOT / "notebooks" / "figures" / "fidelity_options"
 
 PILOT = dict(pilot_periods=40.0, settle_periods=15.0, steps_per_period=200)
