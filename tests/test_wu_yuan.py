@@ -14,7 +14,7 @@
   arm in heading 0 is the row-3 arm in the turned-back wave (mfm.studies.wu_yuan's P_s per WEC).
 - The band database of the time domain (wu_yuan_m1_td.nc) against wu_yuan_m1.nc at the seed's
   periods. The time domain against the frequency domain of model 1 is measured in
-  benchmarks/wu_yuan_td_fd.py (minutes: the 90-dof radiation fit and the compilations; numbers in
+  tools/wu_yuan_td_fd.py (minutes: the 90-dof radiation fit and the compilations; numbers in
   benchmarks/RESULTS.md); the linearised lines it uses are tested in tests/test_catenary.py.
 
 Measured: H 388.9 kN, T 611.8 kN per line, six vertical loads 288.8 t; columns ρV 1.64108e7 kg

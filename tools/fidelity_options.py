@@ -68,7 +68,7 @@ COMPONENTS = (50, 100)
 FINE_COMPONENTS = 1600
 
 SYSTEMS = {
-    # benchmarks/fidelity.py's sea (Hs 0.04 m: motions of a few degrees)
+    # tools/fidelity.py's sea (Hs 0.04 m: motions of a few degrees)
     "m4_134": dict(config="m4_134.toml", T=1.2, other_root="free",
                    sea=dict(hs=0.04, tp=1.2, gamma=3.3, seed=1, omega_range=(1.0, 25.0)),
                    coordinates=("float3.angle", "float7.angle", "float6.angle", "float8.angle"),

@@ -100,7 +100,7 @@ FIDELITY_AT = 200              # mfm.reduce's pilot: dt = T/200
 def _sea(system):
     import hydro
 
-    if system == "m4_134":      # benchmarks/speed.py and fidelity.py
+    if system == "m4_134":      # benchmarks/speed.py and tools/fidelity.py
         return hydro.Jonswap(hs=0.04, tp=1.2, gamma=3.3, seed=1, omega_range=(1.0, 25.0))
     if system == "rm3":         # the README's RM3 case
         return hydro.Regular(height=2.5, period=8.0)
