@@ -217,8 +217,10 @@ def child_defaults():
 
 
 def run_child(tree, what, new, repeats, batch, cache="off"):
-    # cache: a folder for the child's compiled programs (MFM_COMPILATION_CACHE) and radiation fits
-    # (MFM_FIT_CACHE, a subfolder), or "off": every compilation and fit timed, none loaded
+    # a fresh process of this script on the code of ``tree``: PYTHONPATH puts that tree before any
+    # installed mfm (the child does not touch sys.path). cache: a folder for the child's compiled
+    # programs (MFM_COMPILATION_CACHE) and radiation fits (MFM_FIT_CACHE, a subfolder), or "off":
+    # every compilation and fit timed, none loaded
     env = dict(os.environ, PYTHONPATH=str(tree), OMP_NUM_THREADS="1", MFM_COMPILATION_CACHE=cache,
                MFM_FIT_CACHE=cache if cache == "off" else str(Path(cache) / "fits"))
     cmd = [sys.executable, str(Path(__file__).resolve()), "--child", what, "--repeats", str(repeats)]
@@ -340,8 +342,8 @@ def main():
     ap.add_argument("--batch", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
+        # the tree timed comes first on the path through the PYTHONPATH run_child set
         warnings.simplefilter("ignore")
-        sys.path.insert(0, os.environ["PYTHONPATH"])
         res = (child_m4(args.new, args.repeats, args.batch) if args.child == "m4"
                else child_defaults() if args.child == "defaults"
                else child_rm3(args.new, args.repeats))

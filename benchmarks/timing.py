@@ -1,4 +1,6 @@
-"""Shared timing helper of the benchmark scripts."""
+"""Shared timing helper of the benchmark scripts in this folder: they import it as ``timing``
+(``from timing import first_and_warm``), which needs no sys.path edit because
+``python benchmarks/<script>.py`` puts the script's own folder first on sys.path."""
 import statistics
 import time
 

@@ -11,7 +11,6 @@ topology are five compilations (issue 13).
 """
 import argparse
 import os
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -19,24 +18,23 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tools"))
 
 os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
 os.environ.setdefault("MFM_FIT_CACHE", "off")          # fit times measured, not read from disk (hydro.fitcache)
-from timing import first_and_warm  # noqa: E402
+from timing import first_and_warm  # noqa: E402  (benchmarks/timing.py, beside this script)
 
 
 def main(argv=None) -> int:
     import mfm
-    import wu_yuan_study
     from hydro.database import HydroDatabaseWarning
+    from mfm.studies.wu_yuan import seed_periods
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--models", type=int, nargs="+", default=[1, 2, 3, 4, 5])
     ap.add_argument("--repeats", type=int, default=5)
     args = ap.parse_args(argv)
     warnings.simplefilter("ignore", HydroDatabaseWarning)
-    w = 2 * np.pi / wu_yuan_study.seed_periods()
+    w = 2 * np.pi / seed_periods()
     rows = []
     for k in args.models:
         t0 = time.perf_counter()

@@ -600,23 +600,19 @@ def test_six_dof_stiffness_against_moorpy_finite_difference(wy_platform, pose):
 
 def test_moordyn_slow_limit_is_the_quasi_static_line(lines):
     # MoorDyn's lumped-mass line (the seed's eq. 28; the optional `moordyn` package), written by
-    # tools/moordyn_check.py's input writer, with its fairlead moved slowly (8 m away from the
+    # mfm.io.moordyn's input writer (as tools/moordyn_check.py uses it: Table 2's diameter, a
+    # studless chain's coefficients), with its fairlead moved slowly (8 m away from the
     # anchor and 4 m up and back over 200 s, speeds ≤ 0.13 m/s, from rest): its fairlead tension
     # is the engine's quasi-static table along the same path within 3 % of the local tension
     # (measured 1.3 %: 40 segments of 20 m, 3.4 % with 20, 1.0 % with 80, the rest the drag at
     # these speeds, 2.6 % over 100 s). So the large dynamic tensions tools/moordyn_check.py finds
     # in the severe sea are the lines' dynamics, not a different line. ~15 s.
     moordyn = pytest.importorskip("moordyn")
-    import importlib.util
     import tempfile
 
-    from conftest import ROOT
-
-    spec = importlib.util.spec_from_file_location("moordyn_check", ROOT / "tools" / "moordyn_check.py")
-    tool = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(tool)
     import jax
 
+    from mfm.io.moordyn import CHAIN, moordyn_input
     from mfm.loads.catenary import interpolate
 
     _, ld = lines
@@ -626,7 +622,8 @@ def test_moordyn_slow_limit_is_the_quasi_static_line(lines):
     work = tempfile.mkdtemp(prefix="moordyn_")
     path = f"{work}/line.txt"
     with open(path, "w") as f:
-        f.write(tool.moordyn_input([an], [fl], L, EA, W, RHO, G, 60.0, 40, 1.0, 0.005))
+        f.write(moordyn_input([an], [fl], L, EA, W, RHO, G, 60.0, 40, 1.0, 0.005, diameter=0.12,
+                              coefficients=CHAIN))
     md = moordyn.Create(path)
     assert moordyn.Init(md, fl.tolist(), [0.0] * 3) == 0
     away = np.r_[(fl - an)[:2] / np.hypot(*(fl - an)[:2]), 0.0]

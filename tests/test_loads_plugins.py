@@ -92,6 +92,49 @@ def test_import_graph_has_no_cycle_and_hydro_never_imports_mfm():
             visit(m, [])
 
 
+def _is_sys_path(node) -> bool:
+    return (isinstance(node, ast.Attribute) and node.attr == "path"
+            and isinstance(node.value, ast.Name) and node.value.id == "sys")
+
+
+def _path_edits(source: str) -> list[str]:
+    """The ways ``source`` reaches past the installed package: sys.path edited (insert, append,
+    extend, assigned) or a module loaded from a file (importlib's spec_from_file_location)."""
+    out = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Attribute) and node.attr == "spec_from_file_location":
+            out.append("spec_from_file_location")
+        elif (isinstance(node, ast.Attribute) and node.attr in ("insert", "append", "extend")
+              and _is_sys_path(node.value)):
+            out.append(f"sys.path.{node.attr}")
+        elif isinstance(node, (ast.Assign, ast.AugAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            if any(_is_sys_path(t.value if isinstance(t, ast.Subscript) else t) for t in targets):
+                out.append("sys.path assigned")
+    return out
+
+
+def test_tests_notebooks_and_scripts_reach_no_script_by_path():
+    # tests and notebooks import the package, never tools/ or benchmarks/; the scripts there run
+    # with mfm installed and never edit sys.path (README, Architecture)
+    import json
+
+    sources = {p: p.read_text() for d in ("tools", "benchmarks", "tests")
+               for p in sorted((ROOT / d).glob("*.py"))}
+    for p in sorted((ROOT / "notebooks").glob("*.ipynb")):
+        code = "\n".join("".join(c["source"]) for c in json.loads(p.read_text())["cells"]
+                         if c["cell_type"] == "code")
+        sources[p] = "\n".join(line for line in code.splitlines()
+                               if not line.lstrip().startswith(("%", "!")))     # IPython magics
+    assert len(sources) > 40
+    bad = {str(p.relative_to(ROOT)): e for p, s in sources.items() if (e := _path_edits(s))}
+    assert not bad, bad
+    # the check sees what it looks for
+    assert _path_edits("import sys\nsys.path.insert(0, 'tools')") == ["sys.path.insert"]
+    assert _path_edits("import sys\nsys.path[:0] = ['tools']") == ["sys.path assigned"]
+    assert _path_edits("import importlib.util as u\nu.spec_from_file_location('a', 'tools/a.py')")
+
+
 def test_a_load_imports_only_the_mechanics_and_the_load_protocol():
     # the loads sit on the mechanics: what needs more (the model's linearisation for a damping
     # ratio, lines linearised about the equilibrium, datasets) is done above them (mfm.frequency,

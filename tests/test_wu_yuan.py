@@ -1,5 +1,5 @@
 """The semi-sub energy platform with 12 hinged WECs (Wu & Yuan, seed 004): configs/wu_yuan_m1–m5.toml
-(written by tools/wu_yuan_configs.py) against hand checks from the seed's Tables 1–4 and GEOMETRY §4.
+(written by mfm/studies/wu_yuan_layout.py) against hand checks from the seed's Tables 1–4 and GEOMETRY §4.
 
 - The five configs load, are what the generator writes, and differ only in the spacing.
 - Layout: per model the WECs of each row are spaced by L = 2D … 3D along the row; rows 1 and 2
@@ -11,10 +11,10 @@
 - The static equilibrium with the hinge preloads holds every WEC at its stated 2 m draft.
 - The WEC alone (configs/wu_yuan_wec.toml, P_s of eqs. 31–33): its hinge RAO and power from
   mfm.frequency_response against the 1-dof equation assembled by hand from its database; a turned
-  arm in heading 0 is the row-3 arm in the turned-back wave (tools/wu_yuan.py's P_s per WEC).
+  arm in heading 0 is the row-3 arm in the turned-back wave (mfm.studies.wu_yuan's P_s per WEC).
 - The band database of the time domain (wu_yuan_m1_td.nc) against wu_yuan_m1.nc at the seed's
   periods. The time domain against the frequency domain of model 1 is measured in
-  benchmarks/wu_yuan_td_fd.py (minutes: the 90-dof radiation fit and the compilations; numbers in
+  tools/wu_yuan_td_fd.py (minutes: the 90-dof radiation fit and the compilations; numbers in
   benchmarks/RESULTS.md); the linearised lines it uses are tested in tests/test_catenary.py.
 
 Measured: H 388.9 kN, T 611.8 kN per line, six vertical loads 288.8 t; columns ρV 1.64108e7 kg
@@ -27,7 +27,6 @@ shared machine under load). The band database (item below): 0.1 s.
 """
 from __future__ import annotations
 
-import importlib.util
 import math
 
 import jax.numpy as jnp
@@ -37,6 +36,7 @@ from conftest import CONFIGS, ROOT
 
 import mfm
 from mfm.loads import CatenaryLines
+from mfm.studies import wu_yuan_layout as layout
 
 pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 
@@ -46,13 +46,6 @@ ARM, Z_HINGE = 9.72, 5.44
 M_PLATFORM, DISPLACEMENT = 1.61e7, 1.64e7          # Table 1 [S]
 M_WEC = 1.1136e5                                   # Table 3 [S]
 ROWS = {1: range(1, 5), 2: range(5, 9), 3: range(9, 13)}
-
-
-def generator():
-    spec = importlib.util.spec_from_file_location("wu_yuan_configs", ROOT / "tools" / "wu_yuan_configs.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
 
 
 def rot(deg):
@@ -67,7 +60,7 @@ def mechanics():
 
 
 def test_configs_are_the_generators_and_differ_only_in_the_spacing():
-    assert generator().main(["--check"]) == 0
+    assert layout.main(["--check"]) == 0
     texts = [(CONFIGS / f"wu_yuan_m{m}.toml").read_text().splitlines() for m in SPACING]
     assert len({len(t) for t in texts}) == 1
     differ = {i for t in texts[1:] for i, (a, b) in enumerate(zip(texts[0], t)) if a != b}
@@ -78,15 +71,14 @@ def test_configs_are_the_generators_and_differ_only_in_the_spacing():
 
 
 def test_locked_variant_is_model_m_with_rigid_hinges(tmp_path):
-    """The severe-sea variant (tools/wu_yuan_configs.py config_text(m, locked=True)): the same
+    """The severe-sea variant (mfm.studies.wu_yuan_layout.config_text(m, locked=True)): the same
     bodies, hulls, lines and database as model m, every hinge locked (no coordinate, no PTO
     damper, no preload): 6 coordinates. Parsed only (the water and the lines are model m's)."""
     from mfm.io.config import load_config
 
-    gen = generator()
     for m in (1, 5):
-        text = gen.config_text(m, locked=True)
-        plain = gen.config_text(m)
+        text = layout.config_text(m, locked=True)
+        plain = layout.config_text(m)
         assert text.count("\nlocked = true") == 12 and "\n[[joint_loads]]" not in text
         assert plain.count("\ndamping = 4.1e7") == 12 and "\nlocked = true" not in plain
         path = tmp_path / f"m{m}_locked.toml"
@@ -97,7 +89,7 @@ def test_locked_variant_is_model_m_with_rigid_hinges(tmp_path):
         assert options["hydro"]["database"] == f"../hydro/data/wu_yuan_m{m}.nc"
         # everything but the joints, the preloads and the name is model m's, character for character
         a, b = plain.index("\n# ---- hinge preloads"), plain.index("\n# ---- catenary moorings")
-        expected = gen.LOCKED_NOTE + (plain[:a] + plain[b:]).replace(
+        expected = layout.LOCKED_NOTE + (plain[:a] + plain[b:]).replace(
             "damping = 4.1e7                      # N m s/rad, the PTO [S]",
             "locked = true                        # severe sea: the hinge locked [S]").replace(
             f'name = "Wu-Yuan model {m}"', f'name = "Wu-Yuan model {m}, hinges locked"')
@@ -244,13 +236,6 @@ def test_equilibrium_holds_every_wec_at_its_draft(model1):
 # ---- the WEC alone (P_s of eqs. 31–33) ------------------------------------------------------------
 
 
-def _tools_module(name):
-    spec = importlib.util.spec_from_file_location(name, ROOT / "tools" / f"{name}.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
 @pytest.fixture(scope="module")
 def lone_wec():
     path = ROOT / "hydro" / "data" / "wu_yuan_wec.nc"
@@ -310,15 +295,15 @@ def test_turned_arm_is_the_turned_wave_and_the_power_per_wec(lone_wec, tmp_path)
     """A WEC whose arm is turned by α = +120° (row 1's) in heading 0 absorbs what the row-3 WEC
     (arm along x) absorbs in heading −120°: the model of the turned arm (hinge point, axis and
     inertia turned; the same axisymmetric hull at the origin, so the same database) against
-    tools/wu_yuan.py's P_s of WEC 1. And P_s per WEC: rows 1 and 2 equal (mirror images about
+    mfm.studies.wu_yuan's P_s of WEC 1. And P_s per WEC: rows 1 and 2 equal (mirror images about
     the row-3 arm's vertical plane), row 3 apart."""
     model, q0 = lone_wec
-    gen = generator()
+    from mfm.studies import wu_yuan as wy
+
     database = (ROOT / "hydro" / "data" / "wu_yuan_wec.nc").as_posix()
     cfg = tmp_path / "wec_turned.toml"
-    cfg.write_text(gen.wec_config_text(120.0, database=database))
+    cfg.write_text(layout.wec_config_text(120.0, database=database))
     turned = mfm.load(cfg)
-    wy = _tools_module("wu_yuan")
     assert wy.lone_headings() == {**{f"wec{k}": -120.0 for k in range(1, 5)},
                                   **{f"wec{k}": 120.0 for k in range(5, 9)},
                                   **{f"wec{k}": 0.0 for k in range(9, 13)}}

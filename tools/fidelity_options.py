@@ -6,6 +6,9 @@ scene's outputs against the full model with default options, at the levels where
     PYTHONPATH=. python tools/fidelity_options.py stansby_li   # 20 min
     PYTHONPATH=. python tools/fidelity_options.py table        # the markdown tables from the JSON
 
+(from the repository root; the script does not touch sys.path: ``PYTHONPATH=.`` runs this
+checkout's mfm, or leave it out with mfm installed from here).
+
 Each system's rows go to notebooks/figures/fidelity_options/<system>.json as they finish (a rerun
 skips the rows already there; delete the file to start afresh).
 
@@ -58,7 +61,6 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 OUT = ROOT / "notebooks" / "figures" / "fidelity_options"
 
 PILOT = dict(pilot_periods=40.0, settle_periods=15.0, steps_per_period=200)
@@ -66,7 +68,7 @@ COMPONENTS = (50, 100)
 FINE_COMPONENTS = 1600
 
 SYSTEMS = {
-    # benchmarks/fidelity.py's sea (Hs 0.04 m: motions of a few degrees)
+    # tools/fidelity.py's sea (Hs 0.04 m: motions of a few degrees)
     "m4_134": dict(config="m4_134.toml", T=1.2, other_root="free",
                    sea=dict(hs=0.04, tp=1.2, gamma=3.3, seed=1, omega_range=(1.0, 25.0)),
                    coordinates=("float3.angle", "float7.angle", "float6.angle", "float8.angle"),

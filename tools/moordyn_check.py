@@ -37,8 +37,9 @@ Also, ``--equilibrium`` prints the platform's static equilibrium pose of the con
 free, with their preloads): the pose at which tests/test_catenary.py checks the lines' 6 × 6
 stiffness.
 
-Needs the optional ``moordyn`` package (``pip install -e .[moordyn]``) and the model's hydro
-database. Usage::
+The MoorDyn input file is written by mfm.io.moordyn. Needs the optional ``moordyn`` package
+(``pip install -e .[moordyn]``), mfm installed (it does not touch sys.path) and the model's hydro
+database. Usage, from the repository root::
 
     python tools/moordyn_check.py [--model 1] [--wave 8.1 11.4] [--variants "40,1;80,1;40,2"]
     python tools/moordyn_check.py --equilibrium
@@ -60,11 +61,11 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 
 H_WAVE, T_WAVE = 8.1, 11.4            # m, s: the seed's severe sea [S]
 D_LINE = 0.12                         # m [S]
-CHAIN = {"Cd": 2.4, "CdAx": 1.15, "Ca": 1.0, "CaAx": 0.5}   # studless chain [A]
+CHAIN = {"Cd": 2.4, "CdAx": 1.15, "Ca": 1.0, "CaAx": 0.5}   # studless chain [A] (mfm.io.moordyn.CHAIN)
+TITLE = "Wu & Yuan (seed 004) six catenary lines, written by tools/moordyn_check.py"
 
 
 def locked_config(m: int) -> str:
@@ -82,44 +83,12 @@ def locked_config(m: int) -> str:
 
 
 def moordyn_input(anchors, fairleads, length, EA, weight, rho, g, depth, segments, drag, dtM):
-    """A MoorDyn v2 input file: one line type, fixed anchors, coupled fairleads."""
-    mass = weight / g + rho * math.pi * D_LINE ** 2 / 4          # kg/m in air: the wet weight kept
-    pts, lines = [], []
-    for k, (a, f) in enumerate(zip(anchors, fairleads)):
-        pts.append(f"{2 * k + 1} Fixed {a[0]:.9f} {a[1]:.9f} {a[2]:.9f} 0 0 0 0")
-        pts.append(f"{2 * k + 2} Coupled {f[0]:.9f} {f[1]:.9f} {f[2]:.9f} 0 0 0 0")
-        lines.append(f"{k + 1} chain {2 * k + 1} {2 * k + 2} {length:.6f} {segments} -")
-    return f"""--------------------- MoorDyn Input File ------------------------------------
-Wu & Yuan (seed 004) six catenary lines, written by tools/moordyn_check.py
----------------------- LINE TYPES ----------------------------------------------------------------
-TypeName   Diam    Mass/m     EA     BA/-zeta    EI         Cd     Ca     CdAx    CaAx
-(name)     (m)     (kg/m)     (N)    (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
-chain {D_LINE} {mass:.6f} {EA:.6e} -0.8 0 {CHAIN['Cd'] * drag} {CHAIN['Ca']} {CHAIN['CdAx'] * drag} {CHAIN['CaAx']}
----------------------- POINTS ---------------------------------------
-ID   Attachment  X       Y     Z      Mass   Volume  CdA    Ca
-(#)   (word/ID) (m)     (m)   (m)    (kg)   (m^3)   (m^2)  (-)
-{chr(10).join(pts)}
----------------------- LINES ----------------------------------------
-ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
-(#)   (name)     (ID)     (ID)      (m)       (-)      (-)
-{chr(10).join(lines)}
----------------------- OPTIONS -----------------------------------------
-0             writeLog
-1             disableOutput
-1             disableOutTime
-{dtM}         dtM
-3.0e6         kbot
-3.0e5         cbot
-{depth}       WtrDpth
-{rho}         rho
-{g}           g
-1             ICgenDynamic
-1.0           dtIC
-300           TmaxIC
-1e-5          threshIC
----------------------- OUTPUTS -----------------------------------------
-------------------------- need this line -------------------------------------
-"""
+    """A MoorDyn v2 input file of the Wu & Yuan lines (mfm.io.moordyn, with Table 2's diameter
+    and the studless chain's coefficients): one line type, fixed anchors, coupled fairleads."""
+    from mfm.io.moordyn import moordyn_input as write
+
+    return write(anchors, fairleads, length, EA, weight, rho, g, depth, segments, drag, dtM,
+                 diameter=D_LINE, coefficients=CHAIN, title=TITLE)
 
 
 @contextlib.contextmanager

@@ -1,18 +1,21 @@
 """The fidelity ladder on M4 134 (issue 14): the spectral level (mfm.spectral_response) and the
-linearised time domain (mfm.linear_response) against the time domain in the JONSWAP sea of benchmarks/speed.py (Hs 0.04 m, Tp 1.2 s, γ 3.3, 100 Tp at
-Tp/200), each level's warm wall time (median of 3) and its error in the mean PTO power and the
-hinge angles' standard deviations against RK4 (radiation "auto") over the settled part (after 20 Tp).
+linearised time domain (mfm.linear_response) against the time domain in the JONSWAP sea of
+benchmarks/speed.py (Hs 0.04 m, Tp 1.2 s, γ 3.3, 100 Tp at Tp/200), each level's warm wall time
+(median of 3) and its error in the mean PTO power and the hinge angles' standard deviations
+against RK4 (radiation "auto") over the settled part (after 20 Tp). Not a test; numbers in
+benchmarks/RESULTS.md ("The fidelity ladder on M4 134"). From the repository root, with mfm
+installed (the script does not touch sys.path):
 
-    python benchmarks/fidelity.py            # about 3 minutes on 2 shared cores
+    python tools/fidelity.py            # about 3 minutes on 2 shared cores
 
 The spectral level is timed twice: statistics only (no time series), and synthesising q, q̇ and the
 PTO power on the run's time grid (what is compared here). The linear level's warm time reuses its
 modes (cached per model and dt, as the state-space fit is per model); its cold first call (the fit,
 the eigendecomposition of the 1,021-state system, compilation) is printed too.
 """
+import argparse
 import os
 import statistics
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -20,7 +23,6 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 
 os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
 os.environ.setdefault("MFM_FIT_CACHE", "off")          # fit times measured, not read from disk (hydro.fitcache)
@@ -85,4 +87,7 @@ def main():
 
 
 if __name__ == "__main__":
+    # no options: --help prints what the script does instead of running it
+    argparse.ArgumentParser(description=__doc__,
+                            formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

@@ -1,13 +1,14 @@
 """Time domain against the frequency domain of the same model: a table of errors (not a test;
 tests/test_water.py asserts the 0.5 % bounds).
 
-    python benchmarks/validate_td_fd.py
+    python tools/validate_td_fd.py
 
 For RM3 (regular wave H 0.2 m, T 8 s) coupled and uncoupled, with convolution and with state space,
 and the sphere (H 0.05 m, T 3 s): the complex amplitude of each coordinate over the last 10 periods
 of a 60-period run at dt = T/100, against frequency_response with the same radiation model and with
 the raw database A(ω), B(ω). Prints |x_TD/x_FD − 1|.
 """
+import argparse
 import math
 import os
 import warnings
@@ -62,4 +63,7 @@ def main():
 
 
 if __name__ == "__main__":
+    # no options: --help prints what the script does instead of running it
+    argparse.ArgumentParser(description=__doc__,
+                            formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

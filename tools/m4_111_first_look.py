@@ -1,11 +1,12 @@
 """First look at M4 111 with water: figures for the issue notes (not a test).
 
-    python benchmarks/m4_111_first_look.py
+    python tools/m4_111_first_look.py
 
 Prints the natural periods (eigenproblem and min |det Λ|), θ_rms and mean PTO power in JONSWAP
 Hs 0.04 m, Tp 1.2 s, γ 3.3 (100 Tp at Tp/200, means over the last 50 Tp), and the seed 001 scheme
 (A∞ on the right-hand side, Beeman's corrector to 1 %) against ours on JONSWAP Hs 0.04, Tp 1 s, γ 1.
 """
+import argparse
 import os
 import time
 import warnings
@@ -53,4 +54,7 @@ def main():
 
 
 if __name__ == "__main__":
+    # no options: --help prints what the script does instead of running it
+    argparse.ArgumentParser(description=__doc__,
+                            formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

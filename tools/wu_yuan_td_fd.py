@@ -1,7 +1,7 @@
 """Wu & Yuan model 1 (configs/wu_yuan_m1_td.toml, the band database hydro/data/wu_yuan_m1_td.nc):
 the time domain against the frequency domain, the catenary lines' nonlinearity, and the cost.
 
-    OMP_NUM_THREADS=1 python benchmarks/wu_yuan_td_fd.py [--repeats 2] [--skip-database]
+    OMP_NUM_THREADS=1 python tools/wu_yuan_td_fd.py [--repeats 2] [--skip-database]
         [--skip-tdfd] [--skip-nonlinear] [--skip-timing] [--ss "dict(order=12, ...)"]
         [--fit-ladder "dict(order=24, enforce_passivity=False)" ...] [--save runs.npz]
 
@@ -17,7 +17,7 @@ it in 60 iterations), RK4. About 17 min and 5.1 GB on the shared 2-core machine.
    frequency response with the fit's A, B against the database's at the three periods;
 3. regular waves H 0.5 m at T = 6, 8.3, 11.4 s, heading 0, one simulate_batch (dt = T/100,
    60 periods, ramp 5 T, from the static equilibrium), the lines linearised about it in both
-   domains (mfm.loads.catenary.linearise_lines): the complex amplitude of each hinge angle and of
+   domains (mfm.frequency.rest.linearise_lines): the complex amplitude of each hinge angle and of
    the platform's surge, heave and pitch over the last 10 periods (least squares with free terms
    for the natural modes still alive there, :func:`alive`, mfm.studies.wec.harmonic_amplitude) and each
    PTO's mean power there, against mfm.frequency_response(..., radiation="state_space") with the
@@ -29,11 +29,13 @@ it in 60 iterations), RK4. About 17 min and 5.1 GB on the shared 2-core machine.
 5. one regular-wave run of 600 s at dt = T/100 (T = 8.3 s, H 3.8 m, nonlinear lines):
    mfm.simulate, first and warm (median of --repeats), and the pure rollout.
 
-Numbers and the command are recorded in benchmarks/RESULTS.md.
+Numbers and the command (then benchmarks/wu_yuan_td_fd.py) are recorded in benchmarks/RESULTS.md.
+From the repository root, with mfm installed (the script does not touch sys.path).
 """
 import argparse
 import math
 import os
+import statistics
 import time
 import warnings
 from pathlib import Path
@@ -45,15 +47,28 @@ os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured,
 os.environ.setdefault("MFM_FIT_CACHE", "off")          # fit times measured, not read from disk (hydro.fitcache)
 import hydro
 import mfm
-from mfm.loads.catenary import linearise_lines
+from mfm.frequency.rest import linearise_lines
 from mfm.timedomain.setup import model_loads
-from timing import first_and_warm
 
 warnings.simplefilter("ignore", hydro.database.HydroDatabaseWarning)
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = ROOT / "configs" / "wu_yuan_m1_td.toml"
 PERIODS = (6.0, 8.3, 11.4)
 COMPARED = ["platform.surge", "platform.heave", "platform.pitch"] + [f"wec{k}.angle" for k in range(1, 13)]
+
+
+def first_and_warm(fn, repeats):
+    """(wall time of the first call — compilation included —, median of ``repeats`` warm calls;
+    nan when repeats is 0): benchmarks/timing.py's, kept here so that the script runs alone."""
+    t0 = time.perf_counter()
+    fn()
+    first = time.perf_counter() - t0
+    ts = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        ts.append(time.perf_counter() - t0)
+    return first, statistics.median(ts) if repeats > 0 else float("nan")
 
 
 def lap(t0, what):
