@@ -46,7 +46,6 @@ import xarray as xr
 
 from hydro.database import HydroDatabaseWarning, read_netcdf
 
-from ..frequency.modes import resolve_damping_ratios
 from ..frequency.response import frequency_response
 from ..io.build import load
 from ..loads.body_matrix import LinearBodyMatrix
@@ -212,11 +211,9 @@ def fd_study(models=(1, 2, 3, 4, 5), periods=None, H: float = H_AVERAGE, *,
             loads = []
             if platform_damping:
                 z = float(platform_damping)
-                # the fractions of critical set from the model's linearisation (as mfm.load does
-                # for a [[body_matrices]] table)
-                loads = [resolve_damping_ratios(model, LinearBodyMatrix.create(
-                    model, "platform", name="platform_viscous",
-                    damping_ratio={"heave": z, "roll": z, "pitch": z}))]
+                # the fractions of critical, set from the model's linearisation by create
+                loads = [LinearBodyMatrix.create(model, "platform", name="platform_viscous",
+                                                 damping_ratio={"heave": z, "roll": z, "pitch": z})]
             fr = frequency_response(model, w, 0.0, loads=loads, joint_reactions=False)
         wec = [p.split(".")[0] for p in fr.pto.values]
         P = xr.DataArray(fr.pto_power.values * a2, dims=("period", "wec"), coords={"period": T, "wec": wec})
