@@ -6,6 +6,7 @@ import jax.numpy as jnp
 import numpy as np
 from conftest import CONFIGS
 
+import hydro
 from hydro.prepare import HydroSpec
 import mfm
 from mfm.timedomain.rollout import TRACES
@@ -66,8 +67,9 @@ def test_gradient_wrt_pto_damping_matches_finite_difference():
 
 
 def test_the_same_config_loaded_twice_compiles_once():
-    # the HydroSpec rides on the model as static metadata (part of the compiled function's key):
-    # compared by content, a second load of the config reuses the first one's compilation
+    # a second load of the config reuses the first one's compilation (the solvers are handed the
+    # model without its HydroSpec: test_models_differing_only_in_numbers_share_one_compilation);
+    # the HydroSpec itself compares by content (the fit cache and the batch's checks use it)
     import hydro
 
     a, b = mfm.load(CONFIGS / "sphere.toml"), mfm.load(CONFIGS / "sphere.toml")
@@ -78,11 +80,11 @@ def test_the_same_config_loaded_twice_compiles_once():
     rb = mfm.simulate(b, sea, duration=1.0, dt=0.05)
     assert dict(TRACES) == before, "a second load of the same config compiled the rollout again"
     np.testing.assert_array_equal(ra.q.values, rb.q.values)
-    # any difference in the data is another key: other drag, or an attribute set after the spec
-    # was made (its hash is not frozen at construction)
+    # any difference in the data makes another spec: other drag, or an attribute set after the
+    # spec was made (its hash is not frozen at construction)
     spec = a.hydro
     other = HydroSpec(spec.db, spec.body_index, spec.config_names, spec.ref0 - spec.d_ref,
-                                np.array([[0.0, 0.0, 1.0]]))
+                      np.array([[0.0, 0.0, 1.0]]))
     assert other != spec
     changed = copy.copy(spec)
     assert changed == spec
@@ -101,3 +103,41 @@ def test_the_same_config_loaded_twice_compiles_once():
     a.db, b.db = spec.db.assign_attrs(table=big), spec.db.assign_attrs(table=other_big)
     a._cache, b._cache = {}, {}
     assert a != b
+
+
+def test_models_differing_only_in_numbers_share_one_compilation():
+    # issue 34: a model's name, config path and hash, its HydroSpec (compared by its database's
+    # content), a fit's report are static fields, so part of jit's key: a model with other numbers
+    # (here the water-plane stiffness halved, another name and path) compiled everything again.
+    # The solvers are handed the model and loads without them (loads.assembly.compile_view):
+    # counted, not timed, no new compilation; and the reused program gives the bits of a fresh one
+    import copy
+    import dataclasses
+
+    from mfm.frequency import response, rest
+
+    a = mfm.load(CONFIGS / "rm3.toml")
+    spec = copy.copy(a.hydro)
+    spec.C_wp = 0.5 * spec.C_wp
+    b = dataclasses.replace(a, hydro=spec, name="rm3, softer", source="elsewhere.toml",
+                            source_sha256="0" * 64)
+    assert b.hydro != a.hydro and b.name != a.name
+    om = [0.6, 0.9]
+    sea = hydro.Regular(height=1.0, period=8.0)
+    fa = mfm.frequency_response(a, om)
+    sa = mfm.simulate(a, sea, duration=2.0, dt=0.1)
+    counts = (rest._static_jet._cache_size(), response._reaction_derivatives._cache_size(),
+              TRACES["rollout"])
+    fb = mfm.frequency_response(b, om)
+    sb = mfm.simulate(b, sea, duration=2.0, dt=0.1)
+    assert (rest._static_jet._cache_size(), response._reaction_derivatives._cache_size(),
+            TRACES["rollout"]) == counts, "a numbers-only variant compiled again"
+    assert not np.array_equal(fa.rao.values, fb.rao.values)         # other numbers, other RAOs
+    assert not np.array_equal(sa.q.values, sb.q.values)
+    assert fb.attrs["model"] == "rm3, softer"                          # the labels are the model's
+    jax.clear_caches()
+    fresh_f = mfm.frequency_response(b, om)
+    fresh_s = mfm.simulate(b, sea, duration=2.0, dt=0.1)
+    for new, old in ((fresh_f, fb), (fresh_s, sb)):
+        for v in new.data_vars:
+            assert np.array_equal(new[v].values, old[v].values, equal_nan=True), v

@@ -149,7 +149,7 @@ def test_a_load_imports_only_the_mechanics_and_the_load_protocol():
             assert not bad, f"{m} imports {sorted(bad)}"
     # and the runner builds the water beside the config's loads: loads only, and the checks
     assert {d for d in graph["mfm.loads.assembly"] if d.startswith("mfm")} <= {
-        "mfm.loads.base", "mfm.loads.water", "mfm.validation"}
+        "mfm.loads.base", "mfm.loads.water", "mfm.loads.radiation", "mfm.validation"}
 
 
 def test_model_type_does_not_build():

@@ -25,7 +25,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .. import results
-from ..loads.assembly import applied_loads, state_offsets
+from ..loads.assembly import applied_loads, compile_view, state_offsets
 from ..loads.base import Context
 from ..mechanics.dynamics import Evaluation, gravity_loads, reaction_loads
 from ..mechanics.kinematics import kinematics
@@ -62,7 +62,7 @@ def _reaction_function(model, loads):
     the joint point], inertial axes, with the loads at rest in still water (their static loads):
     the joint springs and dampers, and loads acting on the coordinates directly, reach the joints
     through each body's Newton–Euler residual, as in the time domain."""
-    static, mems = _static_functions(model, loads)
+    model, static, mems = _static_functions(model, loads)
     offs = state_offsets(static)
     z = jnp.zeros(int(offs[-1]))
 
@@ -93,7 +93,7 @@ def _reaction_derivatives(model, loads, q0):
 def _joint_reactions(model, sys, omega, heading, options, x):
     """(static (n, 6), complex amplitudes (n_ω, n, 6)): see :func:`joint_reactions`."""
     static, (Jq, Jv, Ja) = jax.tree_util.tree_map(
-        np.asarray, _reaction_derivatives(model, sys.loads, jnp.asarray(sys.q0, jnp.float64)))
+        np.asarray, _reaction_derivatives(*compile_view(model, sys.loads), jnp.asarray(sys.q0, jnp.float64)))
     w = omega[:, None, None, None]
     D = Jq[None] - 1j * w * Jv[None] - w**2 * Ja[None]           # (n_ω, n, 6, n_q)
     out = np.einsum("wnai,wi->wna", D, x)

@@ -30,7 +30,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..loads.assembly import RK4_STAGE_OFFSETS, applied_loads, as_loads, carried_loads
+from ..loads.assembly import (RK4_STAGE_OFFSETS, applied_loads, as_loads, carried_loads,
+                              compile_view)
 from ..mechanics.dynamics import gravity_loads, joint_loads, mass_matrix
 from ..mechanics.kinematics import kinematics
 from ..mechanics.model import Model
@@ -109,21 +110,23 @@ def _init_memories(model, static):
 
 
 def _static_functions(model: Model, loads):
-    """The loads at rest and their memories, ready for :func:`_static_jet`: (static, mems)."""
-    static = static_loads(loads)
-    return static, _init_memories(model, static)
+    """The model and its loads at rest as the compiled functions see them (numbers-only variants
+    share one compilation: :func:`mfm.loads.assembly.compile_view`) and the loads' memories,
+    ready for :func:`_static_jet`: (model, static, mems)."""
+    model, static = compile_view(model, static_loads(loads))
+    return model, static, _init_memories(model, static)
 
 
 def jet(model: Model, q, loads) -> _Jet:
     """The model's jet at (q, q̇ = 0) under ``loads`` at rest (:func:`_static_jet`)."""
-    static, mems = _static_functions(model, loads)
+    model, static, mems = _static_functions(model, loads)
     return _static_jet(model, static, mems, jnp.asarray(q, jnp.float64))
 
 
 def compile_jet(model: Model, loads, q):
     """Compile :func:`jet` for these loads' structure (jit's lower/compile, for a thread beside
     other work): a later call with loads of the same structure finds it compiled."""
-    static, mems = _static_functions(model, loads)
+    model, static, mems = _static_functions(model, loads)
     return _static_jet.lower(model, static, mems, jnp.asarray(q, jnp.float64)).compile()
 
 
@@ -141,8 +144,8 @@ def equilibrium(model: Model, q_guess=None, *, loads=None, tol: float = 1e-10, m
 
 
 def _equilibrium(model, loads, q_guess=None, tol=1e-10, max_iter=50):
-    static, mems = _static_functions(model, loads)
-    jet_at = lambda q: _static_jet(model, static, mems, q)  # noqa: E731
+    keyed, static, mems = _static_functions(model, loads)
+    jet_at = lambda q: _static_jet(keyed, static, mems, q)  # noqa: E731
     q = jnp.zeros(model.n_coordinates) if q_guess is None else jnp.asarray(q_guess, jnp.float64)
     # the size of the loads that must balance: generalised weights, or the largest weight
     scale = max(float(jnp.max(jnp.abs(jet_at(q).weights))),

@@ -8,6 +8,7 @@ all call these: one place where loads meet the equations of motion, as Bᵀ body
 """
 from __future__ import annotations
 
+import dataclasses
 from typing import Sequence
 
 import jax.numpy as jnp
@@ -15,6 +16,8 @@ import numpy as np
 
 from ..validation import check_sea
 from .base import Context, Load
+from .radiation import Convolution, StateSpace
+from .water import Water, build_water
 
 # the stage offsets of RK4 (fractions of dt at which it evaluates the dynamics): what the loads of
 # a linearisation are built with when no integrator is named (their tables hold no run either way)
@@ -30,14 +33,33 @@ def carried_loads(model, sea=None, *, dt, duration, t0=0.0, ramp=0.0, radiation=
     :func:`mfm.timedomain.setup.model_loads` names the integrator instead of its offsets."""
     out = []
     if model.hydro is not None:
-        from .water import build_water
-
         check_sea(sea)
         out.append(build_water(model, model.hydro, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                                radiation=radiation, memory=memory,
                                state_space_options=state_space_options, added_mass=added_mass,
                                stage_offsets=tuple(float(o) for o in stage_offsets)))
     return tuple(out) + tuple(model.loads)
+
+
+def compile_view(model, loads=()):
+    """(model, loads) as the compiled functions are handed them: the fields that only the host
+    reads blanked — the model's name, config path and hash and its HydroSpec, the water's spec
+    (traced code reads only its moved dofs, which the water keeps apart), a state-space fit's
+    report, a convolution's memory length — so that models and loads that differ only in numbers
+    share one compilation (a static field is part of jit's key, compared by value; a HydroSpec by
+    the content of its database). Nothing traced reads them: tests/test_rest.py checks that a
+    reused compilation gives the bits of a fresh one."""
+    def view(ld):
+        if isinstance(ld, Water):
+            rad = ld.rad
+            if isinstance(rad, StateSpace):
+                rad = dataclasses.replace(rad, report=())
+            elif isinstance(rad, Convolution):
+                rad = dataclasses.replace(rad, memory_length=0.0)
+            return dataclasses.replace(ld, spec=None, rad=rad)
+        return ld
+
+    return model.keyed(), tuple(view(ld) for ld in loads)
 
 
 def as_loads(loads) -> tuple[Load, ...]:

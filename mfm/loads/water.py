@@ -75,6 +75,9 @@ class Water(Load):
     added_mass: str = eqx.field(static=True, default="lhs")
     spec: object = eqx.field(static=True, default=None)
     grid_m: int = eqx.field(static=True, default=2)   # excitation samples per step
+    # the moved hydro dofs (spec.moving): what traced code needs of the spec, kept apart so that
+    # the compiled functions can be handed the water without its spec (loads.assembly.compile_view)
+    moving: tuple | None = eqx.field(static=True, default=None)
 
     # the older names, kept for code that reads them
     @property
@@ -153,7 +156,7 @@ class Water(Load):
     @property
     def _moved(self) -> np.ndarray:
         """Indices of the moved hydro dofs (static): the rows of H that are not structurally 0."""
-        return self._all if self.spec is None else np.asarray(self.spec.moving)
+        return self._all if self.moving is None else np.asarray(self.moving)
 
     @property
     def _all(self) -> np.ndarray:
@@ -364,7 +367,7 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
                  buoyancy=f64(spec.rho * spec.g * spec.volume), d_cob=f64(spec.d_cob),
                  drag=f64(spec.drag), exc_t0=f64(t0), exc_step=f64(step), exc_values=f64(exc),
                  eta_values=f64(eta), rad=rad, dofs=spec.dofs, added_mass=added_mass, spec=spec,
-                 grid_m=int(m))
+                 grid_m=int(m), moving=tuple(int(i) for i in np.asarray(spec.moving)))
 
 
 def _assignment_rows(by_name, wet):
@@ -446,5 +449,5 @@ def moving_dofs(model, body_index, d_ref, n_samples: int = 3, seed: int = 0) -> 
                      ref0=jnp.zeros((len(body_index), 3)))
     rng = np.random.default_rng(seed)
     qs = jnp.asarray(rng.uniform(-0.3, 0.3, (n_samples, model.n_coordinates)))
-    peak = np.abs(np.asarray(_h_samples(model, geo, qs))).max(axis=(0, 2))
+    peak = np.abs(np.asarray(_h_samples(model.keyed(), geo, qs))).max(axis=(0, 2))
     return np.flatnonzero(peak > 1e-12 * max(float(np.max(peak)), 1e-300))

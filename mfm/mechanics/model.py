@@ -122,6 +122,13 @@ class Model(eqx.Module):
         return dataclasses.replace(self, **{k: v if k in ("loads", "hydro") else _as_f64(v)
                                             for k, v in changes.items()})
 
+    def keyed(self) -> "Model":
+        """This model as compiled functions are handed it: the fields only the host reads (its
+        name, config path and hash, its HydroSpec) blanked, so that models differing only in
+        numbers share one compilation (static fields are part of jit's key); traced code reads
+        none of them (:func:`mfm.loads.assembly.compile_view`)."""
+        return dataclasses.replace(self, name="", hydro=None, source="", source_sha256="")
+
     def set_damping(self, coordinate: str, value) -> "Model":
         return self.replace(damping=self.damping.at[self.coordinate_index(coordinate)].set(value))
 

@@ -25,7 +25,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..loads.assembly import as_loads
+from ..loads.assembly import as_loads, compile_view
 from ..timedomain.rollout import dynamics_function, init_memories, update_memories
 from ..timedomain.setup import model_loads
 from ..validation import initial_vector
@@ -194,11 +194,12 @@ def floquet(model, sea, *, period, dt, t_start, integrator="verlet",
     z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
     dt_ = jnp.asarray(dt, jnp.float64)
 
-    carry0 = _floquet_start(model, lds, q0, qd0, z0, dt_, n0, integ)
+    km, kl = compile_view(model, lds)       # what the compiled calls see (numbers-only variants share)
+    carry0 = _floquet_start(km, kl, q0, qd0, z0, dt_, n0, integ)
     _, _, idx = _carry_parts(carry0)
     idx = tuple(idx)
     x = _carry_to_x(carry0, idx)
-    fj = lambda x: _flow_and_monodromy(x, model, lds, carry0, dt_, n, integ, idx)  # noqa: E731
+    fj = lambda x: _flow_and_monodromy(x, km, kl, carry0, dt_, n, integ, idx)  # noqa: E731
     y, J = fj(x)
     res0 = res = float(jnp.max(jnp.abs(y - x)))
     for _ in range(int(refine)):

@@ -29,8 +29,8 @@ at the static equilibrium, hinge preloads included): mfm.frequency_response, per
 P = ½ c ω² |θ̂|² (H/2)². Interaction factors (seed eqs. 31–33, the upper limit "2a" of eq. 33
 read as 12): q_s = P_m^i / P_s^i, q_r = Σ_row P_m / Σ_row P_s, q_a = Σ P_m / Σ P_s, with P_s
 from the lone WEC. CWR by eq. 34 as printed: the array's power over the deep-water flux
-ρ g² H² T / (32 π) times 8 m × 12. Each model compiles its own linearisation (≈ 40–90 s on the
-2-core machine: the database rides on the model as identity-hashed static data).
+ρ g² H² T / (32 π) times 8 m × 12. The five models differ only in numbers, so they share one
+compiled linearisation (the first model's compile is most of its first call).
 """
 from __future__ import annotations
 

@@ -13,7 +13,7 @@ import xarray as xr
 
 from .. import results
 from ..errors import SimulationError
-from ..loads.assembly import as_loads
+from ..loads.assembly import as_loads, compile_view
 from ..validation import finite_number, initial_vector, whole_number
 from . import integrators as _integrators
 from .checks import refuse_impossible
@@ -203,7 +203,9 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
             raise ValueError(f"vary_loads: {vary_loads!r}; give a function (case_index, loads) -> "
                              "loads")
         loads = [tuple(vary_loads(i, ld)) for i, ld in enumerate(loads)]
-    defs = {jax.tree_util.tree_structure(ld) for ld in loads}
+    # what the compiled call is handed (loads.assembly.compile_view: the host-only fields blanked)
+    views = [compile_view(pick(models, i), loads[i]) for i in range(B)]
+    defs = {jax.tree_util.tree_structure(v[1]) for v in views}
     if len(defs) > 1:
         raise ValueError("simulate_batch: the cases' loads differ in structure (with "
                          "radiation='convolution' the number of lags follows dt: give every case "
@@ -229,8 +231,8 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     size = -(-B // threads)
     lanes = min(lanes, size)
     groups = [np.minimum(np.arange(k, k + size), B - 1) for k in range(0, B, size)]
-    args = [(stack([pick(models, i) for i in g]) if model_axis == 0 else m0,
-             stack([loads[i] for i in g]), jnp.asarray(dts_all[g])) for g in groups]
+    args = [(stack([views[i][0] for i in g]) if model_axis == 0 else views[0][0],
+             stack([views[i][1] for i in g]), jnp.asarray(dts_all[g])) for g in groups]
     t0_ = jnp.asarray(t0, jnp.float64)
     bar = progress_bar(progress, int(n_steps), f"{m0.name} × {B}")
     if bar is None:

@@ -9,7 +9,7 @@ from typing import Sequence
 import jax
 import jax.numpy as jnp
 
-from ..loads.assembly import applied_loads, as_loads
+from ..loads.assembly import applied_loads, as_loads, compile_view
 from ..loads.base import Load
 from ..mechanics.dynamics import evaluate
 from ..mechanics.kinematics import kinematics
@@ -155,6 +155,7 @@ def rollout_call(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, 
     if z0 is None:
         parts = [ld.initial_state(model) for ld in loads]
         z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
+    model, loads = compile_view(model, loads)       # numbers-only variants share the compile
     args = (model, loads, q0, qd0, jnp.asarray(z0, jnp.float64), jnp.asarray(t0, jnp.float64),
             jnp.asarray(dt, jnp.float64))
     return args, dict(n_steps=int(n_steps), integrator=integ, save_every=int(save_every),
@@ -168,6 +169,7 @@ def rollout_progress(model, q0, qd0, *, dt, n_steps, integrator, loads, save_eve
     z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
     q0, qd0 = jnp.asarray(q0, jnp.float64), jnp.asarray(qd0, jnp.float64)
     t0, dt = jnp.asarray(t0, jnp.float64), jnp.asarray(dt, jnp.float64)
+    model, loads = compile_view(model, loads)
     return run_chunked(
         lambda: _start_jit(model, loads, q0, qd0, z0, t0, dt, integrator=integrator,
                            recording=EVERY),
