@@ -56,7 +56,7 @@ RENAMED = {"_rollout_jit": "rollout_jit", "_as_loads": "as_loads", "_initial_vec
            "_number": "finite_number", "_state_offsets": "state_offsets", "_sea_labels": "sea_labels",
            "_stage_offsets": "stage_offsets", "_check_sea": "check_sea", "_init_memories": "init_memories",
            "_update_memories": "update_memories", "_progress_options": "progress_options",
-           "_static_jet": "_static_jet", "_water": "water_of", "_record": "sample_outputs"}
+           "_water": "water_of", "_record": "sample_outputs"}
 
 # names that left a module that is still there: module -> {name: the module that holds it now}
 MOVED_NAMES = {"mfm.loads.catenary": {"linearise_lines": "mfm.frequency.rest"}}

@@ -47,8 +47,8 @@ def compile_view(model, loads=()):
     (traced code reads only its moved dofs, which the water keeps apart), a state-space fit's
     report, a convolution's memory length — so that models and loads that differ only in numbers
     share one compilation (a static field is part of jit's key, compared by value; a HydroSpec by
-    the content of its database). Nothing traced reads them: tests/test_rest.py checks that a
-    reused compilation gives the bits of a fresh one."""
+    the content of its database). Nothing traced reads them: tests/test_jax_contract.py checks
+    that a reused compilation gives the bits of a fresh one."""
     def view(ld):
         if isinstance(ld, Water):
             rad = ld.rad
