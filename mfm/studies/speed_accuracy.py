@@ -4,13 +4,7 @@ the warm wall time, with the Pareto front. The study (:func:`study`, a case at a
 :func:`run_case`, :func:`spectral_case`, :func:`linear_case`, measured by :func:`measures` and
 :func:`errors`), its figures and tables (:func:`figure`, :func:`table`, :func:`front_table`,
 :func:`cheapest`). Needs a checkout (the configs in configs/). The command line is
-tools/speed_accuracy.py:
-
-    python tools/speed_accuracy.py rm3          # 28 min on 2 shared cores (load 5–6)
-    python tools/speed_accuracy.py m4_134       # 44 min (10 of them the convolution)
-    python tools/speed_accuracy.py stansby_li   # ≈ 30 min
-    python tools/speed_accuracy.py figures      # the PNGs from the stored numbers
-    python tools/speed_accuracy.py stansby_li --slices integrators   # one slice
+tools/speed_accuracy.py (its docstring gives the commands and how long each takes).
 
 Each system's cases go to notebooks/figures/speed_accuracy/<system>.json as they finish (a rerun
 skips the cases already there: delete the file to start afresh), the figures to
