@@ -284,8 +284,7 @@ def batch(model, models, loads, integ, t, q, qd, dts, settings, save_every, labe
         attrs={"title": f"mfm batch of {B} runs of {model.name}",
                **provenance(model, loads[0], integrator=integ.name, save_every=int(save_every),
                             **settings)})
-    for name, (values, attrs) in (labels or {}).items():
-        ds = ds.assign_coords({name: ("case", np.asarray(values), attrs)})
+    ds = label_cases(ds, labels or {})
     damping = np.stack([np.asarray(m.damping) for m in models])
     ds = _joint_dampers(ds, model, damping, q, qd, "step")
     per_case = [{} for _ in range(B)]
@@ -310,7 +309,7 @@ def label_cases(ds, labels: dict, *, as_data=False):
         if as_data:
             ds[name] = ("case", np.asarray(values), attrs)
         else:
-            ds = ds.assign_coords({name: ("case", values, attrs)})
+            ds = ds.assign_coords({name: ("case", np.asarray(values), attrs)})
     return ds
 
 
@@ -423,8 +422,7 @@ def spectral(model, loads, q0, q_rms, power, ptos, comps, seas, settings, series
             eta=(("case", "step"), eta,
                  {"long_name": "undisturbed wave elevation at the origin", "units": "m"}))
     ds = xr.Dataset(data, coords=coords)
-    for name, (values, attrs) in sea_labels(seas).items():
-        ds = ds.assign_coords({name: ("case", np.asarray(values), attrs)})
+    ds = label_cases(ds, sea_labels(seas))
     wall = {} if start is None else {"wall_time_s": time.perf_counter() - start}
     ds.attrs = {
         "title": f"mfm spectral response of {model.name} in {B} sea states",

@@ -367,7 +367,7 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
                  buoyancy=f64(spec.rho * spec.g * spec.volume), d_cob=f64(spec.d_cob),
                  drag=f64(spec.drag), exc_t0=f64(t0), exc_step=f64(step), exc_values=f64(exc),
                  eta_values=f64(eta), rad=rad, dofs=spec.dofs, added_mass=added_mass, spec=spec,
-                 grid_m=int(m), moving=tuple(int(i) for i in np.asarray(spec.moving)))
+                 grid_m=int(m), moving=spec.moving)
 
 
 def _assignment_rows(by_name, wet):

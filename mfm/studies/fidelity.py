@@ -101,7 +101,7 @@ class Reduction:
         """Run the scene at the chosen level: a dataset with ``time``, ``q``, ``qd`` and
         ``pto_power`` whichever the level (spectral: synthesised on the same time grid; no ramp,
         its response is the steady state; linear: from rest at the equilibrium, with the ramp)."""
-        duration = _positive(duration, "duration")
+        duration = finite_number(duration, "duration", positive=True)
         model = variant_model(model, self.variant)
         if self.level == "spectral":
             t = self.dt * np.arange(int(round(duration / self.dt)) + 1)
@@ -110,10 +110,6 @@ class Reduction:
         if self.level == "linear":
             return linear_response(model, sea, duration=duration, dt=self.dt, ramp=ramp)
         return simulate(model, sea, duration=duration, dt=self.dt, ramp=ramp, **self.options)
-
-
-def _positive(value, what):
-    return finite_number(value, what, positive=True)
 
 
 def _measures(ds, window, coordinates):
@@ -168,7 +164,7 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
     chosen level. Refuses a cheaper level (returns "full", saying why) when none is within the
     tolerance, e.g. large motions where the linear answer is wrong.
     """
-    tolerance = _positive(tolerance, "tolerance")
+    tolerance = finite_number(tolerance, "tolerance", positive=True)
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: the fidelity ladder is that "
                          "of a floating model in a sea")
@@ -193,9 +189,9 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
         raise ValueError(f"options: 'body_coupling': model {model.name!r} has no coupling between "
                          f"hydro bodies to drop ({len(model.hydro.db_names)} hydro bodies, "
                          f"body_coupling={model.hydro.body_coupling})")
-    T = _positive(_sea_period(sea, period), "period")
-    pilot_periods = _positive(pilot_periods, "pilot_periods")
-    settle_periods = _positive(settle_periods, "settle_periods")
+    T = finite_number(_sea_period(sea, period), "period", positive=True)
+    pilot_periods = finite_number(pilot_periods, "pilot_periods", positive=True)
+    settle_periods = finite_number(settle_periods, "settle_periods", positive=True)
     if settle_periods >= pilot_periods:
         raise ValueError(f"settle_periods: {settle_periods} must be less than pilot_periods "
                          f"({pilot_periods}): nothing would be compared")

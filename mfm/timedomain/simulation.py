@@ -94,7 +94,8 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     if not whole_number(save_every) or n_steps % save_every:
         raise ValueError(f"save_every: {save_every!r} must be a positive divisor of the {n_steps} "
                          "steps")
-    refuse_impossible(model, as_loads(loads) + tuple(model.loads), n_steps, save_every)
+    extra = as_loads(loads)
+    refuse_impossible(model, extra + tuple(model.loads), n_steps, save_every)
     integ = _integrators.get(integrator)
     if added_mass not in ("lhs", "rhs"):
         raise ValueError(f"added_mass={added_mass!r}; accepted: 'lhs' (A∞ in M*), 'rhs' (seed 001)")
@@ -110,7 +111,6 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
             radiation = "convolution"          # no water: nothing to choose
     q0 = initial_vector(model, q0, "q0")
     qd0 = initial_vector(model, qd0, "qd0")
-    extra = as_loads(loads)
     free = []
     # The checks' linearisation at q0 (the model's jet at rest, ~6 s to compile for M4 134)
     # compiles on a second thread while this one builds the run's water (its radiation fit, in
