@@ -34,7 +34,7 @@ import xarray as xr
 
 from hydro.waves import WaveComponents, _check_components, _harmonic_sum, ramp
 
-__all__ = ["excitation_coefficients", "excitation_time_series", "excitation_dataarray"]
+__all__ = ["ExcitationTable", "polar_interpolation", "excitation_coefficients", "excitation_time_series", "excitation_dataarray"]
 
 # relative slack on the ω grid's ends: a frequency this close beyond an end is that end (configs list
 # their BEM frequencies with six decimals, so 2π/5 s is stored as 0.523599, 4e-7 from 2π/5 itself)
@@ -134,6 +134,142 @@ def _map_headings(grid: np.ndarray, periodic: bool, heading: np.ndarray, active:
     return np.clip(b, lo, hi)
 
 
+def polar_interpolation(xp, polar, i0, k0, k1, sw, sb, *, one_heading: bool):
+    """X(ω_j, β_j) from a table's polar form (:attr:`ExcitationTable.polar`: per ω interval and
+    heading |X| at both ends, arg X at the lower end and the shorter-arc phase step) and the
+    components' brackets (:meth:`ExcitationTable.brackets`): |X| and arg X linear in ω at the
+    headings k0 and k1, then in β (a zero end taking the other's phase, the shorter arc), as
+    :func:`_interp_polar` does in two steps. ``xp``: numpy or jax.numpy (the same numbers on the
+    host and on a device, to round-off). Returns complex (n, n_dof)."""
+    a0, a1, p0, dp = polar
+    sw, sb = sw[:, None], sb[:, None]
+
+    def in_omega(k):
+        return (1.0 - sw) * a0[i0, k] + sw * a1[i0, k], p0[i0, k] + sw * dp[i0, k]
+
+    A0, P0 = in_omega(k0)                               # at the lower heading
+    if one_heading:
+        return A0 * xp.exp(1j * P0)
+    A1, P1 = in_omega(k1)                               # at the upper heading
+    P0 = xp.where(A0 > 0.0, P0, P1)
+    P1 = xp.where(A1 > 0.0, P1, P0)
+    dP = xp.remainder(P1 - P0 + math.pi, 2.0 * math.pi) - math.pi
+    return ((1.0 - sb) * A0 + sb * A1) * xp.exp(1j * (P0 + sb * dP))
+
+
+class ExcitationTable:
+    """X(ω, β) of a database made ready for interpolation at wave components: complex128
+    (n_ω, n_β, n_dof) sorted by ω and β, the heading grid closed around the circle where the
+    database covers it (see the module docstring). Made once per database and reused for every
+    sea state (a batch of thousands of cases interpolates its components in one call,
+    :meth:`coefficients_many`, instead of sorting the dataset again per case)."""
+
+    def __init__(self, db: xr.Dataset, dofs=None, periodic_heading: bool | None = None):
+        X, omega, beta, labels = _excitation_table(db, dofs)
+        self.omega, self.labels = omega, labels
+        self.beta, self.X, self.periodic = _heading_table(beta, X, periodic_heading)
+        self.water_depth = db.attrs.get("water_depth")
+        # the polar form of each ω interval, made once (the numbers _interp_polar makes of its two
+        # ends: |X|, arg X, a zero end taking the other's phase, the shorter-arc step), so that a
+        # component costs one complex exponential in ω instead of two abs, two angles and two
+        # exponentials; a one-frequency grid is one interval of zero length
+        Xb = self.X
+        x0, x1 = (Xb[:-1], Xb[1:]) if Xb.shape[0] > 1 else (Xb, Xb)
+        a0, a1 = np.abs(x0), np.abs(x1)
+        p0, p1 = np.angle(x0), np.angle(x1)
+        p0 = np.where(a0 > 0.0, p0, p1)
+        p1 = np.where(a1 > 0.0, p1, p0)
+        self.polar = (a0, a1, p0, np.angle(np.exp(1j * (p1 - p0))))
+
+    def _check(self, c: WaveComponents, drop_energy_fraction: float) -> np.ndarray:
+        """The components' ω outside the grid (bool, (n,)): an error where they carry more than
+        ``drop_energy_fraction`` of Σa², else a warning; and a warning where the components were
+        discretised for another water depth."""
+        if not 0.0 <= drop_energy_fraction < 1.0:
+            raise ValueError(f"drop_energy_fraction must lie in [0, 1), got {drop_energy_fraction!r}")
+        h_db = float(self.water_depth if self.water_depth is not None else c.water_depth)
+        if not (h_db == c.water_depth or abs(h_db - c.water_depth) <= 1e-9 * abs(h_db)):
+            warnings.warn(f"components were discretised for water_depth={c.water_depth} m but the database "
+                          f"has water_depth={h_db} m: wavenumbers (elevation away from the origin) disagree "
+                          "with the excitation", stacklevel=3)
+        w = c.omega
+        lo, hi = self.omega[0], self.omega[-1]
+        outside = (w < lo * (1.0 - GRID_RTOL)) | (w > hi * (1.0 + GRID_RTOL))
+        if np.any(outside):
+            energy = c.amplitude**2
+            total = float(energy.sum())
+            frac = float(energy[outside].sum()) / total if total > 0.0 else 1.0
+            j = int(np.flatnonzero(outside)[0])
+            if frac > drop_energy_fraction:
+                raise ValueError(
+                    f"wave frequency {w[j]:.6g} rad/s (component {j}; {int(outside.sum())} component(s), "
+                    f"a fraction {frac:.3g} of the wave energy, outside in all) lies outside the database's omega grid "
+                    f"[{lo:.6g}, {hi:.6g}] rad/s: pass omega_range inside the grid to the sea state, use "
+                    "components.band(...), or extend the database"
+                )
+            warnings.warn(
+                f"dropped {int(outside.sum())} wave component(s) outside the database's omega grid "
+                f"[{lo:.6g}, {hi:.6g}] rad/s, carrying a fraction {frac:.3g} of the wave energy (Σa²); their "
+                "excitation is set to zero", stacklevel=3)
+        return outside
+
+    def brackets(self, w, heading, outside):
+        """Where the components (ω_j, β_j) fall on the table: the lower ω point i0 and fraction
+        sω, the headings k0, k1 around β_j and fraction sβ, each (n,) (a heading outside a
+        database that does not cover the circle raises, naming it)."""
+        b = _map_headings(self.beta, self.periodic, heading, ~outside)
+        wi = np.clip(w, self.omega[0], self.omega[-1])
+        i0, _, sw = _bracket(self.omega, wi)
+        k0, k1, sb = _bracket(self.beta, b)
+        return i0, k0, k1, sw, sb
+
+    def _interpolate(self, w, heading, outside):
+        """X at (ω_j, β_j), the rows ``outside`` zero: the polar interpolation of the module
+        docstring, elementwise over the components (:func:`polar_interpolation`)."""
+        out = polar_interpolation(np, self.polar, *self.brackets(w, heading, outside),
+                                  one_heading=self.beta.shape[0] == 1)
+        out[outside] = 0.0
+        return out
+
+    def coefficients(self, components: WaveComponents, *, drop_energy_fraction: float = 1e-3) -> np.ndarray:
+        """X(ω_j, β_j) at each component: complex128 (n_comp, n_dof) (:func:`excitation_coefficients`)."""
+        c = _check_components(components)
+        outside = self._check(c, drop_energy_fraction)
+        return self._interpolate(c.omega, c.heading, outside)
+
+    def brackets_many(self, components, *, drop_energy_fraction: float = 1e-3):
+        """The checks and :meth:`brackets` of each of a sequence of components (a batch's sea
+        states) at once: ``(outside, (i0, k0, k1, sω, sβ))``, each a list of (n_comp_i,) arrays
+        (``outside``: the components given zero force, see the module docstring)."""
+        cs = [_check_components(c) for c in components]
+        if not cs:
+            return [], ([], [], [], [], [])
+        outside = np.concatenate([self._check(c, drop_energy_fraction) for c in cs])
+        w = np.concatenate([c.omega for c in cs])
+        heading = np.concatenate([c.heading for c in cs])
+        try:
+            br = self.brackets(w, heading, outside)
+        except ValueError:
+            # a heading outside the grid: the case's own call names its component
+            for c in cs:
+                self.coefficients(c, drop_energy_fraction=drop_energy_fraction)
+            raise
+        cut = np.cumsum([len(c) for c in cs])[:-1]
+        return np.split(outside, cut), tuple(np.split(a, cut) for a in br)
+
+    def coefficients_many(self, components, *, drop_energy_fraction: float = 1e-3) -> list:
+        """:meth:`coefficients` of each of a sequence of components, interpolated in one call
+        (it is elementwise: the same numbers as case by case). A list of complex128
+        (n_comp_i, n_dof)."""
+        outside, br = self.brackets_many(components, drop_energy_fraction=drop_energy_fraction)
+        if not outside:
+            return []
+        out = polar_interpolation(np, self.polar, *(np.concatenate(a) for a in br),
+                                  one_heading=self.beta.shape[0] == 1)
+        out[np.concatenate(outside)] = 0.0
+        return np.split(out, np.cumsum([len(o) for o in outside])[:-1])
+
+
 def excitation_coefficients(db: xr.Dataset, components: WaveComponents, *, dofs=None,
                             drop_energy_fraction: float = 1e-3, periodic_heading: bool | None = None) -> np.ndarray:
     """X(ω_j, β_j) interpolated at each wave component: complex128 (n_comp, n_dof), N/m or N m/m.
@@ -143,48 +279,8 @@ def excitation_coefficients(db: xr.Dataset, components: WaveComponents, *, dofs=
     components dropped for lying outside the ω grid (see the module docstring) are zero.
     """
     c = _check_components(components)
-    X, omega, beta, _ = _excitation_table(db, dofs)
-    if not 0.0 <= drop_energy_fraction < 1.0:
-        raise ValueError(f"drop_energy_fraction must lie in [0, 1), got {drop_energy_fraction!r}")
-    h_db = float(db.attrs.get("water_depth", c.water_depth))
-    if not (h_db == c.water_depth or abs(h_db - c.water_depth) <= 1e-9 * abs(h_db)):
-        warnings.warn(f"components were discretised for water_depth={c.water_depth} m but the database "
-                      f"has water_depth={h_db} m: wavenumbers (elevation away from the origin) disagree "
-                      "with the excitation", stacklevel=2)
-
-    w = c.omega
-    lo, hi = omega[0], omega[-1]
-    outside = (w < lo * (1.0 - GRID_RTOL)) | (w > hi * (1.0 + GRID_RTOL))
-    if np.any(outside):
-        energy = c.amplitude**2
-        total = float(energy.sum())
-        frac = float(energy[outside].sum()) / total if total > 0.0 else 1.0
-        j = int(np.flatnonzero(outside)[0])
-        if frac > drop_energy_fraction:
-            raise ValueError(
-                f"wave frequency {w[j]:.6g} rad/s (component {j}; {int(outside.sum())} component(s), "
-                f"a fraction {frac:.3g} of the wave energy, outside in all) lies outside the database's omega grid "
-                f"[{lo:.6g}, {hi:.6g}] rad/s: pass omega_range inside the grid to the sea state, use "
-                "components.band(...), or extend the database"
-            )
-        warnings.warn(
-            f"dropped {int(outside.sum())} wave component(s) outside the database's omega grid "
-            f"[{lo:.6g}, {hi:.6g}] rad/s, carrying a fraction {frac:.3g} of the wave energy (Σa²); their "
-            "excitation is set to zero", stacklevel=2)
-    active = ~outside
-
-    grid_b, Xb, periodic = _heading_table(beta, X, periodic_heading)
-    b = _map_headings(grid_b, periodic, c.heading, active)
-
-    wi = np.clip(w, lo, hi)
-    i0, i1, sw = _bracket(omega, wi)
-    k0, k1, sb = _bracket(grid_b, b)
-    sw, sb = sw[:, None], sb[:, None]
-    y0 = _interp_polar(Xb[i0, k0], Xb[i1, k0], sw)  # in ω at the lower heading
-    y1 = _interp_polar(Xb[i0, k1], Xb[i1, k1], sw)  # in ω at the upper heading
-    out = _interp_polar(y0, y1, sb)
-    out[outside] = 0.0
-    return out
+    table = ExcitationTable(db, dofs, periodic_heading)
+    return table.coefficients(c, drop_energy_fraction=drop_energy_fraction)
 
 
 def _time(t) -> np.ndarray:

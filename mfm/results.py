@@ -275,6 +275,7 @@ def batch(model, models, loads, integ, t, q, qd, dts, settings, save_every, labe
     (e.g. each sea state's Hs, Tp) as coordinates on ``case``; ``recorded`` the per-sample outputs
     asked for by name (case, step, …)."""
     B = q.shape[0]
+    template = loads[0]     # case 0's loads: the provenance and the outputs' specs
     ds = xr.Dataset(
         {"time": (("case", "step"), t, {"units": "s"}),
          "q": (("case", "step", "coordinate"), q, _coordinate_attrs(model, 0)),
@@ -282,19 +283,23 @@ def batch(model, models, loads, integ, t, q, qd, dts, settings, save_every, labe
          "dt": (("case",), np.broadcast_to(dts, (B,)).copy(), {"units": "s"})},
         coords={"case": np.arange(B), **_coordinate_coords(model)},
         attrs={"title": f"mfm batch of {B} runs of {model.name}",
-               **provenance(model, loads[0], integrator=integ.name, save_every=int(save_every),
+               **provenance(model, template, integrator=integ.name, save_every=int(save_every),
                             **settings)})
     ds = label_cases(ds, labels or {})
     damping = np.stack([np.asarray(m.damping) for m in models])
     ds = _joint_dampers(ds, model, damping, q, qd, "step")
-    per_case = [{} for _ in range(B)]
-    for i in range(B):
-        for ld in loads[i]:
-            per_case[i].update(ld.batch_outputs(save_every, q.shape[1]))
-    for name, (_, attrs) in per_case[0].items():
-        ds[name] = (("case", "step"), np.stack([per_case[i][name][0] for i in range(B)]), attrs)
+    if hasattr(loads, "batch_outputs"):     # the cases' loads as one (loads.assembly.CaseLoads)
+        for name, (values, attrs) in loads.batch_outputs(save_every, q.shape[1]).items():
+            ds[name] = (("case", "step"), np.array(values), attrs)
+    else:
+        per_case = [{} for _ in range(B)]
+        for i in range(B):
+            for ld in loads[i]:
+                per_case[i].update(ld.batch_outputs(save_every, q.shape[1]))
+        for name, (_, attrs) in per_case[0].items():
+            ds[name] = (("case", "step"), np.stack([per_case[i][name][0] for i in range(B)]), attrs)
     if recorded:
-        specs, coords = record_specs(model, loads[0])
+        specs, coords = record_specs(model, template)
         for name, values in recorded.items():
             dims, attrs = specs[name]
             ds = ds.assign_coords({d: coords[d] for d in dims if d in coords and d not in ds.coords})

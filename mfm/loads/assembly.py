@@ -11,13 +11,15 @@ from __future__ import annotations
 import dataclasses
 from typing import Sequence
 
+import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 
 from ..validation import check_sea
 from .base import Context, Load
 from .radiation import Convolution, StateSpace
-from .water import Water, build_water
+from .water import Water, build_water, build_water_batch
 
 # the stage offsets of RK4 (fractions of dt at which it evaluates the dynamics): what the loads of
 # a linearisation are built with when no integrator is named (their tables hold no run either way)
@@ -39,6 +41,88 @@ def carried_loads(model, sea=None, *, dt, duration, t0=0.0, ramp=0.0, radiation=
                                state_space_options=state_space_options, added_mass=added_mass,
                                stage_offsets=tuple(float(o) for o in stage_offsets)))
     return tuple(out) + tuple(model.loads)
+
+
+@dataclasses.dataclass(frozen=True)
+class CaseLoads:
+    """The loads of B cases of one model as one tuple: ``loads`` whose leaves marked in
+    ``batched`` (a pytree of bools like it) carry a leading case axis of length ``size``, the
+    others shared by every case (:func:`carried_loads_batch`). With water, ``waves`` (a
+    :class:`~mfm.loads.water.WaveSum` over the cases) makes the water's tables, which ``loads``
+    leaves out (None) until :meth:`with_tables` puts them in."""
+    loads: tuple
+    batched: tuple
+    size: int
+    waves: object = None
+    polar: tuple = ()
+
+    def case(self, i: int) -> tuple:
+        """Case i's loads, as :func:`carried_loads` makes them (the water's tables made on the
+        host, by build_water's own route, where they are left out)."""
+        varying, shared = eqx.partition(self.loads, self.batched)
+        loads = eqx.combine(jax.tree_util.tree_map(lambda a: a[i], varying), shared)
+        if self.waves is not None and loads[0].exc_values is None:
+            exc, eta = jax.tree_util.tree_map(lambda a: a[i], self.waves).tables_numpy(
+                tuple(np.asarray(a) for a in self.polar))
+            loads = (self._filled(loads[0], exc, eta),) + tuple(loads[1:])
+        return loads
+
+    @staticmethod
+    def _filled(water, exc, eta):
+        """``water`` with the tables that are not None put in (its fields were None)."""
+        # dataclasses.replace, not eqx.tree_at: a None is not told apart from another None
+        return dataclasses.replace(water, **{f: v for f, v in (("exc_values", exc),
+                                                             ("eta_values", eta)) if v is not None})
+
+    def with_tables(self, exc=None, eta=None) -> "CaseLoads":
+        """These loads with the water's tables put in, with their case axis: exc (B, n, n_dof),
+        eta (B, n); either may be None (left out)."""
+        water = self._filled(self.loads[0], exc, eta)
+        mask = self._filled(self.batched[0], None if exc is None else True,
+                            None if eta is None else True)
+        return dataclasses.replace(self, loads=(water,) + self.loads[1:],
+                                   batched=(mask,) + self.batched[1:])
+
+    def __len__(self):
+        return self.size
+
+    def __getitem__(self, i):
+        return self.case(i)
+
+    def batch_outputs(self, save_every: int, n_saved: int) -> dict:
+        """The loads' :meth:`~mfm.loads.base.Load.batch_outputs` for every case at once:
+        name → (array (B, n_saved), attrs)."""
+        out = {}
+        for ld in self.loads:
+            for name, (v, attrs) in ld.batch_outputs(save_every, n_saved).items():
+                v = np.asarray(v)
+                out[name] = (np.broadcast_to(v, (self.size,) + v.shape[-1:]) if v.ndim == 1
+                             else v, attrs)
+        return out
+
+
+def carried_loads_batch(model, seas, *, dts, ramps, n_steps: int, t0=0.0, radiation="convolution",
+                        memory=None, state_space_options=None, added_mass="lhs",
+                        stage_offsets=RK4_STAGE_OFFSETS) -> CaseLoads:
+    """:func:`carried_loads` of B cases of one model at once (case b: ``seas[b]``, ``dts[b]``,
+    ``ramps[b]``, ``n_steps`` steps): its water by :func:`mfm.loads.water.build_water_batch`
+    (what the cases share made once, what differs vectorised, the tables left to the device),
+    its config's loads shared."""
+    B = len(seas)
+    out, batched, waves, polar = [], [], None, ()
+    if model.hydro is not None:
+        for sea in seas:
+            check_sea(sea)
+        water, mask, waves, polar = build_water_batch(
+            model, model.hydro, seas, dts=dts, ramps=ramps, n_steps=n_steps, t0=t0,
+            radiation=radiation, memory=memory, state_space_options=state_space_options,
+            added_mass=added_mass, stage_offsets=tuple(float(o) for o in stage_offsets))
+        out.append(water)
+        batched.append(mask)
+    for ld in model.loads:
+        out.append(ld)
+        batched.append(jax.tree_util.tree_map(lambda _: False, ld))
+    return CaseLoads(tuple(out), tuple(batched), B, waves, polar)
 
 
 def compile_view(model, loads=()):

@@ -24,6 +24,7 @@ from fractions import Fraction
 from typing import ClassVar
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -207,7 +208,13 @@ class StateSpace(NoRadiation):
             raise ValueError(f"state_space_options: unknown option(s) {bad}; accepted: {accepted} "
                              "(see hydro.statespace.fit_state_space)")
         ss = spec.state_space(**options)
-        P, C, ins, outs = modal_form(ss)
+        # the modal form of the fit, kept beside it on the spec: a batch builds one strategy per
+        # time step, and the realisation (a pass over every fitted entry) is the same for all
+        key = ("modal_form", repr(sorted(options.items())))
+        cache = getattr(spec, "_cache", {})
+        if cache.get(key, (None,))[0] is not ss:
+            cache[key] = (ss, modal_form(ss))
+        P, C, ins, outs = cache[key][1]
         report = tuple((k, v) for k, v in (getattr(ss, "report", None) or {}).items()
                        if isinstance(v, (int, float, str)))
         return cls(p=jnp.asarray(np.stack([P.real, P.imag], 1).reshape(-1, 2)),
@@ -230,7 +237,10 @@ def phi_functions(x, n: int):
     rec = np.exp(xs)
     for k in range(1, n + 1):
         rec = (rec - 1.0 / math.factorial(k - 1)) / xs
-        series = sum(x**j / math.factorial(j + k) for j in range(20))
+        # Σ_{j<20} x^j/(j + k)! by Horner's rule (20 multiply–adds, not 20 complex powers)
+        series = np.full(x.shape, 1.0 / math.factorial(19 + k), dtype=complex)
+        for j in range(18, -1, -1):
+            series = series * x + 1.0 / math.factorial(j + k)
         out.append(np.where(small, series, rec))
     return tuple(out)
 
@@ -328,14 +338,38 @@ class ExactStateSpace(StateSpace):
     @classmethod
     def from_state_space(cls, ss: StateSpace, dt, stage_offsets):
         """The exact update of ``ss``'s states for steps of ``dt`` and stages at ``stage_offsets``."""
+        arrays, static = cls._arrays(ss, np.asarray([float(dt)]), stage_offsets)
+        return cls(p=ss.p, C=ss.C, A_inf=ss.A_inf, inputs=ss.inputs, outputs=ss.outputs,
+                   options=ss.options, report=ss.report,
+                   **{k: jnp.asarray(v[0]) for k, v in arrays.items()}, **static)
+
+    @classmethod
+    def from_state_space_many(cls, ss: StateSpace, dts, stage_offsets):
+        """:meth:`from_state_space` for each of the steps ``dts`` (D,) at once: one strategy
+        whose arrays that follow dt (``E``, ``G``, ``H``, ``CE``, ``CG``, ``CH``, ``dt``) carry a
+        leading axis of D, the same numbers as D single builds (elementwise, in the same order).
+        Returns (strategy, batched): ``batched`` a pytree of bools like it, True on those
+        arrays."""
+        arrays, static = cls._arrays(ss, np.asarray(dts, dtype=float), stage_offsets)
+        out = cls(p=ss.p, C=ss.C, A_inf=ss.A_inf, inputs=ss.inputs, outputs=ss.outputs,
+                  options=ss.options, report=ss.report, **arrays, **static)
+        batched = jax.tree_util.tree_map(lambda _: False, out)
+        return out, eqx.tree_at(lambda r: tuple(getattr(r, k) for k in arrays), batched,
+                                tuple(True for _ in arrays))
+
+    @staticmethod
+    def _arrays(ss: StateSpace, dts, stage_offsets):
+        """The arrays of the class docstring for each step of ``dts`` (D,), with a leading axis
+        of D, and the static fields."""
         offsets = tuple(float(c) for c in stage_offsets)
         p = np.asarray(ss.p[:, 0]) + 1j * np.asarray(ss.p[:, 1])
-        h = float(dt) * np.asarray(offsets + (1.0,))[:, None]
-        e, phi1, phi2 = phi_functions(p[None, :] * h, 2)
+        h = dts[:, None, None] * np.asarray(offsets + (1.0,))[None, :, None]     # (D, S + 1, 1)
+        e, phi1, phi2 = phi_functions(p[None, None, :] * h, 2)
         slot, block_inputs, n_p = _blocks(ss.inputs)
         n_b, n_x = len(block_inputs), len(ss.inputs)
         C = np.asarray(ss.C)
         Rc = C[:, :n_x] - 1j * C[:, n_x:]                 # the complex residues R: F = −Re(R z)
+        D = dts.shape[0]
 
         def blocks(a):
             # (..., n_x) -> (..., n_b, n_p); padded states get zeros (they stay zero)
@@ -344,23 +378,30 @@ class ExactStateSpace(StateSpace):
             return out.reshape(a.shape[:-1] + (n_b, n_p))
 
         def split(a):
-            return jnp.asarray(np.stack([blocks(a.real), blocks(a.imag)]))
+            # (D, n_x) -> (D, 2, n_b, n_p)
+            return np.stack([blocks(a.real), blocks(a.imag)], axis=1)
+
+        # in the block layout from the start: the residues (n_out, n_b, n_p), real and imaginary
+        Rr, Ri = blocks(Rc.real), blocks(Rc.imag)
 
         def per_block(a):
-            # Re(R a) summed over each block's states: (S + 1, n_out, n_b)
-            return jnp.asarray(blocks((Rc[None] * a[:, None, :]).real).sum(-1))
+            # Re(R a) summed over each block's states: (D, S + 1, n_out, n_b)
+            ar, ai = blocks(a.real), blocks(a.imag)                  # (D, S + 1, n_b, n_p)
+            return np.einsum("dsbp,obp->dsob", ar, Rr) - np.einsum("dsbp,obp->dsob", ai, Ri)
 
         # stages after the step's start need a product with the states; one at the start does not
         # where a stage at the end gives it (see the class docstring)
         matvec = tuple(s for s, c in enumerate(offsets) if c != 0.0 or 1.0 not in offsets)
-        RE = Rc[None] * e[list(matvec)][:, None, :]       # (n_c, n_out, n_x)
-        flat = (len(matvec), C.shape[0], n_b * n_p)          # columns in the order of [Re z; Im z]
-        CE = np.concatenate([blocks(RE.real).reshape(flat), -blocks(RE.imag).reshape(flat)], axis=-1)
-        return cls(p=ss.p, C=ss.C, A_inf=ss.A_inf, inputs=ss.inputs, outputs=ss.outputs,
-                   options=ss.options, report=ss.report, E=split(e[-1]), G=split(h[-1] * phi1[-1]),
-                   H=split(h[-1] * phi2[-1]), CE=jnp.asarray(CE), CG=per_block(h * phi1),
-                   CH=per_block(h * phi2), dt=jnp.asarray(dt, jnp.float64),
-                   block_inputs=block_inputs, matvec_stages=matvec, stage_offsets=offsets)
+        er, ei = blocks(e[:, list(matvec)].real), blocks(e[:, list(matvec)].imag)   # (D, n_c, n_b, n_p)
+        er, ei = er[:, :, None], ei[:, :, None]
+        flat = (D, len(matvec), C.shape[0], n_b * n_p)        # columns in the order of [Re z; Im z]
+        # Re(R e) and −Im(R e) elementwise (the output maps of the class docstring)
+        CE = np.concatenate([(Rr * er - Ri * ei).reshape(flat), -(Rr * ei + Ri * er).reshape(flat)],
+                            axis=-1)
+        arrays = dict(E=split(e[:, -1]), G=split(h[:, -1] * phi1[:, -1]),
+                      H=split(h[:, -1] * phi2[:, -1]), CE=CE, CG=per_block(h * phi1),
+                      CH=per_block(h * phi2), dt=np.asarray(dts, dtype=np.float64))
+        return arrays, dict(block_inputs=block_inputs, matvec_stages=matvec, stage_offsets=offsets)
 
 
 def _blocks(inputs):
@@ -401,6 +442,45 @@ def strategy(spec, name, *, dt=None, memory=None, state_space_options=None, stag
     if name == "database":
         return DatabaseRadiation()
     return NoRadiation()
+
+
+def stack_cases(items, index):
+    """One pytree for many cases from the distinct ``items`` (pytrees of one structure) and the
+    item of each case, ``index`` (B,): every leaf stacked along a leading case axis
+    (``np.stack(...)[index]``). None where the items differ in structure."""
+    flat = [jax.tree_util.tree_flatten(it) for it in items]
+    treedef = flat[0][1]
+    if any(d != treedef for _, d in flat[1:]):
+        return None
+    leaves = [np.stack([np.asarray(f[0][k]) for f in flat])[np.asarray(index)]
+              for k in range(len(flat[0][0]))]
+    return jax.tree_util.tree_unflatten(treedef, leaves)
+
+
+def strategy_many(spec, name, dts, *, memory=None, state_space_options=None,
+                  stage_offsets=(0.0, 0.5, 1.0)):
+    """:func:`strategy` for each case's time step ``dts`` (B,) as one strategy: (rad, batched),
+    ``batched`` a pytree of bools like it, True on the arrays that carry a leading case axis:
+    those that follow dt, whatever the values (so a batch of one dt and one of several share a
+    compilation); the others, shared, once. The exact state space makes them for every distinct
+    dt at once (:meth:`ExactStateSpace.from_state_space_many`); a convolution is built once per
+    distinct dt (its weights); the state space and none do not follow dt. None where the cases'
+    strategies differ in structure (a convolution's lags follow dt)."""
+    uniq, inverse = np.unique(np.asarray(dts, dtype=float), return_inverse=True)
+    if name not in STRATEGIES:
+        raise ValueError(f"radiation={name!r}; accepted: {', '.join(map(repr, STRATEGIES))}")
+    if name == "state_space_exact":
+        rad, batched = ExactStateSpace.from_state_space_many(
+            StateSpace.build(spec, state_space_options), uniq, stage_offsets)
+        return (jax.tree_util.tree_map(lambda a, b: np.asarray(a)[inverse] if b else a, rad,
+                                       batched), batched)
+    if name == "convolution":
+        rad = stack_cases([strategy(spec, name, dt=float(d), memory=memory,
+                                    stage_offsets=stage_offsets) for d in uniq], inverse)
+        return None if rad is None else (rad, jax.tree_util.tree_map(lambda _: True, rad))
+    rad = strategy(spec, name, dt=float(uniq[0]), memory=memory,
+                   state_space_options=state_space_options, stage_offsets=stage_offsets)
+    return rad, jax.tree_util.tree_map(lambda _: False, rad)
 
 
 def grid_subdivisions(stage_offsets) -> int:

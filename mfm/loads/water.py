@@ -43,7 +43,7 @@ import numpy as np
 from ..mechanics import se3
 from ..mechanics.points import BodyPoints
 from .base import FrequencyTerms, Load, LoadOutput
-from .radiation import NoRadiation, grid_subdivisions, strategy
+from .radiation import NoRadiation, grid_subdivisions, strategy, strategy_many
 
 MODES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
 HYDRO_COMPONENTS = ("excitation", "radiation", "added_mass", "hydrostatic", "buoyancy", "drag")
@@ -219,7 +219,8 @@ class Water(Load):
                                  "inertial axes", "units": "N or N m"})}
 
     def batch_outputs(self, save_every, n_saved):
-        eta = np.asarray(self.eta_values)[::self.grid_m * save_every][:n_saved]
+        # (n_saved,), or (B, n_saved) for the water of many cases (build_water_batch)
+        eta = np.asarray(self.eta_values)[..., ::self.grid_m * save_every][..., :n_saved]
         return {"eta": (eta, {"long_name": "wave elevation at the origin", "units": "m"})}
 
     def provenance(self):
@@ -368,6 +369,170 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
                  drag=f64(spec.drag), exc_t0=f64(t0), exc_step=f64(step), exc_values=f64(exc),
                  eta_values=f64(eta), rad=rad, dofs=spec.dofs, added_mass=added_mass, spec=spec,
                  grid_m=int(m), moving=spec.moving)
+
+
+def excitation_table(spec):
+    """The spec's excitation X(ω, β) made ready for interpolation
+    (:class:`hydro.excitation.ExcitationTable`), made once and kept with the spec's other caches."""
+    from hydro.excitation import ExcitationTable
+
+    if "excitation_table" not in spec._cache:
+        spec._cache["excitation_table"] = ExcitationTable(spec.database())
+    return spec._cache["excitation_table"]
+
+
+class WaveSum(eqx.Module):
+    """The wave tables of a :class:`Water` as what makes them: the sums
+
+        y(t_k) = r(t_k) Re Σ_j c_j e^{−iω_j t_k},   t_k = t0 + k·step,  k = 0 … n_grid − 1,
+
+    whose columns are the excitation (c_j = a_j e^{iφ_j} X(ω_j, β_j), N or N m; 0 for a
+    component outside the database's ω grid) and, last, the elevation at the origin
+    (c_j = a_j e^{iφ_j}, m); r the start-up ramp of ``hydro.waves.ramp`` over ``ramp`` s (none at
+    0). Per component (n_c,): ``omega`` rad/s, the complex amplitude a_j e^{iφ_j} as ``amp_re``,
+    ``amp_im`` (m), ``active`` (1, or 0 outside the grid) and where it falls on the excitation
+    table (:meth:`hydro.excitation.ExcitationTable.brackets`: ``i0``, ``k0``, ``k1``, ``sw``,
+    ``sb``); X itself comes from the table's polar form, handed to :meth:`tables` (one for every
+    case). With a leading case axis on every array, the tables of many cases: made on the device
+    (:meth:`tables`), a batch's tables never pass through the host, and its cases carry ~10³
+    numbers each instead of n_grid × n_dof (15 MB for 20,000 steps of M4 134)."""
+    omega: jnp.ndarray
+    amp_re: jnp.ndarray
+    amp_im: jnp.ndarray
+    active: jnp.ndarray
+    i0: jnp.ndarray
+    k0: jnp.ndarray
+    k1: jnp.ndarray
+    sw: jnp.ndarray
+    sb: jnp.ndarray
+    t0: jnp.ndarray
+    step: jnp.ndarray
+    ramp: jnp.ndarray
+    n_grid: int = eqx.field(static=True)
+    one_heading: bool = eqx.field(static=True)
+
+    def coefficients(self, polar, xp=jnp):
+        """(c_re, c_im) (n_c, n_dof + 1): the excitation columns a e^{iφ} X(ω, β), X by
+        :func:`hydro.excitation.polar_interpolation` from ``polar``, then the elevation's a e^{iφ}."""
+        from hydro.excitation import polar_interpolation
+
+        X = polar_interpolation(xp, polar, self.i0, self.k0, self.k1, self.sw, self.sb,
+                                one_heading=self.one_heading)
+        a = (self.amp_re + 1j * self.amp_im)[:, None]
+        c = xp.concatenate([a * X * self.active[:, None], a], axis=1)
+        return xp.real(c), xp.imag(c)
+
+    def tables(self, polar):
+        """(exc (n_grid, n_dof), eta (n_grid,)) of one case, in jax: the uniform-grid form of
+        :func:`hydro.waves._harmonic_sum` (e^{−iω(t0 + (aK + b)h)} = e^{−iω b h} · e^{−iω(t0 + aKh)}:
+        sines and cosines of K × n_c and n_blocks × n_c phases, each from its own product ω·time,
+        then real matrix products), so
+        the numbers equal build_water's numpy tables to round-off."""
+        c_re, c_im = self.coefficients(polar)
+        # blocks of 256 rows, as the numpy route (fewer rows per block make the sines and cosines
+        # fewer, (K + n/K) × n_c, but the matrix products slower: K = √n measured 1.7–1.9× slower
+        # for M4 134's 401 and 4,001 rows on one CPU core)
+        n, K = self.n_grid, min(256, self.n_grid)
+        nb = -(-n // K)
+        w = self.omega
+        kh = self.step * jnp.arange(K)
+        ck, sk = jnp.cos(kh[:, None] * w[None, :]), jnp.sin(kh[:, None] * w[None, :])
+        ph = w[None, :] * (self.t0 + (K * self.step) * jnp.arange(nb))[:, None]   # (nb, n_c)
+        rr, ri = jnp.cos(ph), -jnp.sin(ph)             # e^{−iω(t0 + aKh)}
+        cr = c_re[None] * rr[:, :, None] - c_im[None] * ri[:, :, None]
+        ci = c_re[None] * ri[:, :, None] + c_im[None] * rr[:, :, None]
+        y = (jnp.einsum("bj,ajm->abm", ck, cr) + jnp.einsum("bj,ajm->abm", sk, ci))
+        y = y.reshape(nb * K, -1)[:n]
+        t = self.t0 + self.step * jnp.arange(n)
+        T = self.ramp
+        r = jnp.where(T > 0.0, jnp.where(t < 0.0, 0.0, 0.5 * (1.0 - jnp.cos(
+            jnp.pi * jnp.clip(t, 0.0, T) / jnp.where(T > 0.0, T, 1.0)))), 1.0)
+        return y[:, :-1] * r[:, None], y[:, -1] * r
+
+    def tables_numpy(self, polar):
+        """:meth:`tables` of one case on the host, by build_water's own numpy route (hydro.waves)."""
+        from hydro.waves import _harmonic_sum, ramp as ramp_fn
+
+        c_re, c_im = self.coefficients(polar, xp=np)
+        t = float(self.t0) + float(self.step) * np.arange(self.n_grid)
+        y = _harmonic_sum(np.asarray(self.omega), c_re + 1j * c_im, t)
+        if float(self.ramp):
+            y = y * ramp_fn(t, float(self.ramp))[:, None]
+        return y[:, :-1], y[:, -1]
+
+
+def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float = 0.0,
+                      radiation: str = "convolution", memory: float | None = None,
+                      state_space_options: dict | None = None, added_mass: str = "lhs",
+                      stage_offsets=(0.0, 0.5, 1.0)):
+    """The :class:`Water` of B cases at once (a batch's seas, time steps and ramps, each run
+    ``n_steps`` steps): ``(water, batched, waves, polar)``. ``water`` is one Water whose fields that
+    differ between the cases carry a leading case axis (``batched``: a pytree of bools like it,
+    True on those fields), its tables left out (None): ``waves``, a :class:`WaveSum` with a
+    leading case axis, makes them (:meth:`WaveSum.tables`, on the device) with the excitation
+    table's polar form ``polar`` (shared by every case). Case b's water, its
+    tables made, is the one :func:`build_water` makes for ``seas[b]``, ``dts[b]``, ``ramps[b]``
+    to round-off (tests/test_batch_prepare.py).
+
+    What the cases share is made once: the radiation strategy for every distinct time step
+    (:func:`~mfm.loads.radiation.strategy_many`: only its arrays that follow dt get a case axis)
+    and X(ω, β) sorted once
+    (:func:`excitation_table`), every case's wave components placed on it in one call; the
+    interpolation of X at the components and the tables are the device's.
+    Cases with fewer wave components than the most are padded with zero coefficients (a term
+    0 · cos = 0 exactly). Raises ValueError when the cases' radiation differs in structure (a
+    convolution's number of lags follows dt)."""
+    B = len(seas)
+    dts = np.broadcast_to(np.asarray(dts, dtype=float), (B,))
+    ramps = np.broadcast_to(np.asarray(ramps, dtype=float), (B,))
+    uniq = np.unique(dts)
+    stacked = strategy_many(spec, radiation, dts, memory=memory,
+                            state_space_options=state_space_options, stage_offsets=stage_offsets)
+    if stacked is None:
+        raise ValueError("simulate_batch: the cases' loads differ in structure (with "
+                         "radiation='convolution' the number of lags follows dt: give every case "
+                         "the same dt and memory, or use radiation='state_space')")
+    rad, rad_batched = stacked
+    nd = len(spec.dofs)
+    m = grid_subdivisions(stage_offsets)
+    # the grid of build_water: excitation and elevation on the stage grid, one step past the end
+    n_grids = {int(round(n_steps * float(d) / float(d))) * m + m + 1 for d in uniq}
+    if len(n_grids) != 1:
+        raise ValueError(f"n_steps={n_steps}: the time steps {uniq} give tables of different "
+                         "lengths; give one n_steps that each dt divides the duration of")
+    n_grid = n_grids.pop()
+    steps = dts / m
+    live = [i for i, sea in enumerate(seas) if sea is not None]
+    comps = [seas[i].components(water_depth=spec.water_depth, g=spec.g) for i in live]
+    table = excitation_table(spec)
+    outside, br = table.brackets_many(comps)
+    n_c = max([len(c) for c in comps] + [1])
+    # per case and component (padding: a zero amplitude, so 0 · cos = 0 exactly)
+    arrays = {k: np.zeros((B, n_c), dtype=int if k in ("i0", "k0", "k1") else float)
+              for k in ("amp_re", "amp_im", "active", "i0", "k0", "k1", "sw", "sb")}
+    omega = np.ones((B, n_c))
+    for j, (c, i) in enumerate(zip(comps, live)):
+        n = len(c)
+        a = c.complex_amplitude
+        omega[i, :n] = c.omega
+        arrays["amp_re"][i, :n], arrays["amp_im"][i, :n] = a.real, a.imag
+        arrays["active"][i, :n] = ~outside[j]
+        for name, values in zip(("i0", "k0", "k1", "sw", "sb"), br):
+            arrays[name][i, :n] = values[j]
+    waves = WaveSum(omega=omega, **arrays, t0=np.full(B, float(t0)), step=steps.copy(),
+                    ramp=ramps.copy(), n_grid=n_grid, one_heading=table.beta.shape[0] == 1)
+    geometry = BodyPoints(body_index=spec.body_index, d_ref=jnp.asarray(spec.d_ref),
+                          ref0=jnp.asarray(spec.ref0))
+    f64 = lambda a: jnp.asarray(a, dtype=jnp.float64)  # noqa: E731
+    water = Water(geometry=geometry, A_inf=f64(rad.added_mass_inf(spec)), C_wp=f64(spec.C_wp),
+                  buoyancy=f64(spec.rho * spec.g * spec.volume), d_cob=f64(spec.d_cob),
+                  drag=f64(spec.drag), exc_t0=f64(t0), exc_step=steps.copy(),
+                  exc_values=None, eta_values=None, rad=rad, dofs=spec.dofs,
+                  added_mass=added_mass, spec=spec, grid_m=int(m), moving=spec.moving)
+    batched = jax.tree_util.tree_map(lambda _: False, water)
+    # what follows dt has the case axis whatever the values: one compilation for every batch
+    batched = eqx.tree_at(lambda w: (w.exc_step, w.rad), batched, (True, rad_batched))
+    return water, batched, waves, tuple(jnp.asarray(a) for a in table.polar)
 
 
 def _assignment_rows(by_name, wet):

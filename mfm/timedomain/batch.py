@@ -6,6 +6,7 @@ import concurrent.futures
 import functools
 import os
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -13,14 +14,14 @@ import xarray as xr
 
 from .. import results
 from ..errors import SimulationError
-from ..loads.assembly import as_loads, compile_view
+from ..loads.assembly import CaseLoads, as_loads, carried_loads_batch, compile_view
 from ..validation import finite_number, initial_vector, whole_number
 from . import integrators as _integrators
 from .checks import refuse_impossible
 from .progress import progress_bar, progress_options, run_chunked
 from .record import Recording, map_in_groups, output_names
 from .rollout import TRACES, rollout_blocks, rollout_impl, rollout_start
-from .setup import model_loads
+from .setup import model_loads, stage_offsets
 
 
 def _over_cases(f, model, model_axis, batched, lanes):
@@ -75,29 +76,44 @@ def _join_parts(outs, B):
                                   *outs)
 
 
+@jax.jit
+def _tables_jit(waves, polar):
+    """The water's tables of a part's cases (a :class:`~mfm.loads.water.WaveSum` with a leading
+    case axis; ``polar`` the excitation table's polar form, every case's), made on the device:
+    (exc (G, n, n_dof), eta (G, n))."""
+    return jax.vmap(lambda w: w.tables(polar))(waves)
+
+
+def _whole(varying, shared):
+    """A case's loads from its own leaves (``varying``, sliced by the loop over cases) and those
+    every case shares (``shared``: None where the cases' loads were stacked whole)."""
+    return varying if shared is None else eqx.combine(varying, shared)
+
+
 @functools.partial(jax.jit, static_argnames=("model_axis", "n_steps", "integrator", "save_every",
                                              "record", "lanes"))
-def _batch_jit(model, loads, q0, qd0, z0, t0, dt, *, model_axis, n_steps, integrator, save_every,
-               record, lanes):
-    return _over_cases(lambda m, lds, d: rollout_impl(m, lds, q0, qd0, z0, t0, d, n_steps,
-                                                       integrator, save_every, record),
+def _batch_jit(model, loads, shared, q0, qd0, z0, t0, dt, *, model_axis, n_steps, integrator,
+               save_every, record, lanes):
+    return _over_cases(lambda m, lds, d: rollout_impl(m, _whole(lds, shared), q0, qd0, z0, t0, d,
+                                                       n_steps, integrator, save_every, record),
                        model, model_axis, (loads, dt), lanes)
 
 
 @functools.partial(jax.jit, static_argnames=("model_axis", "integrator", "record", "lanes"))
-def _start_batch_jit(model, loads, q0, qd0, z0, t0, dt, *, model_axis, integrator, record, lanes):
-    return _over_cases(lambda m, lds, d: rollout_start(m, lds, q0, qd0, z0, t0, d, integrator,
-                                                        record),
+def _start_batch_jit(model, loads, shared, q0, qd0, z0, t0, dt, *, model_axis, integrator, record,
+                     lanes):
+    return _over_cases(lambda m, lds, d: rollout_start(m, _whole(lds, shared), q0, qd0, z0, t0, d,
+                                                        integrator, record),
                        model, model_axis, (loads, dt), lanes)
 
 
 @functools.partial(jax.jit, static_argnames=("model_axis", "n_blocks", "integrator", "save_every",
                                              "record", "lanes"))
-def _chunk_batch_jit(model, loads, carry, dt, *, model_axis, n_blocks, integrator, save_every,
-                     record, lanes):
+def _chunk_batch_jit(model, loads, shared, carry, dt, *, model_axis, n_blocks, integrator,
+                     save_every, record, lanes):
     TRACES["rollout_chunk"] += 1
-    return _over_cases(lambda m, lds, c, d: rollout_blocks(m, lds, c, d, n_blocks, integrator,
-                                                            save_every, record),
+    return _over_cases(lambda m, lds, c, d: rollout_blocks(m, _whole(lds, shared), c, d, n_blocks,
+                                                            integrator, save_every, record),
                        model, model_axis, (loads, carry, dt), lanes)
 
 
@@ -193,69 +209,118 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     extra = as_loads(loads)
     refuse_impossible(models[0], extra + tuple(models[0].loads), int(n_steps), int(save_every),
                       cases=B, every_output=False, names=outputs, what="n_steps")
-    loads = [model_loads(pick(models, i), pick(seas, i), dt=float(pick(dts, i)),
-                         duration=n_steps * float(pick(dts, i)), t0=t0, ramp=float(pick(ramps, i)),
-                         radiation=radiation, memory=memory,
-                         state_space_options=state_space_options, integrator=integ) + extra
-             for i in range(B)]
-    if vary_loads is not None:
-        if not callable(vary_loads):
-            raise ValueError(f"vary_loads: {vary_loads!r}; give a function (case_index, loads) -> "
-                             "loads")
-        loads = [tuple(vary_loads(i, ld)) for i, ld in enumerate(loads)]
-    # what the compiled call is handed (loads.assembly.compile_view: the host-only fields blanked)
-    views = [compile_view(pick(models, i), loads[i]) for i in range(B)]
-    defs = {jax.tree_util.tree_structure(v[1]) for v in views}
-    if len(defs) > 1:
-        raise ValueError("simulate_batch: the cases' loads differ in structure (with "
-                         "radiation='convolution' the number of lags follows dt: give every case "
-                         "the same dt and memory, or use radiation='state_space')")
-    stack = lambda items: jax.tree_util.tree_map(lambda *a: jnp.stack(a), *items)  # noqa: E731
     m0 = models[0]
+    dts_all = np.broadcast_to(dts, (B,))
+    if vary_loads is None and len(models) == 1:
+        # the cases' loads made together (loads.assembly.carried_loads_batch): what they share
+        # once, what differs (the wave tables, what follows dt) with a leading case axis
+        cases = carried_loads_batch(m0, [pick(seas, i) for i in range(B)], dts=dts_all,
+                                    ramps=np.broadcast_to(ramps, (B,)), n_steps=int(n_steps),
+                                    t0=t0, radiation=radiation, memory=memory,
+                                    state_space_options=state_space_options,
+                                    stage_offsets=stage_offsets(integ) if m0.hydro is not None
+                                    else ())
+        cases = CaseLoads(cases.loads + extra, cases.batched + tuple(
+            jax.tree_util.tree_map(lambda _: False, ld) for ld in extra), B, cases.waves,
+                          cases.polar)
+        model_view, loads_view = compile_view(m0, cases.loads)
+        # the view blanks static fields only: its leaves are the loads' own, in the same order
+        mask = jax.tree_util.tree_unflatten(jax.tree_util.tree_structure(loads_view),
+                                            jax.tree_util.tree_leaves(cases.batched))
+        varying, shared = eqx.partition(loads_view, mask)
+        waves = cases.waves
+
+        def take(g):
+            part = jax.tree_util.tree_map(lambda a: jnp.asarray(np.asarray(a)[g]), varying)
+            if waves is None:
+                return part, None
+            # the water's tables of these cases, made on the device (WaveSum.tables)
+            exc, eta = _tables_jit(jax.tree_util.tree_map(lambda a: jnp.asarray(a[g]), waves),
+                                   cases.polar)
+            return (CaseLoads._filled(part[0], exc, eta),) + tuple(part[1:]), eta
+
+        model_of = lambda g: model_view  # noqa: E731
+        model_axis = None
+        loads = cases
+    else:
+        loads = [model_loads(pick(models, i), pick(seas, i), dt=float(pick(dts, i)),
+                             duration=n_steps * float(pick(dts, i)), t0=t0,
+                             ramp=float(pick(ramps, i)), radiation=radiation, memory=memory,
+                             state_space_options=state_space_options, integrator=integ) + extra
+                 for i in range(B)]
+        if vary_loads is not None:
+            if not callable(vary_loads):
+                raise ValueError(f"vary_loads: {vary_loads!r}; give a function (case_index, loads) "
+                                 "-> loads")
+            loads = [tuple(vary_loads(i, ld)) for i, ld in enumerate(loads)]
+        # what the compiled call is handed (loads.assembly.compile_view: the host-only fields
+        # blanked)
+        views = [compile_view(pick(models, i), loads[i]) for i in range(B)]
+        defs = {jax.tree_util.tree_structure(v[1]) for v in views}
+        if len(defs) > 1:
+            raise ValueError("simulate_batch: the cases' loads differ in structure (with "
+                             "radiation='convolution' the number of lags follows dt: give every "
+                             "case the same dt and memory, or use radiation='state_space')")
+        stack = lambda items: jax.tree_util.tree_map(  # noqa: E731
+            lambda *a: jnp.asarray(np.stack([np.asarray(x) for x in a])), *items)
+        varying, shared = [v[1] for v in views], None
+        take = lambda g: (stack([varying[i] for i in g]), None)  # noqa: E731
+        model_axis = 0 if len(models) > 1 else None
+        model_of = (lambda g: stack([views[i][0] for i in g])) if model_axis == 0 \
+            else (lambda g: views[0][0])
     q0 = jnp.asarray(initial_vector(m0, q0, "q0"))
     qd0 = jnp.asarray(initial_vector(m0, qd0, "qd0"))
-    parts = [ld.initial_state(m0) for ld in loads[0]]
+    first = loads[0]
+    parts = [ld.initial_state(m0) for ld in first]
     z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
 
     recording = Recording(outputs=outputs, states=False)     # the batch form: no z per sample
-    known = set(results.record_specs(m0, loads[0])[0])
+    known = set(results.record_specs(m0, first)[0])
     bad = [n for n in outputs if n not in known]
     if bad:
         raise ValueError(f"outputs: {bad} are not outputs of this model and its loads; accepted: "
                          f"{sorted(known)}")
 
-    model_axis = 0 if len(models) > 1 else None
-    dts_all = np.broadcast_to(dts, (B,))
     # the cases in `threads` parts of one size (the last padded by repeating its last case): one
     # compiled program serves every part, each run from its own host thread
     size = -(-B // threads)
     lanes = min(lanes, size)
     groups = [np.minimum(np.arange(k, k + size), B - 1) for k in range(0, B, size)]
-    args = [(stack([views[i][0] for i in g]) if model_axis == 0 else views[0][0],
-             stack([views[i][1] for i in g]), jnp.asarray(dts_all[g])) for g in groups]
+    args, etas = [None] * len(groups), [None] * len(groups)
+
+    def arg(k):
+        """Part k's (model, loads, dt), made once, in the thread that runs it (its tables)."""
+        if args[k] is None:
+            part, etas[k] = take(groups[k])
+            args[k] = (model_of(groups[k]), part, jnp.asarray(dts_all[groups[k]]))
+        return args[k]
+
     t0_ = jnp.asarray(t0, jnp.float64)
     bar = progress_bar(progress, int(n_steps), f"{m0.name} × {B}")
     if bar is None:
         out = _join_parts(_in_threads(len(groups), lambda k: _batch_jit(
-            args[k][0], args[k][1], q0, qd0, z0, t0_, args[k][2], model_axis=model_axis,
+            *arg(k)[:2], shared, q0, qd0, z0, t0_, arg(k)[2], model_axis=model_axis,
             n_steps=int(n_steps), integrator=integ, save_every=int(save_every), record=recording,
             lanes=lanes)), B)
     else:
         def start():
             res = _in_threads(len(groups), lambda k: _start_batch_jit(
-                args[k][0], args[k][1], q0, qd0, z0, t0_, args[k][2], model_axis=model_axis,
-                integrator=integ, record=recording, lanes=lanes))
+                *arg(k)[:2], shared, q0, qd0, z0, t0_, arg(k)[2],
+                model_axis=model_axis, integrator=integ, record=recording, lanes=lanes))
             return [r[0] for r in res], _join_parts([r[1] for r in res], B)
 
         def chunk(carries, c):
             res = _in_threads(len(groups), lambda k: _chunk_batch_jit(
-                args[k][0], args[k][1], carries[k], args[k][2], model_axis=model_axis,
+                *arg(k)[:2], shared, carries[k], arg(k)[2], model_axis=model_axis,
                 n_blocks=c, integrator=integ, save_every=int(save_every), record=recording,
                 lanes=lanes))
             return [r[0] for r in res], _join_parts([r[1] for r in res], B)
 
         out = run_chunked(start, chunk, int(n_steps) // int(save_every), int(save_every), bar,
                            time_axis=1)
+    if isinstance(loads, CaseLoads) and loads.waves is not None:
+        # the elevation for the dataset, from the tables the device made
+        loads = loads.with_tables(eta=np.concatenate([np.asarray(e) for e in etas])[:B])
     t, q, qd = (np.asarray(a) for a in out[:3])
     for i in range(B):
         if not (np.isfinite(q[i]).all() and np.isfinite(qd[i]).all()):
