@@ -13,11 +13,9 @@ the cases in one vmapped loop on a GPU).
   400; the cost a case pays whatever its length is the extrapolation to no steps,
   (2 T(200) − T(400)) / cases, beside the same for one case (the issue measured it as
   T(240 × 200) against T(1 × 200)). Medians of ``--repeats`` warm calls, alternated.
-- **Study** (``--study N``): N cases of ``--study-steps`` steps in chunks of ``--chunk`` cases
-  (``mfm.sweep`` in this process, its chunks one ``simulate_batch`` each; the dataset kept every
-  10th sample), against the stepping alone: the same chunks' ``simulate_batch`` with their loads
-  made once beforehand is not separable, so the reference is the warm time of one chunk times
-  the number of chunks, and the first chunk's extra is its compile.
+- **Study** (``--study N``): N cases of ``--study-steps`` steps in chunks of ``--chunk`` cases,
+  one ``simulate_batch`` each (every 10th sample kept), after a first chunk that compiles: the
+  warm wall time of the whole study, per case and per step, and each chunk's.
 - ``--reference PATH``: save the study's mean PTO power per case (``.npy``), or compare with a
   saved one (a CPU run against a GPU run: the largest relative difference is printed).
 """
@@ -97,26 +95,24 @@ def main(argv=None):
         chunk = min(args.chunk, N)
         skw = dict(n_steps=n, save_every=10, **kw)
         t = time.perf_counter()
-        one = mfm.simulate_batch(m, seas[:chunk], dt=dts[:chunk], ramp=5 * dts[:chunk] * 200, **skw)
+        mfm.simulate_batch(m, seas[:chunk], dt=dts[:chunk], ramp=5 * dts[:chunk] * 200, **skw)
         first = time.perf_counter() - t
         t = time.perf_counter()
-        mfm.simulate_batch(m, seas[:chunk], dt=dts[:chunk], ramp=5 * dts[:chunk] * 200, **skw)
-        warm = time.perf_counter() - t
-        del one
-        t = time.perf_counter()
-        power = []
+        power, walls = [], []
         for k in range(0, N, chunk):
             sl = slice(k, min(N, k + chunk))
+            tc = time.perf_counter()
             ds = mfm.simulate_batch(m, seas[sl], dt=dts[sl], ramp=5 * dts[sl] * 200, **skw)
+            walls.append(time.perf_counter() - tc)
             last = ds.pto_power.isel(step=slice(ds.sizes["step"] // 2, None))
             power.append(np.asarray(last.sum("pto").mean("step")))
         total = time.perf_counter() - t
         power = np.concatenate(power)
-        n_chunks = -(-N // chunk)
-        print(f"study: {N} cases × {n} steps in {n_chunks} chunks of {chunk}: {total:.1f} s "
-              f"({1e3 * total / N:.1f} ms per case); one chunk first {first:.1f} s, warm "
-              f"{warm:.2f} s; chunks × warm chunk {n_chunks * warm:.1f} s (ratio "
-              f"{total / (n_chunks * warm):.2f})")
+        n_chunks = len(walls)
+        print(f"study: {N} cases × {n} steps in {n_chunks} chunks of {chunk}: {total:.1f} s warm "
+              f"({1e3 * total / N:.2f} ms per case, {1e6 * total / n:.1f} µs per step of the "
+              f"whole study); the first chunk (compiling) {first:.1f} s; chunks "
+              f"{', '.join(f'{w:.2f}' for w in walls[:6])}{' …' if n_chunks > 6 else ''} s")
         if args.reference is not None:
             if args.reference.exists():
                 ref = np.load(args.reference)
