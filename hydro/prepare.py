@@ -166,7 +166,12 @@ class HydroSpec:
 
             h = hashlib.sha256()
             p = Path(self.source)
-            files = [p] if p.suffix == ".nc" else sorted(p.parent.glob(p.stem + ".*"))
+            if p.is_dir() or p.name.lower() == "nemoh.cal":      # a NEMOH run: its inputs/results
+                run = p if p.is_dir() else p.parent
+                files = sorted(f for pat in ("Nemoh.cal", "[Rr]esults/*.tec", "[Mm]esh/*.dat")
+                               for f in run.glob(pat))
+            else:
+                files = [p] if p.suffix == ".nc" else sorted(p.parent.glob(p.stem + ".*"))
             for f in files:
                 if f.is_file():
                     h.update(f.read_bytes())
