@@ -166,7 +166,12 @@ class HydroSpec:
 
             h = hashlib.sha256()
             p = Path(self.source)
-            files = [p] if p.suffix == ".nc" else sorted(p.parent.glob(p.stem + ".*"))
+            if p.is_dir() or p.name.lower() == "nemoh.cal":      # a NEMOH run: its inputs/results
+                run = p if p.is_dir() else p.parent
+                files = sorted(f for pat in ("Nemoh.cal", "[Rr]esults/*.tec", "[Mm]esh/*.dat")
+                               for f in run.glob(pat))
+            else:
+                files = [p] if p.suffix == ".nc" else sorted(p.parent.glob(p.stem + ".*"))
             for f in files:
                 if f.is_file():
                     h.update(f.read_bytes())
@@ -363,11 +368,25 @@ def modal_form(ss):
 
 
 def open_any_database(path, *, names=None, rho=None, g=None) -> xr.Dataset:
-    """Any hydro database file as the internal schema, in memory: our NetCDF (:func:`to_netcdf`),
-    a capytaine NetCDF (``mfm hydro``, ``hydro.bem.save``, ``cpt.export_dataset``; converted by
-    :func:`from_capytaine`), or WAMIT output (``.out`` with its ``.1``/``.3``/``.hst``; `names`
-    the bodies in file order, `rho` and `g` as :func:`hydro.wamit.read_wamit` takes them). A NetCDF
-    file is read once, whole (:func:`read_netcdf`): safe while the process holds it open."""
+    """Any hydro database as the internal schema, in memory, by what `path` names:
+
+    - a ``.nc``: our NetCDF (:func:`to_netcdf`), a capytaine 3 file of ``mfm hydro`` /
+      ``hydro.bem.save`` (:func:`from_capytaine`), or a capytaine file of another version or
+      made without ``mfm hydro`` (:func:`hydro.formats.from_other_capytaine`: complex dim,
+      scalar settings, no ω = ∞, hydrostatics from the KH/Hydrostatics files beside it);
+    - a NEMOH run: its folder, its ``Nemoh.cal`` or its ``Results/`` (:func:`hydro.nemoh.read_nemoh`,
+      v2 and v3);
+    - WAMIT output: the ``.out`` (or ``.1``/``.3``/``.hst``, or the stem) of a run with its
+      ``.1``/``.3``/``.hst`` beside it (:func:`hydro.wamit.read_wamit`).
+
+    `names`: the bodies in the file's order (WAMIT, NEMOH: their names; another capytaine's file:
+    renames them; ignored for the project's own files, whose names are the config's). `rho`, `g`: WAMIT's scaling (as :func:`hydro.wamit.read_wamit` takes
+    them); for NEMOH and other capytaine files (dimensional) they must equal the file's, or the
+    call is refused. A
+    NetCDF file is read once, whole (:func:`read_netcdf`): safe while the process holds it open.
+    """
+    from . import formats, nemoh
+
     path = Path(path)
     if path.suffix == ".nc":
         if not path.exists():
@@ -375,16 +394,40 @@ def open_any_database(path, *, names=None, rho=None, g=None) -> xr.Dataset:
                                     "`mfm hydro CONFIG` or fix the path (relative to the config)")
 
         raw = read_netcdf(check_netcdf_file(path))
-        # ours has A∞ as a variable; capytaine's has it at ω = ∞ (complex dims rejoined by both)
-        return _ours(raw) if "added_mass_inf" in raw.data_vars else from_capytaine(raw)
+        if "added_mass_inf" in raw.data_vars:
+            return _ours(raw)                                # ours has A∞ as a variable
+        if ("waterplane_stiffness" in raw.data_vars and "omega" in raw.coords
+                and np.any(np.isinf(np.asarray(raw["omega"].values, dtype=float)))):
+            return from_capytaine(raw)                       # mfm hydro's capytaine file
+        # (the project's own files keep their behaviour: names and rho there are the generator's)
+        db = formats.from_other_capytaine(raw, path, names=names)
+        _same_setting(db, path, rho=rho, g=g)
+        return db
+    if path.is_dir() or path.name.lower() == "nemoh.cal":
+        if nemoh.is_nemoh(path):
+            return nemoh.read_nemoh(nemoh.find_nemoh_cal(path), body_names=names, rho=rho, g=g)
+        raise FileNotFoundError(f"hydro.database: {str(path)!r} is a folder without a Nemoh.cal; "
+                                "accepted: a NetCDF database (.nc), a NEMOH run (its folder or "
+                                "Nemoh.cal) or a WAMIT .out/.1/.3/.hst set")
 
     stem = path.with_suffix("") if path.suffix in (".out", ".1", ".3", ".hst") else path
     if not stem.with_suffix(".out").exists():
         raise FileNotFoundError(f"hydro.database: {str(path)!r}: no WAMIT output {stem}.out and not "
-                                "a .nc file; accepted: a NetCDF database or a WAMIT .out/.1/.3/.hst set")
+                                "a .nc file or a NEMOH run; accepted: a NetCDF database (.nc), a "
+                                "NEMOH run (its folder or Nemoh.cal) or a WAMIT .out/.1/.3/.hst set")
     kw = {}
     if rho is not None:
         kw["rho"] = float(rho)
     if g is not None:
         kw["g"] = float(g)
     return read_wamit(stem, body_names=names, **kw)
+
+
+def _same_setting(db, path, **given):
+    """A dimensional database (NetCDF) was computed with its rho and g: a config asking for others
+    is refused (they cannot be rescaled here)."""
+    for name, v in given.items():
+        if v is not None and not np.isclose(float(v), float(db.attrs[name]), rtol=1e-6):
+            raise ValueError(f"hydro.{name} = {v} differs from the {name} = {db.attrs[name]} of "
+                             f"{str(path)!r}, whose coefficients are dimensional; drop hydro.{name} "
+                             f"or set it to {db.attrs[name]}")

@@ -341,3 +341,49 @@ def check_grid(db: xr.Dataset, memory_length: float, *, on_fail: str = "raise") 
             raise ValueError(msg)
         warnings.warn(msg, HydroDatabaseWarning, stacklevel=2)
     return ratio
+
+
+def radiation_band(omega, B, fraction: float = 0.05):
+    """(ω_lo, ω_hi): where some diagonal damping B_ii(ω) is at least `fraction` of its own peak
+    (B: (n_ω, n, n)); dofs whose peak is below 1e-6 of the largest of their kind (translation /
+    rotation) are ignored. Above ω_hi the BEM damping is numerical noise (CAPYTAINE.md)."""
+    om = np.asarray(omega, dtype=float)
+    diag = np.einsum("wii->wi", np.asarray(B, dtype=float))
+    peak = np.abs(diag).max(axis=0)
+    active = np.zeros(len(om), dtype=bool)
+    for i in range(diag.shape[1]):
+        group = [j for j in range(diag.shape[1]) if (j % 6 < 3) == (i % 6 < 3)]
+        if peak[i] > 1e-6 * peak[group].max():
+            active |= diag[:, i] >= fraction * peak[i]
+    idx = np.flatnonzero(active)
+    if idx.size == 0:
+        return float(om[0]), float(om[-1])
+    return float(om[idx[0]]), float(om[idx[-1]])
+
+
+def estimate_added_mass_inf(db: xr.Dataset, fraction: float = 0.05) -> np.ndarray:
+    """A∞ (n, n) from A(ω) and B(ω) alone, for a database whose source has no infinite-frequency
+    added mass (NEMOH; capytaine runs without ω = ∞).
+
+    Ogilvie's relation (2) gives, at every ω of the grid, A∞ = A(ω) + (1/ω) ∫ K(t) sin(ωt) dt
+    with K from B by (1); the estimate is its median over the band where radiation matters
+    (:func:`radiation_band`: B_ii ≥ `fraction` of its peak), robust to the stretches where A(ω)
+    is noisy or irregular; symmetrised. This is the constant :class:`hydro.prepare.HydroSpec`'s
+    ``added_mass_inf = "consistent"`` adds to a database A∞, so with that option (the default) a
+    model gets the same A∞ whether the source gave one or not. Checked on the shipped WAMIT RM3,
+    whose .1 gives A∞: see tests/test_bem_formats.py.
+    """
+    om = np.asarray(db["omega"].values, dtype=float)
+    A = np.asarray(db["added_mass"].values, dtype=float)
+    with warnings.catch_warnings():
+        # ringing / undecayed-K warnings concern a time-domain model, not this estimate
+        warnings.simplefilter("ignore", HydroDatabaseWarning)
+        t0 = np.arange(0.0, 400.0, 0.05)
+        mem = memory_length(impulse_response(db, t0), t0, rtol=1e-3)
+        t = np.arange(0.0, max(2.0 * mem, 60.0), min(0.02, np.pi / om.max() / 4.0))
+        T = impulse_response_transform(db, t, om)        # ∫ K e^{−iωt} dt: Im = −∫ K sin ωt dt
+    cand = A - T.imag / om[:, None, None]
+    lo, hi = radiation_band(om, db["radiation_damping"].values, fraction)
+    sel = (om >= lo) & (om <= hi)
+    est = np.median(cand[sel], axis=0)
+    return 0.5 * (est + est.T)

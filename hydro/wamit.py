@@ -220,6 +220,7 @@ def read_wamit(stem_or_paths, rho: float = 1000.0, g: float = 9.81, body_names=N
         reg = col0 > 0
         omega_of = lambda c: c                                            # noqa: E731
     keys = np.unique(col0[reg])
+    _check_complete(paths["1"], col0, np.stack([ii, jj], axis=1), "(i, j) pairs", line1)
     omega = omega_of(keys)
     order = np.argsort(omega)
     keys, omega = keys[order], omega[order]
@@ -241,9 +242,12 @@ def read_wamit(stem_or_paths, rho: float = 1000.0, g: float = 9.81, body_names=N
 
     # ---- .3: excitation (period, heading deg, i, |X|, phase deg, Re, Im)
     if "3" in paths:
-        r3 = np.array([r[:7] for r in _rows(paths["3"], 7)])
+        raw3, line3 = _rows(paths["3"], 7, lines=True)
+        r3 = np.array([r[:7] for r in raw3])
         om3 = omega_of(r3[:, 0])
         heads = np.unique(r3[:, 1])
+        # every (period, heading) must hold the same modes: a file cut at a line end still parses
+        _check_complete(paths["3"], r3[:, 0] + 1j * r3[:, 1], r3[:, 2:3].astype(int), "modes", line3)
         if not np.allclose(np.unique(om3), omega, rtol=1e-6):
             raise ValueError(f"{paths['3']}: its frequencies differ from those of {paths['1']}.")
         X = np.zeros((len(omega), len(heads), n), dtype=complex)
@@ -306,6 +310,38 @@ def read_wamit(stem_or_paths, rho: float = 1000.0, g: float = 9.81, body_names=N
         "date_read": datetime.now(timezone.utc).isoformat(timespec="seconds"),
     }
     return ds
+
+
+def _check_complete(path, key, items, what, lines):
+    """Raise unless every value of `key` (a period, or period + heading) lists the same `items`
+    (rows of ints) once each: a WAMIT file cut short at a line end, or edited, still parses but
+    leaves entries missing (read as zeros) — named here with its line instead."""
+    items = [tuple(int(v) for v in r) for r in np.asarray(items)]
+    groups = {}
+    for k, it, ln in zip(key, items, lines):
+        groups.setdefault(k, []).append((it, ln))
+    ref_key = max(groups, key=lambda k: len(groups[k]))
+    ref = sorted(it for it, _ in groups[ref_key])
+    for k, rows in groups.items():
+        got = sorted(it for it, _ in rows)
+        if got == ref:
+            continue
+        if len(got) != len(set(got)):
+            dup = next(it for it in got if got.count(it) > 1)
+            ln = next(n for it, n in rows if it == dup)
+            raise ValueError(f"{path}, line {ln}: {what} {dup} repeated for the same period"
+                             f"{'/heading' if np.iscomplexobj(key) else ''} ({k}); the file is damaged")
+        if np.iscomplexobj(key) or any(np.iscomplexobj(x) for x in [k]):
+            label = f"period {np.real(k):g} s, heading {np.imag(k):g} deg"
+        else:
+            label = f"period {k:g}"
+        missing = sorted(set(ref) - set(got))
+        # the (i, j) of the zero/infinite-frequency rows may legitimately differ: compare regular only
+        if not np.iscomplexobj(key) and k <= 0:
+            continue
+        raise ValueError(f"{path}: {label} has {len(got)} {what}, other periods {len(ref)} (missing "
+                         f"{missing[:4]}{'…' if len(missing) > 4 else ''}, last line {rows[-1][1]}): the "
+                         "file is truncated or damaged; re-export it from WAMIT")
 
 
 def _pair(C, i, j):
