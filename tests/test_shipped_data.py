@@ -43,3 +43,21 @@ def test_staleness_keys_on_the_bem_inputs_only(tmp_path):
 def test_hydro_on_a_config_without_bem_settings_says_so():
     with pytest.raises(mfm.ConfigError, match=r"no \[hydro.bem\] table.*not made by `mfm hydro`"):
         bemgen.generate(CONFIGS / "sphere.toml", progress=False)
+
+
+def test_a_copied_config_says_its_database_path_is_relative_to_its_folder(tmp_path):
+    import re
+    (tmp_path / "rm3.toml").write_text((CONFIGS / "rm3.toml").read_text())
+    resolved = str((tmp_path / "../hydro/data/rm3/rm3.out").resolve()).replace(str(tmp_path.parent), "")
+    with pytest.raises(FileNotFoundError, match=r"'\.\./hydro/data/rm3/rm3\.out' is relative to the "
+                       rf"config's folder {re.escape(repr(str(tmp_path)))}: .*{re.escape(resolved)}' not found"):
+        mfm.load(tmp_path / "rm3.toml")
+
+
+def test_seas_print_with_units():
+    import math
+
+    import hydro
+    assert str(hydro.Regular(height=2.5, period=8.0)) == "regular wave H 2.5 m, T 8 s"
+    assert (str(hydro.Jonswap(hs=2.0, tp=9.0, gamma=3.3, seed=1, heading=math.radians(30.0)))
+            == "JONSWAP Hs 2 m, Tp 9 s, γ 3.3, heading 30°, seed 1")
