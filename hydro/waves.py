@@ -327,6 +327,11 @@ def _spreading(value) -> Spreading | None:
 # regular wave
 
 
+def _heading_label(heading) -> str:
+    """", heading 30°" for a heading in rad; nothing for head seas (0)."""
+    return "" if heading == 0 else f", heading {math.degrees(heading):g}°"
+
+
 @dataclass(frozen=True)
 class Regular:
     """Regular (monochromatic) wave: height H (m, crest to trough), period T (s), heading β (rad,
@@ -342,6 +347,9 @@ class Regular:
         object.__setattr__(self, "period", _positive("period", self.period))
         object.__setattr__(self, "heading", _finite("heading", self.heading))
         object.__setattr__(self, "phase", _finite("phase", self.phase))
+
+    def __str__(self):
+        return f"regular wave H {self.height:g} m, T {self.period:g} s" + _heading_label(self.heading)
 
     @property
     def omega(self) -> float:
@@ -496,6 +504,12 @@ class _PeakSea(_SpectralSea):
     def _check_hs_tp(self):
         object.__setattr__(self, "hs", _positive("hs (significant wave height, m)", self.hs))
         object.__setattr__(self, "tp", _positive("tp (peak period, s)", self.tp))
+
+    def __str__(self):
+        name = type(self).__name__.replace("Jonswap", "JONSWAP").replace("PiersonMoskowitz", "PM")
+        gamma = f", γ {self.gamma:g}" if hasattr(self, "gamma") else ""
+        return (f"{name} Hs {self.hs:g} m, Tp {self.tp:g} s{gamma}" + _heading_label(self.heading)
+                + f", seed {self.seed}")
 
     @property
     def omega_peak(self) -> float:

@@ -107,7 +107,7 @@ def test_database_held_open_while_mfm_hydro_rewrites_it(tmp_path):
                         overrides={{"omega_min": 0.1, "omega_max": 6.0, "n_omega": 60, "dx": 0.05}})
         model = mfm.load({str(cfg)!r})                     # the rewritten file loads
         new = xr.open_dataset({str(db)!r})
-        assert "mfm_generate_key" in new.attrs and "mfm_generate_key" not in old_attrs
+        assert "mfm_bem_inputs_sha256" in new.attrs and "mfm_bem_inputs_sha256" not in old_attrs
         assert float(ds.added_mass.sum()) == float(shipped.added_mass.sum())   # old handle intact
         ds.close(); new.close()
         print("DONE")

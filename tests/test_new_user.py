@@ -177,7 +177,7 @@ def test_edited_hull_radius_makes_the_database_stale(tmp_path):
     assert f"mfm hydro {p} --force" in why
     p = _config_copy(tmp_path, "m4_111.toml", **{"dx = 0.03": "dx = 0.04"})
     stale, why = database_is_stale(p)
-    assert stale and "[hydro.bem] dx: 0.03 in the database, 0.04 in the config" in why
+    assert stale and "BEM input dx: 0.03 in the database, 0.04 from the config" in why
 
 
 def test_bem_cache_key_covers_the_code_version(monkeypatch):

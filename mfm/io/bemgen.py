@@ -285,6 +285,37 @@ def geometry_hash(specs) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
+def bem_inputs(specs, kwargs) -> dict:
+    """What the BEM's answer depends on, and nothing else: the hulls (:func:`geometry_record`:
+    shapes, sizes, positions, per-body panel sizes, STL files by content) and the arguments of
+    ``hydro.bem.solve`` as resolved from ``[hydro.bem]`` and its defaults (frequencies, headings,
+    depth, ρ, g, panel size, lid, symmetry, A∞, deep_water_kh). Not the config's other tables, its
+    comments or the version of the code."""
+    solve = {k: (np.asarray(v, float).tolist() if k in ("omega", "wave_directions") else v)
+             for k, v in kwargs.items()}
+    return {"geometry": geometry_record(specs), "solve": solve}
+
+
+def bem_inputs_key(specs, kwargs) -> str:
+    """SHA-256 of :func:`bem_inputs` (recorded as ``mfm_bem_inputs_sha256``): a database is up to
+    date with a config exactly when the two keys agree."""
+    text = json.dumps(bem_inputs(specs, kwargs), sort_keys=True, default=float)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def config_bem_inputs(config_path, overrides=None):
+    """(specs, kwargs of ``hydro.bem.solve``, output path) of a config with ``[hydro.bem]``."""
+    config_path = Path(config_path)
+    options, bodies = load_config(config_path)
+    raw = tomllib.loads(config_path.read_text())
+    hydro = options.get("hydro") or {}
+    settings = bem_settings(hydro.get("bem"), hydro=hydro, gravity=options["gravity"],
+                            overrides=overrides)
+    out = (Path(os.path.normpath(config_path.parent / hydro["database"]))
+           if hydro.get("database") else None)
+    return body_specs(config_path, raw, bodies), settings["kwargs"], out
+
+
 def _code_version() -> str:
     from hydro.bem import code_version
 
@@ -308,6 +339,11 @@ def _spec_diff(old: list, new: list) -> list[str]:
                              f"{'other contents' if k == 'file_sha256' else repr(b)} in the config")
     diffs += [f"body {name!r} is in the database but not in the config" for name in o if name not in n]
     return diffs
+
+
+def _short(v) -> str:
+    text = repr(v)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def database_is_stale(config_path, database=None, *, parsed=None) -> tuple[bool, str]:
@@ -346,6 +382,24 @@ def database_is_stale(config_path, database=None, *, parsed=None) -> tuple[bool,
 
     attrs = read_netcdf_attrs(check_netcdf_file(database))
     specs = body_specs(config_path, raw, bodies)
+    if "mfm_bem_inputs_sha256" in attrs and hydro.get("bem") is not None:
+        kwargs = bem_settings(hydro.get("bem"), hydro=hydro, gravity=options["gravity"])["kwargs"]
+        if attrs["mfm_bem_inputs_sha256"] == bem_inputs_key(specs, kwargs):
+            return False, (f"{os.path.normpath(database)} was made from the BEM inputs of "
+                           f"{config_path} (hulls and [hydro.bem] settings)")
+        diffs = []
+        if "mfm_bem_inputs" in attrs:
+            old, new = json.loads(attrs["mfm_bem_inputs"]), bem_inputs(specs, kwargs)
+            diffs += _spec_diff(old["geometry"], new["geometry"])
+            new_solve = json.loads(json.dumps(new["solve"], default=float))
+            diffs += [f"BEM input {k}: {_short(old['solve'].get(k))} in the database, "
+                      f"{_short(new_solve.get(k))} from the config"
+                      for k in sorted(set(old["solve"]) | set(new_solve))
+                      if old["solve"].get(k) != new_solve.get(k)]
+        return True, (f"hydro database {os.path.normpath(database)!r} is stale: it was made from "
+                      f"other BEM inputs than {str(config_path)!r} gives now: "
+                      + ("; ".join(diffs) or "the recorded key differs")
+                      + f". Regenerate it: mfm hydro {config_path} --force")
     diffs = []
     if "mfm_geometry" in attrs:
         diffs += _spec_diff(json.loads(attrs["mfm_geometry"]), geometry_record(specs))
@@ -437,38 +491,43 @@ def generate(config_path, *, out=None, force=False, progress=True, n_threads=Non
     out = Path(out)
     if out.suffix != ".nc":
         raise ConfigError(f"out: {str(out)!r}: `mfm hydro` writes NetCDF; give a path ending in .nc")
+    if hydro.get("bem") is None and not overrides:
+        raise ConfigError(
+            f"{config_path}: no [hydro.bem] table, so `mfm hydro` does not know how to solve its "
+            f"hulls; its database {hydro.get('database')!r} was not made by `mfm hydro` (see "
+            "hydro/data/README.md for how each shipped file was made). To make one, add "
+            "[hydro.bem] (dx, and omega_min, omega_max, n_omega or omega = [...]; see "
+            "configs/m4_111.toml) and a [bodies.geometry] table for each wet body")
     settings = bem_settings(hydro.get("bem"), hydro=hydro, gravity=options["gravity"],
                             overrides=overrides)
     specs = body_specs(config_path, raw, bodies)
     kw = settings["kwargs"]
     config_sha = hashlib.sha256(text.encode()).hexdigest()
-    # the up-to-date stamp: the config's text, the hulls it points to (STL files by content), the
-    # settings and the code; any change of one makes the file stale
+    # the up-to-date stamp: what the BEM's answer depends on (the hulls, STL files by content, and
+    # the solver's resolved arguments), not the rest of the config or the code's version
     geometry_sha = geometry_hash(specs)
     code = _code_version()
-    key = hashlib.sha256(json.dumps({"config": config_sha, "geometry": geometry_sha,
-                                     "overrides": overrides or {}, "code": code},
-                                    sort_keys=True, default=str).encode()).hexdigest()
+    key = bem_inputs_key(specs, kw)
 
     if out.exists() and not force:
         stored = None
         try:
-            from hydro.database import read_netcdf
+            from hydro.database import read_netcdf_attrs
 
-            stored = read_netcdf(out).attrs.get("mfm_generate_key")
+            stored = read_netcdf_attrs(out).get("mfm_bem_inputs_sha256")
         except Exception:  # noqa: BLE001 - unreadable: treat as foreign
             pass
         if stored == key:
-            print(f"mfm hydro: {out} is up to date (same config, hull files, settings and code "
-                  f"version); use --force to solve again")
+            print(f"mfm hydro: {out} is up to date (made from the same hulls and BEM settings); "
+                  f"use --force to solve again")
             return out
         stale, why = (False, "")
         try:
             stale, why = database_is_stale(config_path, out)
         except Exception:  # noqa: BLE001 - the reason is optional
             pass
-        raise FileExistsError(f"mfm hydro: {str(out)!r} exists and was not made from this config, "
-                              f"its hull files and this code version as they are now"
+        raise FileExistsError(f"mfm hydro: {str(out)!r} exists and was not made from the BEM "
+                              f"inputs of this config (its hull files and [hydro.bem] settings)"
                               + (f" ({why})" if stale else "") + "; use --force to overwrite it")
 
     try:
@@ -499,7 +558,8 @@ def generate(config_path, *, out=None, force=False, progress=True, n_threads=Non
         "mfm_config_sha256": config_sha,
         "mfm_bem_settings": json.dumps(settings["record"], sort_keys=True, default=str),
         "mfm_overrides": json.dumps(overrides or {}, sort_keys=True, default=str),
-        "mfm_generate_key": key,
+        "mfm_bem_inputs_sha256": key,
+        "mfm_bem_inputs": json.dumps(bem_inputs(specs, kw), sort_keys=True, default=float),
         "mfm_geometry": json.dumps(geometry_record(specs), sort_keys=True, default=float),
         "mfm_geometry_sha256": geometry_sha,
         "mfm_code_version": code,

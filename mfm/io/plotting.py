@@ -151,7 +151,7 @@ def plot_simulation(ds):
     a.grid(alpha=0.3)
     a.legend(fontsize=7, ncol=3)
     title = ds.attrs.get("model", ds.attrs.get("config", "simulation"))
-    fig.suptitle(f"{title}: {ds.attrs.get('sea', 'still water')}"[:110], fontsize=10)
+    fig.suptitle(f"{title}: {ds.attrs.get('sea_label', ds.attrs.get('sea', 'still water'))}"[:110], fontsize=10)
     fig.tight_layout()
     return fig
 

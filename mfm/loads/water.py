@@ -33,6 +33,7 @@ force Hᵀ X(ω, β).
 from __future__ import annotations
 
 import warnings
+import os
 from pathlib import Path
 
 import equinox as eqx
@@ -561,6 +562,13 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
     path = Path(options["database"])
     if not path.is_absolute():
         path = Path(config_dir) / path
+        stem = path.with_suffix("") if path.suffix in (".out", ".1", ".3", ".hst") else path
+        if not (path.exists() or stem.with_suffix(".out").exists()):
+            raise FileNotFoundError(
+                f"hydro.database: {options['database']!r} is relative to the config's folder "
+                f"{str(config_dir)!r}: {os.path.normpath(path)!r} not found (a config copied to "
+                "another folder keeps its relative path); give the path from the config's folder, "
+                "an absolute path, or copy the database beside the config")
     db = open_any_database(path, names=options.get("names"), rho=options.get("rho"), g=options.get("g"))
     available = [str(b) for b in db["body"].values]
     tagged = [(b.name, b.extra["hydro"]) for b in bodies if "hydro" in b.extra]

@@ -168,7 +168,8 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     rec = {k: np.asarray(v) for k, v in out[6].items()}
     settings = dict(duration=duration, n_steps=n_steps, save_every=int(save_every), t0=t0,
                     complete="true", ramp_s=ramp, memory_s=memory,
-                    sea="still water" if sea is None else repr(sea), radiation_choice=choice,
+                    sea="still water" if sea is None else repr(sea),
+                    sea_label="still water" if sea is None else str(sea), radiation_choice=choice,
                     no_restoring=", ".join(free) if check_stability else "not checked")
     finite = np.isfinite(q).all(axis=1) & np.isfinite(qd).all(axis=1)
     if not finite.all():
