@@ -15,7 +15,9 @@ the cases in one vmapped loop on a GPU).
   T(240 × 200) against T(1 × 200)). Medians of ``--repeats`` warm calls, alternated.
 - **Study** (``--study N``): N cases of ``--study-steps`` steps in chunks of ``--chunk`` cases,
   one ``simulate_batch`` each (every 10th sample kept), after a first chunk that compiles: the
-  warm wall time of the whole study, per case and per step, and each chunk's.
+  warm wall time of the whole study, per case and per step, and each chunk's; and the time of the
+  compiled time loops alone (``batch._batch_jit``, timed in the threads that run them, per
+  thread) and of the wave tables (``batch._tables_jit``): the study against the stepping alone.
 - ``--reference PATH``: save the study's mean PTO power per case (``.npy``), or compare with a
   saved one (a CPU run against a GPU run: the largest relative difference is printed).
 """
@@ -90,6 +92,22 @@ def main(argv=None):
               f"(stepping of 200 steps per case {1e3 * (med[(B, 400)] - med[(B, 200)]) / B:.2f} ms)")
 
     if args.study:
+        # the time each part's compiled loop and its tables take, from the threads that run them
+        # (blocking on each result there, as simulate_batch's threads do anyway)
+        import mfm.timedomain.batch as batch_mod
+
+        spent = {"stepping": [], "tables": []}
+
+        def timed(fn, what):
+            def call(*a, **k):
+                t = time.perf_counter()
+                out = jax.block_until_ready(fn(*a, **k))
+                spent[what].append(time.perf_counter() - t)
+                return out
+            return call
+
+        batch_mod._batch_jit = timed(batch_mod._batch_jit, "stepping")
+        batch_mod._tables_jit = timed(batch_mod._tables_jit, "tables")
         N, n = args.study, args.study_steps
         seas, dts = seas_of(N, seed=1)
         chunk = min(args.chunk, N)
@@ -97,6 +115,8 @@ def main(argv=None):
         t = time.perf_counter()
         mfm.simulate_batch(m, seas[:chunk], dt=dts[:chunk], ramp=5 * dts[:chunk] * 200, **skw)
         first = time.perf_counter() - t
+        for v in spent.values():
+            v.clear()
         t = time.perf_counter()
         power, walls = [], []
         for k in range(0, N, chunk):
@@ -113,6 +133,12 @@ def main(argv=None):
               f"({1e3 * total / N:.2f} ms per case, {1e6 * total / n:.1f} µs per step of the "
               f"whole study); the first chunk (compiling) {first:.1f} s; chunks "
               f"{', '.join(f'{w:.2f}' for w in walls[:6])}{' …' if n_chunks > 6 else ''} s")
+        parts = max(1, len(spent["stepping"]) // n_chunks)     # the threads of a chunk
+        step_s = sum(spent["stepping"]) / parts
+        tab_s = sum(spent["tables"]) / parts
+        print(f"of which the compiled time loops {step_s:.1f} s and the wave tables {tab_s:.1f} s "
+              f"per thread ({parts} threads); the whole study {total / step_s:.2f} × the stepping "
+              f"alone")
         if args.reference is not None:
             if args.reference.exists():
                 ref = np.load(args.reference)
