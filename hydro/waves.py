@@ -332,6 +332,33 @@ def _heading_label(heading) -> str:
     return "" if heading == 0 else f", heading {math.degrees(heading):g}°"
 
 
+# Miche's limit: the highest periodic wave of length L in water of depth h is 0.142 L tanh(kh)
+# (Stokes' 1/7 of the length in deep water; about 0.88 h in shallow water)
+BREAKING_STEEPNESS = 0.142
+
+
+def breaking_height(period: float, water_depth: float = math.inf, g: float = G_STANDARD) -> float:
+    """The highest wave (m, crest to trough) of ``period`` (s) in water of ``water_depth`` (m):
+    H_b = 0.142 L tanh(k h) (Miche), L = 2π/k from ω² = g k tanh(k h); past it the wave breaks
+    and linear (Airy) theory, the BEM excitation and the elevation stand for nothing real."""
+    k = float(wavenumber(2.0 * math.pi / period, water_depth, g))
+    h = _water_depth(water_depth)
+    return BREAKING_STEEPNESS * (2.0 * math.pi / k) * (math.tanh(k * h) if math.isfinite(h) else 1.0)
+
+
+def _check_breaking(what: str, height: float, period: float, water_depth, g):
+    limit = breaking_height(period, water_depth, g)
+    if height > limit:
+        depth = "deep water" if not math.isfinite(_water_depth(water_depth)) else \
+            f"water {float(water_depth):g} m deep"
+        raise ValueError(
+            f"{what} {height:g} m at a period of {period:g} s is past breaking: the highest wave of "
+            f"that period in {depth} is {limit:.3g} m (Miche: 0.142 L tanh(kh), L = "
+            f"{2.0 * math.pi / float(wavenumber(2.0 * math.pi / period, water_depth, g)):.3g} m); "
+            f"linear waves and the BEM excitation do not hold there. Give a height below "
+            f"{limit:.3g} m or a longer period")
+
+
 @dataclass(frozen=True)
 class Regular:
     """Regular (monochromatic) wave: height H (m, crest to trough), period T (s), heading β (rad,
@@ -356,6 +383,9 @@ class Regular:
         return 2.0 * math.pi / self.period
 
     def components(self, water_depth: float = math.inf, g: float = G_STANDARD) -> WaveComponents:
+        """The one component (ω = 2π/T, a = H/2); a wave past breaking
+        (:func:`breaking_height`) is refused."""
+        _check_breaking("regular wave: height", self.height, self.period, water_depth, g)
         return _make_components(
             np.array([self.omega]), np.array([0.5 * self.height]), np.array([self.phase]),
             np.array([self.heading]), water_depth, g, self.period,
@@ -514,6 +544,13 @@ class _PeakSea(_SpectralSea):
     @property
     def omega_peak(self) -> float:
         return 2.0 * math.pi / self.tp
+
+    def components(self, water_depth: float = math.inf, g: float = G_STANDARD) -> WaveComponents:
+        """As :meth:`_SpectralSea.components`; a sea whose significant height would break as a
+        regular wave of its peak period (:func:`breaking_height`; realistic seas stay below about
+        half of it, a significant steepness 2π Hs/(g Tp²) of 1/15, DNV-RP-C205 §3.5.5) is refused."""
+        _check_breaking(f"{type(self).__name__}: hs", self.hs, self.tp, water_depth, g)
+        return super().components(water_depth=water_depth, g=g)
 
     def _default_range(self):
         return (DEFAULT_BAND[0] * self.omega_peak, DEFAULT_BAND[1] * self.omega_peak)

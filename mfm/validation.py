@@ -168,3 +168,17 @@ def check_sea(sea, what="sea", *, still_water=True):
     if not hasattr(sea, "components"):
         raise SeaStateError(f"{what}: {sea!r} is not a sea state; give one of {SEAS}"
                         + (", or None for still water" if still_water else ""))
+
+
+def check_model(model, what: str = "model"):
+    """``model`` is an :class:`mfm.Model`; else a TypeError that says what it got and how to make
+    one (a config path given where its model is meant: ``mfm.load(path)`` first)."""
+    from .mechanics.model import Model
+
+    if isinstance(model, Model):
+        return model
+    if isinstance(model, (str, bytes)) or hasattr(model, "__fspath__"):
+        raise TypeError(f"{what}: {str(model)!r} is a path, not a model; load it first: "
+                        f"model = mfm.load({str(model)!r})")
+    raise TypeError(f"{what}: got {type(model).__name__} {model!r:.80}; give an mfm.Model, made "
+                    "by mfm.load(<config path>)")

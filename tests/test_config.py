@@ -87,11 +87,16 @@ def test_load_reports_file_and_toml_errors(tmp_path):
 
 
 def test_two_roots_each_hang_from_the_inertial_frame():
-    """Two bodies without a parent: each moves as it would alone (no coupling through the tree),
-    the second one's coordinates after the first's; a free joint below a root stays an error."""
+    """Two roots, a floating body and a pendulum hinged to the earth (parent = "earth", said so
+    beside a floating root: without it the hinge would hang from the earth by a missing parent,
+    refused): each moves as it would alone (no coupling through the tree), the second one's
+    coordinates after the first's; a free joint below a root stays an error."""
     d = modified(lambda d: (d["bodies"][1].pop("parent"),
                             d["bodies"][1].update(joint={"type": "revolute", "axis": [0, 1, 0],
                                                          "point": [0.5, 0, 0]})))
+    with pytest.raises(mfm.ConfigError, match=r"no parent, so its revolute joint hangs"):
+        parse_config(d)
+    d["bodies"][1]["parent"] = "earth"
     _, bodies = parse_config(d)
     both = mfm.compile_tree(bodies)
     assert both.coordinates[-1] == "b.angle" and both.bodies[1].parent is None

@@ -148,3 +148,85 @@ def test_a_run_that_cannot_fit_is_refused_before_any_work(rm3, monkeypatch):
     monkeypatch.setattr(checks, "machine_memory", lambda: 100_000)
     with pytest.raises(ValueError, match="more than this machine's 0.0001 GB"):
         mfm.simulate(rm3, SEA, duration=20.0, dt=0.1)
+
+
+@pytest.mark.parametrize("front", ["simulate", "simulate_batch", "frequency_response",
+                                   "natural_frequencies", "equilibrium", "spectral_response",
+                                   "sweep"])
+def test_a_path_where_a_model_is_meant_is_refused_with_the_fix(front):
+    """Every front door that takes a model refuses a config path (a TypeError naming the call that
+    makes the model), and anything else that is not a Model, before any work."""
+    path = str(CONFIGS / "rm3.toml")
+    calls = {
+        "simulate": lambda m: mfm.simulate(m, SEA, duration=10.0, dt=0.1),
+        "simulate_batch": lambda m: mfm.simulate_batch(m, [SEA], dt=0.1, n_steps=10),
+        "frequency_response": lambda m: mfm.frequency_response(m, [0.8]),
+        "natural_frequencies": lambda m: mfm.natural_frequencies(m),
+        "equilibrium": lambda m: mfm.equilibrium(m),
+        "spectral_response": lambda m: mfm.spectral_response(m, SEA),
+        "sweep": lambda m: mfm.sweep(m, [SEA], dt=0.1, n_steps=10),
+    }
+    with pytest.raises(TypeError, match=r"is a path, not a model; load it first: model = "
+                                        r"mfm.load\("):
+        calls[front](path)
+    with pytest.raises(TypeError, match="give an mfm.Model"):
+        calls[front]({"model": path})
+
+
+def test_load_refuses_what_is_not_a_path(rm3):
+    with pytest.raises(TypeError, match=r"path: 123 \(int\); give the path of a config TOML"):
+        mfm.load(123)
+    with pytest.raises(TypeError, match="already loaded"):
+        mfm.load(rm3)
+
+
+def test_waves_past_breaking_are_refused():
+    """Miche's limit H_b = 0.142 L tanh(kh), against its two ends: Stokes' H/L = 1/7 (0.142) in
+    deep water, 0.142 · 2π h = 0.89 h in shallow water (kh → 0, tanh kh ≈ kh); a regular wave or
+    a sea (its Hs at Tp) past it is refused by every front door, one just below runs."""
+    from hydro.waves import breaking_height
+
+    g = 9.81
+    assert breaking_height(8.0, g=g) == pytest.approx(0.142 * g * 8.0**2 / (2 * np.pi), rel=1e-12)
+    # T = 200 s in 10 m: kh = 0.05, tanh kh / kh = 1 − (kh)²/3: 0.1 % from the shallow limit
+    assert breaking_height(200.0, 10.0, g=g) == pytest.approx(0.142 * 2 * np.pi * 10.0, rel=2e-3)
+    Hb = breaking_height(8.0, g=9.81)
+    with pytest.raises(ValueError, match=r"height 15 m at a period of 8 s is past breaking.*"
+                                         r"below 14\.2 m"):
+        hydro.Regular(height=15.0, period=8.0).components(g=9.81)
+    hydro.Regular(height=0.99 * Hb, period=8.0).components(g=9.81)
+    with pytest.raises(ValueError, match="hs 15 m at a period of 4 s is past breaking"):
+        hydro.Jonswap(hs=15.0, tp=4.0).components()
+    rm3 = mfm.load(CONFIGS / "rm3.toml")
+    with pytest.raises(ValueError, match="past breaking"):
+        mfm.simulate(rm3, hydro.Regular(height=20.0, period=3.0), duration=1.0, dt=0.1)
+    with pytest.raises(ValueError, match="past breaking"):
+        mfm.simulate_batch(rm3, [SEA, hydro.Regular(height=20.0, period=3.0)], dt=0.1,
+                           n_steps=10)
+
+
+def test_a_body_without_its_parent_beside_a_floating_root_is_refused(tmp_path):
+    """RM3 with the float's ``parent`` left out: its slider would hang from the earth, not from the
+    spar (two roots where one was meant); refused naming the body and both fixes. Said on
+    purpose (parent = "earth"), it loads, and the float no longer follows the spar."""
+    text = (CONFIGS / "rm3.toml").read_text()
+    db = str((CONFIGS / "../hydro/data/rm3/rm3.out").resolve())
+    text = text.replace('"../hydro/data/rm3/rm3.out"', repr(db).replace("'", '"'))
+    orphan = tmp_path / "orphan.toml"
+    orphan.write_text(text.replace('parent = "spar"\n', "", 1))
+    with pytest.raises(mfm.ConfigError, match=r"'float'.*prismatic joint hangs from the inertial "
+                                              r"frame.*parent = \"spar\".*parent = \"earth\""):
+        mfm.load(orphan)
+    earthed = tmp_path / "earthed.toml"
+    earthed.write_text(text.replace('parent = "spar"\n', 'parent = "earth"\n', 1))
+    model = mfm.load(earthed, hydro=False)
+    assert model.coordinates == ("spar.surge", "spar.heave", "spar.pitch", "float.stroke")
+    q = np.array([0.0, 0.3, 0.0, 0.0])            # the spar heaves 0.3 m; the float stays put
+    com, _ = mfm.body_poses(model, q)
+    assert abs(float(com[model.body_index("float"), 2]) - (-0.72)) < 1e-12
+    assert abs(float(com[model.body_index("spar"), 2]) - (-21.29 + 0.3)) < 1e-12
+    two = tmp_path / "two.toml"
+    two.write_text(text.replace('body = "float"', 'body = "spar"'))
+    with pytest.raises(mfm.ConfigError, match="bodies 'spar' and 'float' both name the database "
+                                              "body 'spar'"):
+        mfm.load(two)

@@ -46,7 +46,7 @@ import xarray as xr
 from .. import results
 from ..loads.pto import load_dampers
 from ..mechanics.model import Model
-from ..validation import check_sea, finite_number
+from ..validation import check_model, check_sea, finite_number
 from .rest import linear_system, water_of
 
 # the largest condition number of the mode matrix V accepted: the modes' round-off grows as
@@ -239,6 +239,7 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
     Raises ValueError on bad input, NotImplementedError for a load with frequency-dependent terms
     other than the water's (no time-domain realisation of them here).
     """
+    model = check_model(model)
     from hydro.excitation import excitation_time_series
     from hydro.waves import elevation
 

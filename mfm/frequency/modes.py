@@ -16,6 +16,7 @@ from ..mechanics.model import Model
 from ..mechanics.points import BodyPoints
 from .response import _frequency_range, _mass_and_damping_at
 from .rest import linear_system
+from ..validation import check_model
 
 
 def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: int = 30,
@@ -43,6 +44,7 @@ def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: i
     ``radiation_damping_ratio``, ``damped`` (mode), ``modes`` (coordinate, mode), ``min_det``
     (root), ``min_det_damped`` (root_damped); it reads like the former dict (``nat["eigen"]``).
     """
+    model = check_model(model)
     import scipy.linalg
 
     options = {"radiation": radiation}

@@ -31,6 +31,7 @@ from ..mechanics.dynamics import Evaluation, gravity_loads, reaction_loads
 from ..mechanics.kinematics import kinematics
 from ..mechanics.model import Model
 from .rest import _static_functions, linear_system
+from ..validation import check_model
 
 
 def _terms(model, sys, omega, heading, options):
@@ -175,6 +176,7 @@ def frequency_response(model: Model, omega, heading: float = 0.0, *, q0=None,
     per metre of wave amplitude and the static preload ``joint_force_static``,
     ``joint_moment_static`` (body, axis) (:func:`joint_reactions`).
     """
+    model = check_model(model)
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: frequency_response needs a "
                          "config with a [hydro] table (and mfm.load(..., hydro=True))")

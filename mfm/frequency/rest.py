@@ -35,7 +35,7 @@ from ..loads.assembly import (RK4_STAGE_OFFSETS, applied_loads, as_loads, carrie
 from ..mechanics.dynamics import gravity_loads, joint_loads, mass_matrix
 from ..mechanics.kinematics import kinematics
 from ..mechanics.model import Model
-from ..validation import initial_vector
+from ..validation import check_model, initial_vector
 
 
 def still_water_loads(model: Model, loads=None, *, added_mass="lhs",
@@ -140,6 +140,7 @@ def equilibrium(model: Model, q_guess=None, *, loads=None, tol: float = 1e-10, m
     stiffness). Raises ValueError when no equilibrium is found (a body that cannot float freely
     sinks or capsizes), naming the residual by coordinate.
     """
+    model = check_model(model)
     return _equilibrium(model, system_loads(model, loads), q_guess, tol, max_iter)
 
 
@@ -199,6 +200,7 @@ class LinearSystem(NamedTuple):
 def linear_system(model: Model, q0=None, *, loads=None) -> LinearSystem:
     """Linearise the model with its loads (:func:`system_loads`) about q₀ (default: the
     equilibrium)."""
+    model = check_model(model)
     lds = system_loads(model, loads)
     return _linear_system(model, lds, q0)
 

@@ -29,7 +29,7 @@ import xarray as xr
 from .. import results
 from ..loads.pto import linear_ptos, mean_absorbed_power
 from ..mechanics.model import Model
-from ..validation import check_sea
+from ..validation import check_model, check_sea
 from .response import _amplitudes
 from .rest import linear_system
 
@@ -52,6 +52,7 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
     provenance, the sea, ``level = "spectral"``, ``n_components`` and the wall time. The one-sea
     case of :func:`spectral_sweep`.
     """
+    model = check_model(model)
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: spectral_response needs a "
                          "config with a [hydro] table")

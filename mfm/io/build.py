@@ -33,6 +33,12 @@ def load(path: str | Path, hydro: bool = True, body_coupling: bool | None = None
     body_coupling: overrides ``hydro.body_coupling`` (hydrodynamic interaction between bodies: the
         cross-body blocks of A∞, A(ω), B(ω) and K); True, False or None (the config's value).
     """
+    if isinstance(path, Model):
+        raise TypeError(f"path: got a Model ({path.name!r}), already loaded; pass it on as it is, "
+                        "or give mfm.load the path of its config TOML file")
+    if not isinstance(path, (str, Path)) and not hasattr(path, "__fspath__"):
+        raise TypeError(f"path: {path!r} ({type(path).__name__}); give the path of a config TOML "
+                        "file, a str or a pathlib.Path (e.g. 'configs/rm3.toml')")
     if not isinstance(hydro, bool):
         raise ValueError(f"hydro: {hydro!r}; accepted: True (with the config's [hydro] table) or False")
     if body_coupling is not None and not isinstance(body_coupling, bool):

@@ -27,7 +27,9 @@ The root may use ``free`` (6 coordinates: surge, sway, heave, roll, pitch, yaw),
 heave, pitch) or ``free`` with ``dofs = [...]`` (any subset), or a revolute/prismatic/fixed joint to
 the inertial frame. For a root with several coordinates, ``damping``/``stiffness``/``rest`` take
 one value per coordinate. Several roots (bodies without ``parent``) each hang from the inertial
-frame: bodies that interact only through the water (or through loads such as moorings).
+frame: bodies that interact only through the water (or through loads such as moorings). A
+revolute, prismatic or fixed root beside floating (free, planar) roots must say
+``parent = "earth"``: without it, a missing ``parent`` is the likelier reading, and it is refused.
 """
 from __future__ import annotations
 
@@ -222,6 +224,7 @@ def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodyS
     if not isinstance(raw_bodies, list) or not raw_bodies:
         raise ConfigError(f"{source}: no [[bodies]]; a config needs at least one body")
     bodies = []
+    earthed = set()      # bodies given parent = "earth": jointed to the inertial frame on purpose
     for i, raw in enumerate(raw_bodies):
         where = f"bodies[{i}]"
         if not isinstance(raw, dict):
@@ -251,9 +254,15 @@ def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodyS
             inertia = np.zeros((3, 3))   # a massless hull: its `com` is its hydro reference point
         else:
             inertia = _parse_inertia(raw, mass, where)
+        if name == EARTH:
+            raise ConfigError(f"{where}.name: {name!r} is reserved: parent = \"{EARTH}\" joints a "
+                              "body to the inertial frame; give the body another name")
         parent = raw.get("parent")
         if parent is not None and not isinstance(parent, str):
             raise ConfigError(f"{where}.parent: {parent!r} is not a body name")
+        if parent == EARTH:
+            parent = None
+            earthed.add(name)
         if "joint" not in raw:
             raise ConfigError(f"{where}.joint: missing; accepted types: {list(JOINT_KINDS)}")
         joint = _parse_joint(raw["joint"], f"{where}.joint", parent is None)
@@ -263,6 +272,7 @@ def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodyS
             extra["hydro"] = _parse_body_hydro(raw["hydro"], f"{where}.hydro", name)
         bodies.append(BodySpec(name=name, mass=mass, com=com, inertia=inertia, parent=parent,
                                joint=joint, extra=extra))
+    _check_roots(bodies, earthed)
     ordered = tree_order(bodies)
     if "hydro" in data:
         options["hydro"] = _parse_hydro(data["hydro"], source)
@@ -270,6 +280,29 @@ def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodyS
     options["loads"] = {table: load_class(table).parse_table(data[table], [b.name for b in bodies])
                         for table in LOAD_TABLES if table in data}
     return options, ordered
+
+
+# parent = "earth": a body jointed to the inertial frame (a revolute, prismatic or fixed root),
+# said so where the tree also has floating roots
+EARTH = "earth"
+
+
+def _check_roots(bodies, earthed):
+    """A tree with floating roots (free, planar) and a body whose hinge, slider or weld hangs from
+    the inertial frame only because its ``parent`` is missing is refused: one root was likely
+    meant (RM3's float without ``parent = "spar"`` would slide on the earth, not on the spar). A
+    body jointed to the earth on purpose beside floating ones says ``parent = "earth"``."""
+    roots = [b for b in bodies if b.parent is None]
+    floating = [b.name for b in roots if b.joint.kind in ("free", "planar")]
+    hanging = [b for b in roots if b.joint.kind not in ("free", "planar") and b.name not in earthed]
+    if floating and hanging:
+        b = hanging[0]
+        raise ConfigError(
+            f"bodies ({b.name!r}): no parent, so its {b.joint.kind} joint hangs from the inertial "
+            f"frame, beside the floating root(s) {floating}: a tree with {len(roots)} roots. If "
+            f"{b.name!r} is jointed to another body, give parent = \"<that body>\" (e.g. parent = "
+            f"\"{floating[0]}\"); if it is jointed to the earth on purpose, give parent = "
+            f"\"{EARTH}\"")
 
 
 def load_config(path: str | Path) -> tuple[dict, list[BodySpec]]:

@@ -580,6 +580,14 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
         raise ValueError(f"hydro: no config body is in the database {str(path)!r} (database bodies "
                          f"{available}, config bodies {[b.name for b in bodies]}); give each wet "
                          "body a [bodies.hydro] table with body = \"<database name>\"")
+    seen = {}
+    for name, db_name, _ in wet:
+        if db_name in seen:
+            raise ConfigError(f"hydro: bodies {seen[db_name]!r} and {name!r} both name the database "
+                              f"body {db_name!r}; each wet body needs its own hull's data (its "
+                              f"added mass, excitation and hydrostatics at its own place): give "
+                              f"{name!r} its own [bodies.hydro] body, one of {available}")
+        seen[db_name] = name
     missing = [db_name for _, db_name, _ in wet if db_name not in available]
     if missing:
         raise ValueError(f"hydro: database bodies {missing} named by the config are not in "

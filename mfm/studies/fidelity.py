@@ -40,7 +40,7 @@ from ..frequency.linear import linear_response
 from ..frequency.spectral import spectral_response
 from ..mechanics.model import Model
 from ..timedomain.simulation import simulate
-from ..validation import check_sea, finite_number
+from ..validation import check_model, check_sea, finite_number
 
 LEVELS = ("spectral", "linear", "fast", "full")
 # the run options each time-domain level gives mfm.simulate
@@ -164,6 +164,7 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
     chosen level. Refuses a cheaper level (returns "full", saying why) when none is within the
     tolerance, e.g. large motions where the linear answer is wrong.
     """
+    model = check_model(model)
     tolerance = finite_number(tolerance, "tolerance", positive=True)
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: the fidelity ladder is that "

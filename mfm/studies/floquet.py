@@ -28,7 +28,7 @@ import numpy as np
 from ..loads.assembly import as_loads, compile_view
 from ..timedomain.rollout import dynamics_function, init_memories, update_memories
 from ..timedomain.setup import model_loads
-from ..validation import initial_vector
+from ..validation import check_model, initial_vector
 from ..validation import positive as _positive
 from .stability import _added_mass, _integrator
 
@@ -163,6 +163,7 @@ def floquet(model, sea, *, period, dt, t_start, integrator="verlet",
     period must be a whole number of steps; ``t_start`` a whole number of steps. radiation must
     have finitely many states: "state_space", "state_space_exact" or "none" (the convolution's
     memory is its whole velocity history: allowed, but Φ is then as large as that history)."""
+    model = check_model(model)
     period = _positive(period, "period")
     dt = _positive(dt, "dt")
     ok = isinstance(t_start, numbers.Real) and not isinstance(t_start, bool) \

@@ -38,7 +38,7 @@ from ..timedomain import integrators as _integrators
 from ..timedomain.batch import simulate_batch
 from ..timedomain.progress import progress_bar, progress_options
 from ..timedomain.setup import model_loads
-from ..validation import finite_number
+from ..validation import check_model, finite_number
 
 # options passed through to simulate_batch (one value for every case, except dt and ramp)
 BATCH_OPTIONS = ("integrator", "radiation", "state_space_options", "memory", "save_every", "t0",
@@ -224,6 +224,8 @@ def sweep(model, seas, *, dt=None, n_steps: int | None = None, chunk_size: int =
     ``ds.set_index(case=["sea_hs", "sea_tp"]).unstack("case")``.
     Raises :class:`SweepError` when every chunk failed.
     """
+    for m_ in (model if isinstance(model, (list, tuple)) else [model]):
+        check_model(m_)
     if level is not None:
         return _spectral_sweep(model, seas, level, dt, n_steps, parameters, options,
                                dict(client=client, n_workers=n_workers, vary_loads=vary_loads,

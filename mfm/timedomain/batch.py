@@ -15,7 +15,7 @@ import xarray as xr
 from .. import results
 from ..errors import SimulationError
 from ..loads.assembly import CaseLoads, as_loads, carried_loads_batch, compile_view
-from ..validation import finite_number, initial_vector, whole_number
+from ..validation import check_model, finite_number, initial_vector, whole_number
 from . import integrators as _integrators
 from .checks import refuse_impossible
 from .progress import progress_bar, progress_options, run_chunked
@@ -162,7 +162,7 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     parameters as coordinates on ``case`` (``sea_hs``, ``sea_tp``, …).
     Raises :class:`SimulationError` naming the first case that goes non-finite.
     """
-    models = list(model) if isinstance(model, (list, tuple)) else [model]
+    models = [check_model(m_) for m_ in (model if isinstance(model, (list, tuple)) else [model])]
     seas = list(seas) if isinstance(seas, (list, tuple)) else [seas]
     try:
         dts = np.atleast_1d(np.asarray(dt, dtype=float))

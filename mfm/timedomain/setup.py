@@ -8,6 +8,7 @@ from ..loads.assembly import carried_loads
 from ..loads.base import Load
 from ..mechanics.model import Model
 from . import integrators as _integrators
+from ..validation import check_model
 
 
 def model_loads(model: Model, sea=None, *, dt, duration, t0=0.0, ramp=0.0,
@@ -17,6 +18,7 @@ def model_loads(model: Model, sea=None, *, dt, duration, t0=0.0, ramp=0.0,
     [hydro] config its water for this sea and time grid (:func:`mfm.loads.water.build_water`,
     prepared for the stage times of ``integrator``), then the config's loads (``model.loads``:
     moorings, PTOs, …): :func:`mfm.loads.assembly.carried_loads` for this integrator."""
+    model = check_model(model)
     stages = stage_offsets(integrator) if model.hydro is not None else ()
     return carried_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                          radiation=radiation, memory=memory,

@@ -15,7 +15,7 @@ from ..errors import AccuracyWarning, SimulationError, StabilityWarning  # noqa:
 from ..frequency import rest
 from ..loads.assembly import as_loads
 from ..mechanics.model import Model
-from ..validation import finite_number, initial_vector, whole_number
+from ..validation import check_model, finite_number, initial_vector, whole_number
 from . import integrators as _integrators
 from .batch import simulate_batch  # noqa: F401  (exported)
 from .checks import (nonfinite_message, refuse_impossible, warn_accuracy, warn_stability,
@@ -79,6 +79,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     Raises :class:`SimulationError` when the state goes non-finite; its ``dataset`` holds the run
     up to the last finite sample.
     """
+    model = check_model(model)
     if sea is not None and model.hydro is None:
         raise ValueError("sea: this model has no hydrodynamics (no [hydro] table in its config, or "
                          "mfm.load(..., hydro=False)); pass sea=None")
