@@ -17,7 +17,7 @@ the cases in one vmapped loop on a GPU).
   one ``simulate_batch`` each (every 10th sample kept), after a first chunk that compiles: the
   warm wall time of the whole study, per case and per step, and each chunk's; and the time of the
   compiled time loops alone (``batch._batch_jit``, timed in the threads that run them, per
-  thread) and of the wave tables (``batch._tables_jit``): the study against the stepping alone.
+  thread) and of the wave tables (``batch._tables``): the study against the stepping alone.
 - ``--reference PATH``: save the study's mean PTO power per case (``.npy``), or compare with a
   saved one (a CPU run against a GPU run: the largest relative difference is printed).
 """
@@ -107,7 +107,7 @@ def main(argv=None):
             return call
 
         batch_mod._batch_jit = timed(batch_mod._batch_jit, "stepping")
-        batch_mod._tables_jit = timed(batch_mod._tables_jit, "tables")
+        batch_mod._tables = timed(batch_mod._tables, "tables")
         N, n = args.study, args.study_steps
         seas, dts = seas_of(N, seed=1)
         chunk = min(args.chunk, N)

@@ -45,23 +45,21 @@ def _cases():
     return seas, dts, ramps
 
 
-def test_each_case_gets_the_water_build_water_makes_alone(m4):
-    """Case b's water (its tables made on the device) against build_water's for seas[b], dts[b],
-    ramps[b]: the radiation arrays to 1e-13 of their scale (the same elementwise formulas, the
-    block sums in another order), the tables to their round-off bound: a value of
-    Re Σ_j c_j e^{−iω_j t} (n_c terms, each made of a few roundings) is off by at most
-    ~10 ε Σ_j |c_j| per column, whichever order the sums take."""
-    import jax
-    import jax.numpy as jnp
-
-    from mfm.timedomain.batch import _tables_jit
+@pytest.mark.parametrize("n_steps", [120, 1100])
+def test_each_case_gets_the_water_build_water_makes_alone(m4, n_steps):
+    """Case b's water (its tables made as a batch makes them: by XLA for 120 steps, by numpy on a
+    CPU for 1,100, batch.NUMPY_TABLE_ROWS) against build_water's for seas[b], dts[b], ramps[b]:
+    the radiation arrays to 1e-13 of their scale (the same elementwise formulas, the block sums
+    in another order), the tables to their round-off bound: a value of Re Σ_j c_j e^{−iω_j t}
+    (n_c terms, each made of a few roundings) is off by at most ~10 ε Σ_j |c_j| per column,
+    whichever order the sums take."""
+    from mfm.timedomain.batch import _tables
 
     seas, dts, ramps = _cases()
     offs = stage_offsets("verlet")
-    n_steps = 120
     cases = carried_loads_batch(m4, seas, dts=dts, ramps=ramps, n_steps=n_steps,
                                 radiation="state_space_exact", stage_offsets=offs)
-    exc, eta = _tables_jit(jax.tree_util.tree_map(jnp.asarray, cases.waves), cases.polar)
+    exc, eta = _tables(cases.waves, cases.polar, np.arange(len(seas)))
     for b, (sea, dt, ramp) in enumerate(zip(seas, dts, ramps)):
         alone = carried_loads(m4, sea, dt=dt, duration=n_steps * dt, ramp=ramp,
                               radiation="state_space_exact", stage_offsets=offs)[0]
@@ -130,6 +128,22 @@ def test_batch_equals_its_cases_made_one_by_one(m4):
     np.testing.assert_allclose(fast.q.values[1], one.q.values, rtol=0,
                                atol=max(1e-12 * np.abs(one.q.values).max(),
                                         10 * np.abs(floor.q.values[1] - slow.q.values[1]).max()))
+
+
+def test_a_batch_without_outputs_makes_the_moved_dofs_excitation_alone(m4):
+    """With nothing of the water recorded the time step reads only the moved dofs' excitation
+    (Water._forces): a batch makes those columns alone (half of M4 134's 48) and its runs are the
+    ones of full tables, to the bit; asked for the water's forces, it makes every column."""
+    seas, dts, ramps = _cases()
+    kw = dict(dt=dts[:2], ramp=ramps[:2], n_steps=1100, **KW)
+    lean = mfm.simulate_batch(m4, seas[:2], **kw)
+    full = mfm.simulate_batch(m4, seas[:2], vary_loads=lambda i, loads: loads, **kw)
+    np.testing.assert_array_equal(lean.q.values, full.q.values)
+    forces = mfm.simulate_batch(m4, seas[:2], outputs=("hydro_force",), **kw)
+    one = mfm.simulate(m4, seas[0], duration=1100 * dts[0], dt=dts[0], ramp=ramps[0],
+                       **KW)
+    np.testing.assert_allclose(forces.hydro_force.values[0], one.hydro_force.values, rtol=0,
+                               atol=1e-9 * np.abs(one.hydro_force.values).max())
 
 
 def test_batches_differing_in_numbers_compile_once(m4):

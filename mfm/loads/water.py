@@ -411,12 +411,18 @@ class WaveSum(eqx.Module):
     ramp: jnp.ndarray
     n_grid: int = eqx.field(static=True)
     one_heading: bool = eqx.field(static=True)
+    # the excitation columns made (None: all); the others are 0. A run that records no output
+    # of the water reads only the moved dofs' (Water._forces), so a batch makes those alone
+    columns: tuple | None = eqx.field(static=True, default=None)
 
     def coefficients(self, polar, xp=jnp):
-        """(c_re, c_im) (n_c, n_dof + 1): the excitation columns a e^{iφ} X(ω, β), X by
-        :func:`hydro.excitation.polar_interpolation` from ``polar``, then the elevation's a e^{iφ}."""
+        """(c_re, c_im) (n_c, n_cols + 1): the excitation columns a e^{iφ} X(ω, β) (those of
+        ``columns``), X by :func:`hydro.excitation.polar_interpolation` from ``polar``, then the
+        elevation's a e^{iφ}."""
         from hydro.excitation import polar_interpolation
 
+        if self.columns is not None:
+            polar = tuple(a[..., list(self.columns)] for a in polar)
         X = polar_interpolation(xp, polar, self.i0, self.k0, self.k1, self.sw, self.sb,
                                 one_heading=self.one_heading)
         a = (self.amp_re + 1j * self.amp_im)[:, None]
@@ -448,7 +454,19 @@ class WaveSum(eqx.Module):
         T = self.ramp
         r = jnp.where(T > 0.0, jnp.where(t < 0.0, 0.0, 0.5 * (1.0 - jnp.cos(
             jnp.pi * jnp.clip(t, 0.0, T) / jnp.where(T > 0.0, T, 1.0)))), 1.0)
-        return y[:, :-1] * r[:, None], y[:, -1] * r
+        return self._placed(jnp, y[:, :-1] * r[:, None], polar[0].shape[-1]), y[:, -1] * r
+
+    def _placed(self, xp, exc, n_dof):
+        """The made columns in a table of every dof (the others 0)."""
+        if self.columns is None:
+            return exc
+        if xp is np:
+            out = np.zeros((exc.shape[0], n_dof))
+            out[:, list(self.columns)] = exc
+            return out
+        # a static 0/1 matrix, not a scatter (as the water's own placements)
+        P = (np.arange(n_dof)[None, :] == np.asarray(self.columns)[:, None]).astype(float)
+        return exc @ P
 
     def tables_numpy(self, polar):
         """:meth:`tables` of one case on the host, by build_water's own numpy route (hydro.waves)."""
@@ -459,7 +477,7 @@ class WaveSum(eqx.Module):
         y = _harmonic_sum(np.asarray(self.omega), c_re + 1j * c_im, t)
         if float(self.ramp):
             y = y * ramp_fn(t, float(self.ramp))[:, None]
-        return y[:, :-1], y[:, -1]
+        return self._placed(np, y[:, :-1], np.shape(polar[0])[-1]), y[:, -1]
 
 
 def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float = 0.0,

@@ -3,6 +3,7 @@ vmapped loop, groups of lanes one after another, parts of the cases on host thre
 from __future__ import annotations
 
 import concurrent.futures
+import dataclasses
 import functools
 import os
 
@@ -74,6 +75,24 @@ def _join_parts(outs, B):
     """The parts' outputs joined on the case axis, the padding cases dropped (numpy)."""
     return jax.tree_util.tree_map(lambda *a: np.concatenate([np.asarray(x) for x in a])[:B],
                                   *outs)
+
+
+# tables at least this long are made by numpy on a CPU (OpenBLAS's products: 66 ms for one of
+# M4 134's 20,000 steps against XLA's ~100–190 ms); shorter ones by XLA, whose sines and cosines
+# win there (2.8 against 5.6 ms for 200 steps), and every table on an accelerator
+NUMPY_TABLE_ROWS = 1024
+
+
+def _tables(waves, polar, g):
+    """The water's tables (exc (G, n, n_dof), eta (G, n)) of the cases ``g``: on a CPU, for long
+    runs, by numpy case by case (:meth:`~mfm.loads.water.WaveSum.tables_numpy`, the single run's
+    route: the same bits), else on the device in one call (:func:`_tables_jit`). Called from the
+    thread that runs the cases: a part's tables are made beside the other parts' work."""
+    if jax.default_backend() == "cpu" and waves.n_grid >= NUMPY_TABLE_ROWS:
+        pol = tuple(np.asarray(a) for a in polar)
+        made = [jax.tree_util.tree_map(lambda a: a[i], waves).tables_numpy(pol) for i in g]
+        return jnp.asarray(np.stack([e for e, _ in made])), jnp.asarray(np.stack([h for _, h in made]))
+    return _tables_jit(jax.tree_util.tree_map(lambda a: jnp.asarray(a[g]), waves), polar)
 
 
 @jax.jit
@@ -229,14 +248,17 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
                                             jax.tree_util.tree_leaves(cases.batched))
         varying, shared = eqx.partition(loads_view, mask)
         waves = cases.waves
+        if waves is not None and not outputs:
+            # nothing recorded of the water: the time step reads the moved dofs' excitation alone
+            moving = cases.loads[0].moving
+            waves = waves if moving is None else dataclasses.replace(
+                waves, columns=tuple(int(k) for k in moving))
 
         def take(g):
             part = jax.tree_util.tree_map(lambda a: jnp.asarray(np.asarray(a)[g]), varying)
             if waves is None:
                 return part, None
-            # the water's tables of these cases, made on the device (WaveSum.tables)
-            exc, eta = _tables_jit(jax.tree_util.tree_map(lambda a: jnp.asarray(a[g]), waves),
-                                   cases.polar)
+            exc, eta = _tables(waves, cases.polar, g)
             return (CaseLoads._filled(part[0], exc, eta),) + tuple(part[1:]), eta
 
         model_of = lambda g: model_view  # noqa: E731
