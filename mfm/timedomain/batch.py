@@ -77,21 +77,12 @@ def _join_parts(outs, B):
                                   *outs)
 
 
-# tables at least this long are made by numpy on a CPU (OpenBLAS's products: 66 ms for one of
-# M4 134's 20,000 steps against XLA's ~100–190 ms); shorter ones by XLA, whose sines and cosines
-# win there (2.8 against 5.6 ms for 200 steps), and every table on an accelerator
-NUMPY_TABLE_ROWS = 1024
-
-
 def _tables(waves, polar, g):
-    """The water's tables (exc (G, n, n_dof), eta (G, n)) of the cases ``g``: on a CPU, for long
-    runs, by numpy case by case (:meth:`~mfm.loads.water.WaveSum.tables_numpy`, the single run's
-    route: the same bits), else on the device in one call (:func:`_tables_jit`). Called from the
-    thread that runs the cases: a part's tables are made beside the other parts' work."""
-    if jax.default_backend() == "cpu" and waves.n_grid >= NUMPY_TABLE_ROWS:
-        pol = tuple(np.asarray(a) for a in polar)
-        made = [jax.tree_util.tree_map(lambda a: a[i], waves).tables_numpy(pol) for i in g]
-        return jnp.asarray(np.stack([e for e, _ in made])), jnp.asarray(np.stack([h for _, h in made]))
+    """The water's tables (exc (G, n, n_dof), eta (G, n)) of the cases ``g``, made on the device in
+    one call (:func:`_tables_jit`), from the thread that runs the cases: a part's tables are made
+    beside the other parts' work. (numpy's route, case by case, was as fast on 2 cores with only
+    the moved dofs' columns, 17.0 against 17.2 s per thread for 240 cases × 20,000 steps of
+    M4 134, and slower on 16, 2.3×: its Python loop holds the GIL.)"""
     return _tables_jit(jax.tree_util.tree_map(lambda a: jnp.asarray(a[g]), waves), polar)
 
 
