@@ -245,19 +245,11 @@ class HydroSpec:
         """(ω_lo, ω_hi): where some diagonal damping B_ii(ω) is at least ``fraction`` of its own
         peak: the band where radiation matters and the BEM data are meaningful (above it, BEM
         damping is numerical noise; CAPYTAINE.md). Diagonals below 1e-6 of the largest (by
-        dimension group) are ignored."""
+        dimension group) are ignored (:func:`hydro.radiation.radiation_band` of the database)."""
+        from .radiation import radiation_band
+
         db = self.database()
-        om = np.asarray(db["omega"].values)
-        B = np.asarray(db["radiation_damping"].values)
-        diag = np.einsum("wii->wi", B)
-        peak = np.abs(diag).max(axis=0)
-        active = np.zeros(len(om), dtype=bool)
-        for i in range(diag.shape[1]):
-            group = [j for j in range(diag.shape[1]) if (j % 6 < 3) == (i % 6 < 3)]
-            if peak[i] > 1e-6 * peak[group].max():
-                active |= diag[:, i] >= fraction * peak[i]
-        idx = np.flatnonzero(active)
-        return float(om[idx[0]]), float(om[idx[-1]])
+        return radiation_band(db["omega"].values, db["radiation_damping"].values, fraction)
 
     def state_space(self, **options):
         """The passive state-space fit of :mod:`hydro.statespace` (cached per options). The fit
