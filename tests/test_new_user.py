@@ -608,3 +608,22 @@ def test_cli_progress_choice(tmp_path, capsys):
     assert "  every coordinate has restoring (at q0)" in out
     assert main(argv) == 0                                   # auto, not a terminal, a short run
     assert "50/50" not in capsys.readouterr().err
+
+
+def test_cli_progress_in_a_log_ends_at_100_percent(tmp_path, capsys, monkeypatch):
+    """`mfm simulate ... 2> log` (issue 35): a bar in a log (refreshed every 10 s) whose steps
+    take less than that, after a compile longer than the bar's delay, ended at its first chunk
+    ("1%"): tqdm's reset moved the start of the delay and close took the bar as never shown.
+    The delay is made 1 ms here (the compile takes longer), the log interval stays 10 s (the
+    250 steps take far less): the last line of the log is the whole run."""
+    import mfm_cli
+
+    monkeypatch.setattr(mfm_cli, "PROGRESS_DELAY_LOG", 1e-3)
+    argv = ["simulate", str(CONFIGS / "double_pendulum.toml"), "--duration", "2.5", "--dt", "0.01",
+            "--no-plot", "--out", str(tmp_path / "dp.nc")]
+    assert mfm_cli.main(argv) == 0                           # auto, stderr is not a terminal
+    err = capsys.readouterr().err
+    shown = [line for line in err.replace("\r", "\n").splitlines() if "/250" in line]
+    assert any("compiled in" in line for line in shown[:-1]), err   # shown after the compile
+    assert " 100%" in shown[-1] and "250/250" in shown[-1], shown
+    assert err.endswith("\n"), repr(err[-80:])              # the bar's line is closed
