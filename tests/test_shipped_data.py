@@ -61,3 +61,41 @@ def test_seas_print_with_units():
     assert str(hydro.Regular(height=2.5, period=8.0)) == "regular wave H 2.5 m, T 8 s"
     assert (str(hydro.Jonswap(hs=2.0, tp=9.0, gamma=3.3, seed=1, heading=math.radians(30.0)))
             == "JONSWAP Hs 2 m, Tp 9 s, γ 3.3, heading 30°, seed 1")
+
+
+def test_a_users_database_still_warns_once_per_process(tmp_path, monkeypatch):
+    """The same RM3 WAMIT files outside hydro/data are a user's database: their three asymmetries
+    warn, once per database per process (a second load of the same file is silent, another copy
+    warns again); `mfm info`'s list of known issues is empty for them and names the three for
+    the shipped file."""
+    import shutil
+    import warnings
+
+    from hydro import database
+    from hydro.database import HydroDatabaseWarning, known_data_issues, validate
+    from hydro.prepare import open_any_database
+
+    monkeypatch.setattr(database, "_WARNED", set())
+    shipped = CONFIGS.parent / "hydro" / "data" / "rm3"
+    copies = []
+    for k in range(2):
+        (tmp_path / str(k)).mkdir()
+        for ext in (".out", ".1", ".3", ".hst"):
+            shutil.copy(shipped / f"rm3{ext}", tmp_path / str(k) / f"rm3{ext}")
+        copies.append(tmp_path / str(k) / "rm3.out")
+    db = open_any_database(copies[0], names=["float", "spar"])     # as configs/rm3.toml names them
+    counts = []
+    for source in (copies[0], copies[0], copies[1], shipped / "rm3.out"):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            validate(db, source=source)
+        counts.append(sum(issubclass(w.category, HydroDatabaseWarning) for w in caught))
+    assert counts == [3, 0, 3, 0]
+    assert known_data_issues(copies[0]) == []
+    assert len(known_data_issues(shipped / "rm3.out")) == 3
+    # a larger asymmetry than documented in the shipped file warns
+    worse = db.copy(deep=True)
+    i, j = (list(worse.influenced_dof.values).index(d) for d in ("float__Sway", "float__Roll"))
+    worse["added_mass_inf"][i, j] = 2 * worse["added_mass_inf"][i, j]
+    with pytest.warns(HydroDatabaseWarning, match=r"added_mass_inf is not symmetric.*float__Sway"):
+        validate(worse, source=shipped / "rm3.out")

@@ -107,6 +107,15 @@ def cmd_info(args):
             loads.append(f"damper {float(model.damping[k]):g} N{' m' if u == 'rad' else ''} s/{u}")
         print(f"  q[{k}] {c} [{u}]" + (f"  ({', '.join(loads)})" if loads else ""))
     print(f"\ntotal mass {float(model.mass.sum()):g} kg")
+    if wet and model.hydro is not None:
+        from hydro.database import known_data_issues
+
+        print(f"\nhydro database {model.hydro.source}")
+        issues = known_data_issues(model.hydro.source)
+        print("  known data issues (not warned at load; every computation uses the symmetric "
+              "part of A, B, A∞):" if issues else "  no known data issues")
+        for line in issues:
+            print("    " + line)
     if args.no_restoring:
         return
 
