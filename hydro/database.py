@@ -103,7 +103,7 @@ def _check_bodies(db, names):
 
 # ----------------------------------------------------------------------------------------- validate
 def validate(db: xr.Dataset, bodies=None, *, sym_rtol: float = 0.05,
-             damping_noise: float = 0.02) -> xr.Dataset:
+             damping_noise: float = 0.02, source=None) -> xr.Dataset:
     """Check `db` against the schema; raise on errors, warn on suspicious data. Returns `db`.
 
     Errors (ValueError / KeyError): a required variable, dimension, coordinate or attribute is
@@ -117,6 +117,12 @@ def validate(db: xr.Dataset, bodies=None, *, sym_rtol: float = 0.05,
       noise of about ±1 % of its peak, hence the default 2 %); the frequency and dof are named.
       Dofs whose damping peak is below 1e-6 of the largest of their kind (translation or
       rotation), e.g. yaw of an axisymmetric body, are noise and not checked.
+
+    Each warning is given once per database per process (a database: its file `source`, or its
+    arrays' content without one), not at every load. A shipped database's documented data issue
+    (:data:`KNOWN_DATA_ISSUES`: the file, the check, the dofs and the measure up to its documented
+    size) is not a warning: the user cannot act on it; ``mfm info`` reports it
+    (:func:`known_data_issues`). A larger measure, another pair or another file still warns.
     """
     if "added_mass_inf" not in db:
         raise ValueError(
@@ -159,11 +165,83 @@ def validate(db: xr.Dataset, bodies=None, *, sym_rtol: float = 0.05,
     _check_finite(db, om)
 
     labels = expected
-    for name in ("added_mass", "radiation_damping", "added_mass_inf"):
-        _warn_asymmetry(name, np.asarray(db[name].values, dtype=float), labels, om, sym_rtol)
-    _warn_negative_damping(np.asarray(db["radiation_damping"].values, dtype=float), labels, om,
-                           damping_noise)
+    found = [_asymmetry(name, np.asarray(db[name].values, dtype=float), labels, om, sym_rtol)
+             for name in ("added_mass", "radiation_damping", "added_mass_inf")]
+    found.append(_negative_damping(np.asarray(db["radiation_damping"].values, dtype=float),
+                                   labels, om, damping_noise))
+    _give_warnings([f for f in found if f is not None], db, source)
     return db
+
+
+# The data issues of the shipped databases that the checks above find, documented (with why they
+# are not fixed) in hydro/data/README.md, "Known warnings": file (relative to hydro/data) ->
+# {(variable, dof_i, dof_j): the measure as measured, rounded up}. Only these (the same file,
+# variable and dofs, a measure no larger) are kept from the warnings; mfm info reports them.
+KNOWN_DATA_ISSUES = {
+    # RM3's WAMIT files (not ours: NREL/Sandia's run; no geometry or mesh to re-solve here):
+    # asymmetry of the float's sway-roll coupling (and the spar-float roll-sway in B). HydroSpec
+    # symmetrises A, B, A∞ (reciprocity) before any use; RM3 runs in head seas (y-plane modes)
+    "rm3/rm3.out": {("added_mass", "float__Sway", "float__Roll"): 0.17,
+                    ("radiation_damping", "spar__Roll", "float__Sway"): 0.5,
+                    ("added_mass_inf", "float__Sway", "float__Roll"): 0.16},
+    # M4 134 (ours, capytaine dx = 0.03 m with lids): an irregular frequency the lid does not
+    # remove, at 19.25 rad/s, 2.5x the highest peak frequency of the seed's seas (Tp >= 0.8 s);
+    # fixing it needs a BEM re-solve (a finer lid), ~hours on 2 cores
+    "m4_134.nc": {("negative_damping", "float7__Heave", "float7__Heave"): 0.022},
+    # the Wu & Yuan databases (ours, capytaine): the WEC's surge-pitch / sway-roll damping
+    # coupling at 1.257 rad/s, unconverged at the mesh used (the symmetric part is what every
+    # computation uses); a finer mesh is a BEM re-solve of the 12-WEC platform, ~hours
+    "wu_yuan_m1.nc": {("radiation_damping", "wec2__Surge", "wec2__Pitch"): 0.12},
+    "wu_yuan_m1_td.nc": {("radiation_damping", "wec6__Surge", "wec6__Pitch"): 0.06},
+    "wu_yuan_m2.nc": {("radiation_damping", "wec11__Sway", "wec11__Roll"): 0.12},
+    "wu_yuan_m3.nc": {("radiation_damping", "wec6__Sway", "wec6__Roll"): 0.12},
+    "wu_yuan_m4.nc": {("radiation_damping", "wec6__Sway", "wec6__Roll"): 0.12},
+    "wu_yuan_m5.nc": {("radiation_damping", "wec3__Surge", "wec3__Pitch"): 0.12},
+    "wu_yuan_wec.nc": {("radiation_damping", "wec__Surge", "wec__Pitch"): 0.12},
+}
+_SHIPPED = Path(__file__).resolve().parent / "data"
+_WARNED: set = set()          # (database, message): each warning once per database per process
+
+
+def _shipped_name(source):
+    """`source`'s path relative to hydro/data, or None for a file elsewhere (or none)."""
+    if source is None:
+        return None
+    try:
+        return Path(source).resolve().relative_to(_SHIPPED).as_posix()
+    except ValueError:
+        return None
+
+
+def known_data_issues(source) -> list[str]:
+    """The documented data issues of the database file `source` (none for a file that is not
+    shipped): one line each, for ``mfm info``."""
+    name = _shipped_name(source)
+    return [(f"radiation_damping of {i} negative, down to -{size:g} of its peak" if
+             var == "negative_damping" else
+             f"{var} asymmetric at ({i}, {j}): |M_ij - M_ji|/sqrt(d_i d_j) up to {size:g}")
+            + " (hydro/data/README.md, Known warnings)"
+            for (var, i, j), size in KNOWN_DATA_ISSUES.get(name, {}).items()]
+
+
+def _give_warnings(found, db, source):
+    # a pair in either order (argmax of a symmetric measure takes (i, j) or (j, i) by dof order)
+    known = {(var, *sorted(ij)): size for (var, *ij), size
+             in KNOWN_DATA_ISSUES.get(_shipped_name(source), {}).items()}
+    if source is not None:
+        key = str(Path(source).resolve())
+    else:
+        import hashlib
+
+        h = hashlib.sha1()
+        for name in ("added_mass", "radiation_damping", "added_mass_inf"):
+            h.update(np.ascontiguousarray(db[name].values, dtype=float).tobytes())
+        key = h.hexdigest()
+    for (var, i, j), size, message in found:
+        if size <= known.get((var, *sorted((i, j))), -1.0) or (key, message) in _WARNED:
+            continue
+        _WARNED.add((key, message))
+        warnings.warn(message, HydroDatabaseWarning, stacklevel=3)   # validate's caller
 
 
 def _check_finite(db, om):
@@ -197,7 +275,8 @@ def _check_finite(db, om):
             f"coefficient must be finite: {fix}.")
 
 
-def _warn_asymmetry(name, M, labels, om, rtol):
+def _asymmetry(name, M, labels, om, rtol):
+    """The largest asymmetry of `M` above `rtol` as ((name, dof_i, dof_j), size, message), or None."""
     M3 = M if M.ndim == 3 else M[None]
     d = np.abs(np.diagonal(M3, axis1=1, axis2=2)).max(axis=0)
     d = np.maximum(d, 1e-12 * max(d.max(), 1e-300))          # keeps zero diagonals (e.g. yaw) finite
@@ -205,14 +284,17 @@ def _warn_asymmetry(name, M, labels, om, rtol):
     k, i, j = np.unravel_index(np.argmax(asym), asym.shape)
     if asym[k, i, j] > rtol:
         where = f" at omega = {om[k]:.4g} rad/s" if M.ndim == 3 else ""
-        warnings.warn(
+        return ((name, labels[i], labels[j]), float(asym[k, i, j]),
             f"{name} is not symmetric: largest |M_ij - M_ji|/sqrt(d_i d_j) = {asym[k, i, j]:.3g} > "
             f"{rtol:g} for ({labels[i]}, {labels[j]}){where}: M_ij = {M3[k, i, j]:.6g}, "
-            f"M_ji = {M3[k, j, i]:.6g}. The BEM data may be unconverged there.",
-            HydroDatabaseWarning, stacklevel=3)
+            f"M_ji = {M3[k, j, i]:.6g}. The BEM data may be unconverged there (every computation "
+            "uses the symmetric part).")
+    return None
 
 
-def _warn_negative_damping(B, labels, om, noise):
+def _negative_damping(B, labels, om, noise):
+    """The most negative damping beyond `noise` as (("negative_damping", dof, dof), −its fraction
+    of the peak, message), or None."""
     diag = np.diagonal(B, axis1=1, axis2=2)                  # (omega, dof)
     peak = np.abs(diag).max(axis=0)
     # a dof whose damping is negligible beside the others of its kind (translation / rotation),
@@ -224,12 +306,12 @@ def _warn_negative_damping(B, labels, om, noise):
     if np.any(bad & (peak[None] > 0)):
         rel = np.where(peak > 0, diag / np.where(peak > 0, peak, 1.0), 0.0)
         k, i = np.unravel_index(np.argmin(rel), rel.shape)
-        warnings.warn(
+        return (("negative_damping", labels[i], labels[i]), float(-rel[k, i]),
             f"radiation_damping diagonal is negative beyond the noise tolerance {noise:g} of its "
             f"peak: B[{labels[i]}] = {diag[k, i]:.4g} at omega = {om[k]:.4g} rad/s "
             f"({rel[k, i]:.3g} of its peak {peak[i]:.4g}). Irregular frequency or unconverged "
-            "mesh? Use a lid / finer mesh, or taper the damping before the impulse response.",
-            HydroDatabaseWarning, stacklevel=3)
+            "mesh? Use a lid / finer mesh, or taper the damping before the impulse response.")
+    return None
 
 
 # ------------------------------------------------------------------------------------ NetCDF I/O

@@ -49,7 +49,7 @@ class HydroSpec:
         self.body_index = tuple(int(i) for i in body_index)
         self.body_coupling = bool(body_coupling)
         self.source = source
-        validate(db)
+        validate(db, source=source or None)
         self.rho = float(db.attrs["rho"])
         self.g = float(db.attrs["g"])
         self.water_depth = float(db.attrs.get("water_depth", math.inf))

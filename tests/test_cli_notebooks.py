@@ -63,5 +63,36 @@ def run_in_smoke_mode(path, monkeypatch):
     # points at (another worktree's code would be tested otherwise)
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
     nb = nbformat.read(path, as_version=4)
+    stored = stored_outputs(nb)
     NotebookClient(nb, timeout=900, kernel_name="python3",
                    resources={"metadata": {"path": str(path.parent)}}).execute()
+    # issue 35: a notebook's stored numbers went stale (quickstart's natural frequencies). The
+    # cells tagged "compare-output" print numbers that the smoke mode does not change: their
+    # fresh stdout must be their stored stdout, as text (the numbers as printed, rounded by the
+    # cell itself). A line the smoke mode changes on purpose is excluded by its cell's metadata
+    # "smoke_changes" {line prefix: why}.
+    fresh = stored_outputs(nb)
+    for k, text in stored.items():
+        assert fresh[k] == text, (f"{path.name} cell {k}: stored output {text!r}, a fresh run "
+                                  f"gives {fresh[k]!r}; re-run the cell and save the notebook")
+
+
+def stored_outputs(nb) -> dict[int, list[str]]:
+    """The stdout lines of the cells tagged "compare-output" (by cell index), less the lines the
+    cell's "smoke_changes" metadata excludes."""
+    out = {}
+    for k, cell in enumerate(nb.cells):
+        if "compare-output" not in cell.get("metadata", {}).get("tags", []):
+            continue
+        skip = tuple(cell.metadata.get("smoke_changes", {}))
+        text = "".join(o.get("text", "") for o in cell.get("outputs", [])
+                       if o.get("output_type") == "stream" and o.get("name") == "stdout")
+        out[k] = [l for l in text.splitlines() if not (skip and l.startswith(skip))]
+    return out
+
+
+def test_stored_outputs_are_compared():
+    """The comparison above is not vacuous: the quickstart has tagged cells with stored numbers."""
+    nb = nbformat.read(ROOT / "notebooks" / "quickstart.ipynb", as_version=4)
+    stored = stored_outputs(nb)
+    assert stored and all(any(c.isdigit() for l in v for c in l) for v in stored.values()), stored

@@ -608,3 +608,54 @@ def test_cli_progress_choice(tmp_path, capsys):
     assert "  every coordinate has restoring (at q0)" in out
     assert main(argv) == 0                                   # auto, not a terminal, a short run
     assert "50/50" not in capsys.readouterr().err
+
+
+def test_cli_progress_in_a_log_ends_at_100_percent(tmp_path, capsys, monkeypatch):
+    """`mfm simulate ... 2> log` (issue 35): a bar in a log (refreshed every 10 s) whose steps
+    take less than that, after a compile longer than the bar's delay, ended at its first chunk
+    ("1%"): tqdm's reset moved the start of the delay and close took the bar as never shown.
+    The delay is made 1 ms here (the compile takes longer), the log interval stays 10 s (the
+    250 steps take far less): the last line of the log is the whole run."""
+    import mfm_cli
+
+    monkeypatch.setattr(mfm_cli, "PROGRESS_DELAY_LOG", 1e-3)
+    argv = ["simulate", str(CONFIGS / "double_pendulum.toml"), "--duration", "2.5", "--dt", "0.01",
+            "--no-plot", "--out", str(tmp_path / "dp.nc")]
+    assert mfm_cli.main(argv) == 0                           # auto, stderr is not a terminal
+    err = capsys.readouterr().err
+    shown = [line for line in err.replace("\r", "\n").splitlines() if "/250" in line]
+    assert any("compiled in" in line for line in shown[:-1]), err   # shown after the compile
+    assert " 100%" in shown[-1] and "250/250" in shown[-1], shown
+    assert err.endswith("\n"), repr(err[-80:])              # the bar's line is closed
+
+
+def test_readme_double_pendulum_command_moves_and_a_run_at_rest_says_why(tmp_path, capsys):
+    """The README's `mfm simulate configs/double_pendulum.toml ...` line (issue 35: the config
+    has no initial condition, the config format has none, so the example must give one) swings:
+    run as written but for --duration (2 s, about one period of the 1 m rods) and --out, its upper
+    angle has a spread over the run of more than a tenth of the 1 rad start. Without --initial the
+    run stays at q = 0 (an equilibrium, still water) and the summary says so and names the option."""
+    import re
+    import shlex
+
+    import xarray as xr
+
+    from mfm_cli import main
+
+    readme = (ROOT / "README.md").read_text().replace("\\\n", " ")
+    line = next(l for l in readme.splitlines() if l.startswith("mfm simulate configs/double_pendulum"))
+    argv = shlex.split(line.split("#")[0])[1:]
+    assert "--initial" in argv, line
+    argv[argv.index("--duration") + 1] = "2"
+    argv[argv.index("--out") + 1] = str(tmp_path / "run.nc")
+    argv[1] = str(ROOT / argv[1])
+    assert main(argv + ["--no-plot", "--progress", "off"]) == 0
+    out = capsys.readouterr().out
+    assert "stayed at rest" not in out
+    with xr.open_dataset(tmp_path / "run.nc") as ds:
+        assert float(ds.q.sel(coordinate="upper.angle").std()) > 0.1, out
+    assert main(["simulate", argv[1], "--duration", "0.5", "--no-plot", "--progress", "off",
+                 "--out", str(tmp_path / "rest.nc")]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"stayed at rest .*no --initial or --initial-velocity.*"
+                     r"e\.g\. --initial upper\.angle=0\.5 \(rad\)", out), out

@@ -61,3 +61,83 @@ def test_seas_print_with_units():
     assert str(hydro.Regular(height=2.5, period=8.0)) == "regular wave H 2.5 m, T 8 s"
     assert (str(hydro.Jonswap(hs=2.0, tp=9.0, gamma=3.3, seed=1, heading=math.radians(30.0)))
             == "JONSWAP Hs 2 m, Tp 9 s, γ 3.3, heading 30°, seed 1")
+
+
+SHIPPED_CONFIGS = sorted(CONFIGS.glob("*.toml")) + sorted((CONFIGS / "sensitivity").glob("*.toml"))
+# the warnings a shipped config may give on load and a short run: those a user can act on. None
+# today: the database issues of the shipped files are documented (hydro/data/README.md, Known
+# warnings) and listed by `mfm info`, not warned
+DOCUMENTED_WARNINGS: tuple[str, ...] = ()
+
+
+# the configs whose short run still warns (issue 35, item 3, left to do): "the omega grid is too
+# coarse for a memory length T_K" (hydro/radiation.py: every capytaine database's grid, 0.03-0.25
+# rad/s, against pi/T_K = 0.009-0.14 rad/s) and "K(t) rings from the truncation of B" (hallak_fowt,
+# stansby_li, wu_yuan_m4: 1-1.5 % of max|K|); measured with this test on 2 shared cores.
+# strict: a config that stops warning fails here until it is taken off this list
+STILL_WARN = {"hallak_fowt", "hallak_fwwp", "hallak_hydro_coupled", "m4_111", "m4_132", "m4_134",
+              "stansby_li", "wu_yuan_m1", "wu_yuan_m1_td", "wu_yuan_m2", "wu_yuan_m3",
+              "wu_yuan_m4", "wu_yuan_m5", "wu_yuan_wec", "m4_111_spacing080",
+              "m4_111_stern_hemisphere", "m4_134_spacing080"}
+
+
+@pytest.mark.slow            # ~25 min on 2 shared cores: a compile of every shipped config
+@pytest.mark.parametrize("config", [
+    pytest.param(p, marks=pytest.mark.xfail(strict=True, reason="issue 35: radiation warnings "
+                                            "(coarse omega grid, K(t) ringing) not yet handled"))
+    if p.stem in STILL_WARN else p for p in SHIPPED_CONFIGS], ids=lambda p: p.stem)
+def test_shipped_config_loads_and_runs_without_warnings(config, monkeypatch):
+    """Issue 35: a warning on every run of shipped data is noise that hides the ones that matter.
+    Load each shipped config (its database validated afresh: the once-per-process memory of given
+    warnings emptied) and run it 5 steps in still water (the radiation's preparation included)."""
+    import warnings
+
+    from hydro import database
+
+    monkeypatch.setattr(database, "_WARNED", set())
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        m = mfm.load(config)
+        mfm.simulate(m, None, duration=0.05 if m.hydro is None else 0.5, dt=0.01 if m.hydro is None
+                     else 0.1, check_stability=False)
+    unexpected = [f"{w.category.__name__}: {w.message}" for w in caught
+                  if not any(d in str(w.message) for d in DOCUMENTED_WARNINGS)]
+    assert not unexpected, unexpected
+
+
+def test_a_users_database_still_warns_once_per_process(tmp_path, monkeypatch):
+    """The same RM3 WAMIT files outside hydro/data are a user's database: their three asymmetries
+    warn, once per database per process (a second load of the same file is silent, another copy
+    warns again); `mfm info`'s list of known issues is empty for them and names the three for
+    the shipped file."""
+    import shutil
+    import warnings
+
+    from hydro import database
+    from hydro.database import HydroDatabaseWarning, known_data_issues, validate
+    from hydro.prepare import open_any_database
+
+    monkeypatch.setattr(database, "_WARNED", set())
+    shipped = CONFIGS.parent / "hydro" / "data" / "rm3"
+    copies = []
+    for k in range(2):
+        (tmp_path / str(k)).mkdir()
+        for ext in (".out", ".1", ".3", ".hst"):
+            shutil.copy(shipped / f"rm3{ext}", tmp_path / str(k) / f"rm3{ext}")
+        copies.append(tmp_path / str(k) / "rm3.out")
+    db = open_any_database(copies[0], names=["float", "spar"])     # as configs/rm3.toml names them
+    counts = []
+    for source in (copies[0], copies[0], copies[1], shipped / "rm3.out"):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            validate(db, source=source)
+        counts.append(sum(issubclass(w.category, HydroDatabaseWarning) for w in caught))
+    assert counts == [3, 0, 3, 0]
+    assert known_data_issues(copies[0]) == []
+    assert len(known_data_issues(shipped / "rm3.out")) == 3
+    # a larger asymmetry than documented in the shipped file warns
+    worse = db.copy(deep=True)
+    i, j = (list(worse.influenced_dof.values).index(d) for d in ("float__Sway", "float__Roll"))
+    worse["added_mass_inf"][i, j] = 2 * worse["added_mass_inf"][i, j]
+    with pytest.warns(HydroDatabaseWarning, match=r"added_mass_inf is not symmetric.*float__Sway"):
+        validate(worse, source=shipped / "rm3.out")

@@ -107,6 +107,15 @@ def cmd_info(args):
             loads.append(f"damper {float(model.damping[k]):g} N{' m' if u == 'rad' else ''} s/{u}")
         print(f"  q[{k}] {c} [{u}]" + (f"  ({', '.join(loads)})" if loads else ""))
     print(f"\ntotal mass {float(model.mass.sum()):g} kg")
+    if wet and model.hydro is not None:
+        from hydro.database import known_data_issues
+
+        print(f"\nhydro database {model.hydro.source}")
+        issues = known_data_issues(model.hydro.source)
+        print("  known data issues (not warned at load; every computation uses the symmetric "
+              "part of A, B, A∞):" if issues else "  no known data issues")
+        for line in issues:
+            print("    " + line)
     if args.no_restoring:
         return
 
@@ -188,11 +197,37 @@ def cmd_simulate(args):
         for p in ds.pto.values:
             print(f"  mean power of {p}: {float(half.pto_power.sel(pto=p).mean()):.6g} W")
     print("  " + _restoring_text(ds.attrs.get("no_restoring", "not checked")))
+    if sea is None and _at_rest(ds):
+        print("  " + _at_rest_text(model, args))
     if not args.no_plot:
         from .plotting import save_result_plot
 
         save_result_plot(ds, png)
         print(f"  figure -> {png}")
+
+
+# a run whose every coordinate and rate stays within this of zero (m, rad, m/s, rad/s) stayed at
+# rest: float64 round-off about an exact equilibrium is ~1e-16, the smallest motion a user asks
+# for (a mm, a mrad) is ~1e-3
+AT_REST = 1e-9
+
+
+def _at_rest(ds) -> bool:
+    """Whether a run never left its start at rest (q and q̇ within :data:`AT_REST` of zero)."""
+    import numpy as np
+
+    return bool(np.nanmax(np.abs(ds.q.values), initial=0.0) < AT_REST
+                and np.nanmax(np.abs(ds.qd.values), initial=0.0) < AT_REST)
+
+
+def _at_rest_text(model, args) -> str:
+    """Why a still-water run printed zeros, and the option that makes it move."""
+    given = "--initial/--initial-velocity of 0" if (args.initial or args.initial_velocity) else \
+        "no --initial or --initial-velocity"
+    c = model.coordinates[0]
+    return (f"the run stayed at rest (every coordinate within {AT_REST:g} of 0): still water, "
+            f"{given}, and q0 = 0 is an equilibrium of this config; start it away from rest, "
+            f"e.g. --initial {c}=0.5 ({_unit(c)}), or give a sea (--wave)")
 
 
 def _restoring_text(no_restoring: str) -> str:

@@ -4,6 +4,7 @@ same numbers as the run in one call."""
 from __future__ import annotations
 
 import sys
+import threading
 import time
 
 import jax
@@ -40,15 +41,51 @@ def progress_bar(options, total, desc):
     from tqdm.auto import tqdm
 
     try:
-        return tqdm(**{"total": total, "unit": "step", "desc": desc, "file": sys.stderr, **options})
+        bar = tqdm(**{"total": total, "unit": "step", "desc": desc, "file": sys.stderr, **options})
     except (TypeError, KeyError) as e:     # tqdm's TqdmKeyError for an unknown option
         raise ValueError(f"progress: {options!r} is not a set of tqdm options ({e})") from None
+    if bar.delay > 0:
+        # a phase said before the end of the delay is not shown then (see _say): show it at that
+        # end, else a minute's radiation fit would show no bar until its end
+        timer = threading.Timer(bar.delay, lambda: bar.disable or bar.refresh())
+        timer.daemon = True
+        timer.start()
+    return bar
+
+
+def _due(bar) -> bool:
+    """Whether ``bar`` is past its ``delay`` (tqdm's option: no bar for a run shorter than that)."""
+    return bar._time() >= bar.start_t + bar.delay
+
+
+def _say(bar, what: str):
+    """Put ``what`` after the bar, shown now only once the bar is past its delay (tqdm's own
+    ``set_postfix_str`` shows it at once, delay or not: a short run in a log got a bar)."""
+    bar.set_postfix_str(what, refresh=False)
+    if _due(bar):
+        bar.refresh()
 
 
 def phase(bar, what: str):
     """Say on ``bar`` (or nowhere, for None) which phase of the preparation is under way."""
     if bar is not None:
-        bar.set_postfix_str(what)
+        _say(bar, what)
+
+
+def _restart(bar, n: int):
+    """Count ``bar``'s rate, elapsed time and ETA from now, at ``n`` steps done (the compilation,
+    seconds to a minute, would else show as slow steps and a far-off ETA). tqdm's ``reset``
+    would also move the start of the ``delay`` to now, and ``close`` would then take a bar shown
+    before as never shown and leave it at its last refresh: in a log (``mininterval`` 10 s) the
+    bar of a run whose steps take less than that stayed at the first chunk, "1 %". Here the
+    delay keeps its end (the time left of it, none once passed)."""
+    from tqdm.std import EMA
+
+    now = bar._time()
+    bar.delay = max(0.0, bar.start_t + bar.delay - now)
+    bar.start_t = bar.last_print_t = now
+    bar.initial = bar.n = bar.last_print_n = n
+    bar._ema_dn, bar._ema_dt, bar._ema_miniters = (EMA(bar.smoothing) for _ in range(3))
 
 
 def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis):
@@ -58,7 +95,7 @@ def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis):
     finds where). Returns the saved outputs as numpy, the initial state first, as the unchunked
     rollout does: the same compiled steps in the same order, so the same numbers."""
     c, n_chunks = chunk_plan(n_blocks)
-    bar.set_postfix_str("compiling")
+    _say(bar, "compiling")
     began = time.perf_counter()
     carry, first = start()
     pieces = [jax.tree_util.tree_map(lambda a: np.expand_dims(np.asarray(a), time_axis), first)]
@@ -75,13 +112,14 @@ def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis):
                 # the first chunk compiled: rate, elapsed and ETA count from here, else the
                 # compilation (seconds to a minute) shows as slow steps and a far-off ETA
                 compiled = time.perf_counter() - began
-                bar.reset(total=bar.total)
-                bar.initial = bar.n = bar.last_print_n = take * save_every
-                bar.set_postfix_str(f"compiled in {compiled:.0f} s")
+                _restart(bar, take * save_every)
+                _say(bar, f"compiled in {compiled:.0f} s")
             else:
                 bar.update(take * save_every)
             if not (np.isfinite(traj[1]).all() and np.isfinite(traj[2]).all()):
                 break
     finally:
+        # the last count is shown, whatever ``mininterval`` held back (close shows it only for
+        # a bar past its delay: a run shorter than that shows none)
         bar.close()
     return jax.tree_util.tree_map(lambda *a: np.concatenate(a, axis=time_axis), *pieces)
