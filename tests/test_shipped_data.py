@@ -63,48 +63,6 @@ def test_seas_print_with_units():
             == "JONSWAP Hs 2 m, Tp 9 s, γ 3.3, heading 30°, seed 1")
 
 
-SHIPPED_CONFIGS = sorted(CONFIGS.glob("*.toml")) + sorted((CONFIGS / "sensitivity").glob("*.toml"))
-# the warnings a shipped config may give on load and a short run: those a user can act on. None
-# today: the database issues of the shipped files are documented (hydro/data/README.md, Known
-# warnings) and listed by `mfm info`, not warned
-DOCUMENTED_WARNINGS: tuple[str, ...] = ()
-
-
-# the configs whose short run still warns (issue 35, item 3, left to do): "the omega grid is too
-# coarse for a memory length T_K" (hydro/radiation.py: every capytaine database's grid, 0.03-0.25
-# rad/s, against pi/T_K = 0.009-0.14 rad/s) and "K(t) rings from the truncation of B" (hallak_fowt,
-# stansby_li, wu_yuan_m4: 1-1.5 % of max|K|); measured with this test on 2 shared cores.
-# strict: a config that stops warning fails here until it is taken off this list
-STILL_WARN = {"hallak_fowt", "hallak_fwwp", "hallak_hydro_coupled", "m4_111", "m4_132", "m4_134",
-              "stansby_li", "wu_yuan_m1", "wu_yuan_m1_td", "wu_yuan_m2", "wu_yuan_m3",
-              "wu_yuan_m4", "wu_yuan_m5", "wu_yuan_wec", "m4_111_spacing080",
-              "m4_111_stern_hemisphere", "m4_134_spacing080"}
-
-
-@pytest.mark.slow            # ~25 min on 2 shared cores: a compile of every shipped config
-@pytest.mark.parametrize("config", [
-    pytest.param(p, marks=pytest.mark.xfail(strict=True, reason="issue 35: radiation warnings "
-                                            "(coarse omega grid, K(t) ringing) not yet handled"))
-    if p.stem in STILL_WARN else p for p in SHIPPED_CONFIGS], ids=lambda p: p.stem)
-def test_shipped_config_loads_and_runs_without_warnings(config, monkeypatch):
-    """Issue 35: a warning on every run of shipped data is noise that hides the ones that matter.
-    Load each shipped config (its database validated afresh: the once-per-process memory of given
-    warnings emptied) and run it 5 steps in still water (the radiation's preparation included)."""
-    import warnings
-
-    from hydro import database
-
-    monkeypatch.setattr(database, "_WARNED", set())
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        m = mfm.load(config)
-        mfm.simulate(m, None, duration=0.05 if m.hydro is None else 0.5, dt=0.01 if m.hydro is None
-                     else 0.1, check_stability=False)
-    unexpected = [f"{w.category.__name__}: {w.message}" for w in caught
-                  if not any(d in str(w.message) for d in DOCUMENTED_WARNINGS)]
-    assert not unexpected, unexpected
-
-
 def test_a_users_database_still_warns_once_per_process(tmp_path, monkeypatch):
     """The same RM3 WAMIT files outside hydro/data are a user's database: their three asymmetries
     warn, once per database per process (a second load of the same file is silent, another copy
