@@ -162,7 +162,7 @@ class ExcitationTable:
     (n_ω, n_β, n_dof) sorted by ω and β, the heading grid closed around the circle where the
     database covers it (see the module docstring). Made once per database and reused for every
     sea state (a batch of thousands of cases interpolates its components in one call,
-    :meth:`coefficients_many`, instead of sorting the dataset again per case)."""
+    :meth:`brackets_many`, instead of sorting the dataset again per case)."""
 
     def __init__(self, db: xr.Dataset, dofs=None, periodic_heading: bool | None = None):
         X, omega, beta, labels = _excitation_table(db, dofs)
@@ -256,18 +256,6 @@ class ExcitationTable:
             raise
         cut = np.cumsum([len(c) for c in cs])[:-1]
         return np.split(outside, cut), tuple(np.split(a, cut) for a in br)
-
-    def coefficients_many(self, components, *, drop_energy_fraction: float = 1e-3) -> list:
-        """:meth:`coefficients` of each of a sequence of components, interpolated in one call
-        (it is elementwise: the same numbers as case by case). A list of complex128
-        (n_comp_i, n_dof)."""
-        outside, br = self.brackets_many(components, drop_energy_fraction=drop_energy_fraction)
-        if not outside:
-            return []
-        out = polar_interpolation(np, self.polar, *(np.concatenate(a) for a in br),
-                                  one_heading=self.beta.shape[0] == 1)
-        out[np.concatenate(outside)] = 0.0
-        return np.split(out, np.cumsum([len(o) for o in outside])[:-1])
 
 
 def excitation_coefficients(db: xr.Dataset, components: WaveComponents, *, dofs=None,

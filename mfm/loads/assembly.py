@@ -49,7 +49,7 @@ class CaseLoads:
     ``batched`` (a pytree of bools like it) carry a leading case axis of length ``size``, the
     others shared by every case (:func:`carried_loads_batch`). With water, ``waves`` (a
     :class:`~mfm.loads.water.WaveSum` over the cases) makes the water's tables, which ``loads``
-    leaves out (None) until :meth:`with_tables` puts them in."""
+    leaves out (None); :meth:`with_eta` puts the elevation in for the dataset."""
     loads: tuple
     batched: tuple
     size: int
@@ -64,22 +64,15 @@ class CaseLoads:
         if self.waves is not None and loads[0].exc_values is None:
             exc, eta = jax.tree_util.tree_map(lambda a: a[i], self.waves).tables_numpy(
                 tuple(np.asarray(a) for a in self.polar))
-            loads = (self._filled(loads[0], exc, eta),) + tuple(loads[1:])
+            loads = (dataclasses.replace(loads[0], exc_values=exc, eta_values=eta),) \
+                + tuple(loads[1:])
         return loads
 
-    @staticmethod
-    def _filled(water, exc, eta):
-        """``water`` with the tables that are not None put in (its fields were None)."""
-        # dataclasses.replace, not eqx.tree_at: a None is not told apart from another None
-        return dataclasses.replace(water, **{f: v for f, v in (("exc_values", exc),
-                                                             ("eta_values", eta)) if v is not None})
-
-    def with_tables(self, exc=None, eta=None) -> "CaseLoads":
-        """These loads with the water's tables put in, with their case axis: exc (B, n, n_dof),
-        eta (B, n); either may be None (left out)."""
-        water = self._filled(self.loads[0], exc, eta)
-        mask = self._filled(self.batched[0], None if exc is None else True,
-                            None if eta is None else True)
+    def with_eta(self, eta) -> "CaseLoads":
+        """These loads with the water's elevation table put in, with its case axis (B, n): what
+        the dataset reads of the tables (:meth:`batch_outputs`)."""
+        water = dataclasses.replace(self.loads[0], eta_values=eta)
+        mask = dataclasses.replace(self.batched[0], eta_values=True)
         return dataclasses.replace(self, loads=(water,) + self.loads[1:],
                                    batched=(mask,) + self.batched[1:])
 

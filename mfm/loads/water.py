@@ -32,8 +32,8 @@ force Hᵀ X(ω, β).
 """
 from __future__ import annotations
 
-import warnings
 import os
+import warnings
 from pathlib import Path
 
 import equinox as eqx
@@ -433,8 +433,8 @@ class WaveSum(eqx.Module):
         """(exc (n_grid, n_dof), eta (n_grid,)) of one case, in jax: the uniform-grid form of
         :func:`hydro.waves._harmonic_sum` (e^{−iω(t0 + (aK + b)h)} = e^{−iω b h} · e^{−iω(t0 + aKh)}:
         sines and cosines of K × n_c and n_blocks × n_c phases, each from its own product ω·time,
-        then real matrix products), so
-        the numbers equal build_water's numpy tables to round-off."""
+        then real matrix products), so the numbers equal build_water's numpy tables to
+        round-off."""
         c_re, c_im = self.coefficients(polar)
         # blocks of 256 rows, as the numpy route (fewer rows per block make the sines and cosines
         # fewer, (K + n/K) × n_c, but the matrix products slower: K = √n measured 1.7–1.9× slower
@@ -578,16 +578,22 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
     from ..errors import ConfigError
 
     path = Path(options["database"])
-    if not path.is_absolute():
+    relative = not path.is_absolute()
+    if relative:
         path = Path(config_dir) / path
-        stem = path.with_suffix("") if path.suffix in (".out", ".1", ".3", ".hst") else path
-        if not (path.exists() or stem.with_suffix(".out").exists()):
-            raise FileNotFoundError(
-                f"hydro.database: {options['database']!r} is relative to the config's folder "
-                f"{str(config_dir)!r}: {os.path.normpath(path)!r} not found (a config copied to "
-                "another folder keeps its relative path); give the path from the config's folder, "
-                "an absolute path, or copy the database beside the config")
-    db = open_any_database(path, names=options.get("names"), rho=options.get("rho"), g=options.get("g"))
+    try:
+        db = open_any_database(path, names=options.get("names"), rho=options.get("rho"),
+                               g=options.get("g"))
+    except FileNotFoundError:
+        # open_any_database knows every form a database takes (a WAMIT stem among them); where it
+        # finds none and the path itself is missing, say what the path is relative to
+        if not relative or path.exists():
+            raise
+        raise FileNotFoundError(
+            f"hydro.database: {options['database']!r} is relative to the config's folder "
+            f"{str(config_dir)!r}: {os.path.normpath(path)!r} not found (a config copied to "
+            "another folder keeps its relative path); give the path from the config's folder, "
+            "an absolute path, or copy the database beside the config") from None
     available = [str(b) for b in db["body"].values]
     tagged = [(b.name, b.extra["hydro"]) for b in bodies if "hydro" in b.extra]
     if tagged:

@@ -250,7 +250,8 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
             if waves is None:
                 return part, None
             exc, eta = _tables(waves, cases.polar, g)
-            return (CaseLoads._filled(part[0], exc, eta),) + tuple(part[1:]), eta
+            return (dataclasses.replace(part[0], exc_values=exc, eta_values=eta),) \
+                + tuple(part[1:]), eta
 
         model_of = lambda g: model_view  # noqa: E731
         model_axis = None
@@ -333,7 +334,7 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
                            time_axis=1)
     if isinstance(loads, CaseLoads) and loads.waves is not None:
         # the elevation for the dataset, from the tables the device made
-        loads = loads.with_tables(eta=np.concatenate([np.asarray(e) for e in etas])[:B])
+        loads = loads.with_eta(np.concatenate([np.asarray(e) for e in etas])[:B])
     t, q, qd = (np.asarray(a) for a in out[:3])
     for i in range(B):
         if not (np.isfinite(q[i]).all() and np.isfinite(qd[i]).all()):
