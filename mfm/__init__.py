@@ -38,6 +38,7 @@ from .frequency.linear import linear_response  # noqa: E402
 from .studies.fidelity import reduce  # noqa: E402
 from .errors import ConfigError, SweepError  # noqa: E402
 from .studies.sweep import sweep  # noqa: E402
+from .studies.optimize import optimize  # noqa: E402
 from . import _compat  # noqa: E402
 
 _compat.install()
@@ -54,5 +55,5 @@ __all__ = ["AccuracyWarning", "ConfigError", "Model", "PerformanceWarning", "Sea
            "energies", "equilibrium", "evaluate", "floquet", "forward_dynamics", "frequency",
            "frequency_response", "integrators", "kinematics", "largest_stable_dt",
            "linear_response", "load", "loads", "mass_matrix", "model_loads",
-           "natural_frequencies", "reaction_loads", "reduce", "results", "rollout", "simulate",
+           "natural_frequencies", "optimize", "reaction_loads", "reduce", "results", "rollout", "simulate",
            "simulate_batch", "spectral_response", "sweep"]

@@ -43,3 +43,13 @@ class StabilityWarning(UserWarning):
 class AccuracyWarning(UserWarning):
     """The run's accuracy is in doubt: dt too coarse for the periods the sea excites (the expected
     period error is given), or a coordinate without restoring integrated by Verlet (it drifts)."""
+
+
+class OptimizeError(ValueError):
+    """:func:`mfm.optimize` stopped: the objective or a constraint went non-finite, or the
+    constraints cannot be met within the bounds. ``last_good`` the last parameter values (name →
+    value) where everything was finite, or None."""
+
+    def __init__(self, message, last_good=None):
+        super().__init__(message)
+        self.last_good = last_good

@@ -522,3 +522,74 @@ def with_natural_frequencies(ds, nat, config):
     ds.attrs["natural_frequencies_min_det"] = np.array2string(nat["min_det"].values, precision=5)
     ds.attrs["config"] = str(config)
     return ds
+
+
+def optimum(model, loads, seas, *, labels, units, optimum, baseline, lower, upper, at_bound,
+            gradient, objective, objective_baseline, limits, con_opt, con_base, pto_names, power,
+            power_base, q_rms, iterations, evaluations, gradient_norm, confirm, settings,
+            start) -> xr.Dataset:
+    """The dataset of :func:`mfm.studies.optimize.optimize`: the optimum over ``parameter``, the
+    constraints over ``constraint`` (their largest value over the seas), the spectral responses
+    at the optimum and the baseline over (case, pto) and (case, coordinate), the time-domain
+    confirmation when asked; provenance with ``settings`` and the wall time since ``start``."""
+    B = len(seas)
+    con_labels = [f"{lm.kind}({lm.quantity})" for lm in limits]
+    gain = (objective - objective_baseline) / abs(objective_baseline) if objective_baseline else np.nan
+    data = {
+        "optimum": (("parameter",), optimum, {"long_name": "optimal value"}),
+        "baseline": (("parameter",), baseline, {"long_name": "the model's own value"}),
+        "lower": (("parameter",), lower, {"long_name": "lower bound"}),
+        "upper": (("parameter",), upper, {"long_name": "upper bound"}),
+        "parameter_unit": (("parameter",), np.array(units, dtype=object).astype(str)),
+        "at_bound": (("parameter",), np.asarray(at_bound).astype(str),
+                     {"long_name": "the bound that holds the optimum ('' for none)"}),
+        "gradient": (("parameter",), gradient,
+                     {"long_name": "derivative of the objective at the optimum",
+                      "units": "objective units per parameter unit"}),
+        "objective": ((), objective, {"long_name": "objective at the optimum",
+                                      "units": "W (mean absorbed power) or the user's"}),
+        "objective_baseline": ((), objective_baseline,
+                               {"long_name": "objective at the model's own values"}),
+        "gain": ((), gain, {"long_name": "relative gain over the baseline", "units": "1"}),
+        "constraint_value": (("constraint",), con_opt.max(axis=1) if len(limits) else np.zeros(0),
+                             {"long_name": "largest value over the seas at the optimum",
+                              "units": "m or rad"}),
+        "constraint_value_baseline": (("constraint",),
+                                      con_base.max(axis=1) if len(limits) else np.zeros(0),
+                                      {"units": "m or rad"}),
+        "constraint_limit": (("constraint",), np.array([lm.limit for lm in limits]),
+                             {"units": "m or rad"}),
+        "constraint_active": (("constraint",),
+                              (con_opt.max(axis=1) >= np.array([lm.limit for lm in limits])
+                               * (1 - 1e-4)) if len(limits) else np.zeros(0, bool),
+                              {"long_name": "the limit holds the optimum (within 1e-4 of it)"}),
+        "pto_power_mean": (("case", "pto"), power,
+                           {"long_name": "expected mean power at the optimum, Σ a² ½ c ω² |G x|²",
+                            "units": "W"}),
+        "pto_power_mean_baseline": (("case", "pto"), power_base, {"units": "W"}),
+        "q_rms": (("case", "coordinate"), q_rms,
+                  {"long_name": "standard deviation about the equilibrium at the optimum",
+                   "units": "m or rad (per coordinate: coordinate_unit)"}),
+        "iterations": ((), iterations), "evaluations": ((), evaluations),
+        "gradient_norm": ((), gradient_norm,
+                          {"long_name": "norm of the projected gradient of objective/|baseline| "
+                           "on parameters scaled to [0, 1] by their bounds"}),
+    }
+    if confirm is not None:
+        data.update(
+            time_domain_power=(("case",), confirm["power"].sum(axis=1),
+                               {"long_name": "mean power of every PTO in the time domain at the "
+                                "optimum, after the settling time", "units": "W"}),
+            time_domain_objective=((), confirm["objective"], {"units": "W"}),
+            time_domain_relative_difference=((), confirm["relative_difference"],
+                                             {"long_name": "(time domain − spectral) / spectral"}))
+        settings = dict(settings, time_domain_settle_s=confirm["settle_s"],
+                        time_domain_options=confirm["options"])
+    coords = {"parameter": list(labels), "constraint": con_labels, "case": np.arange(B),
+              "pto": list(pto_names), **_coordinate_coords(model)}
+    ds = xr.Dataset(data, coords=coords)
+    ds = label_cases(ds, sea_labels(seas))
+    ds.attrs = {"title": f"mfm optimum of {model.name} in {B} sea states",
+                **provenance(model, loads, **settings, wall_time_s=time.perf_counter() - start),
+                "source": model.hydro.source}
+    return ds

@@ -7,6 +7,7 @@ fairlead couples surge and pitch (K = k [[1, ℓ], [ℓ, ℓ²]] for a lever ℓ
 """
 from __future__ import annotations
 
+import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
@@ -21,6 +22,9 @@ class PointSprings(Load):
     (:class:`~mfm.mechanics.points.BodyPoints`, p₀ = their positions at q = 0); ``stiffness`` (m, 3) N/m."""
     points: BodyPoints
     stiffness: jnp.ndarray
+    # the config's names of the springs (what mfm.optimize calls "<name>.kx"); static, read by
+    # the host only
+    names: tuple[str, ...] = eqx.field(static=True, default=())
 
     def evaluate(self, ctx):
         f = -self.stiffness * (self.points.positions(ctx.kin) - self.points.ref0)
@@ -48,4 +52,5 @@ class PointSprings(Load):
     def from_parsed(cls, parsed, model):
         return cls(points=BodyPoints.on_bodies(model.com, [model.body_index(m["body"]) for m in parsed],
                                                [m["point"] for m in parsed]),
-                   stiffness=jnp.asarray(np.stack([m["stiffness"] for m in parsed])))
+                   stiffness=jnp.asarray(np.stack([m["stiffness"] for m in parsed])),
+                   names=tuple(m["name"] for m in parsed))

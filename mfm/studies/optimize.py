@@ -1,0 +1,739 @@
+"""Design by gradient: the PTO, mooring and ballast values that maximise an objective of a model's
+response, with exact derivatives of the very linearisation the engine simulates.
+
+The spectral level (:mod:`mfm.frequency.spectral`) written as one pure jax function of the design
+parameters θ. For each sea s with components a_sj at (ω_j, β_j) (the union of every sea's pairs):
+
+    q₀(θ):  Q(q₀, 0; θ) = 0                        (the static equilibrium; implicit derivative)
+    M, K, C at q₀(θ)                               (the jet of :mod:`mfm.frequency.rest`)
+    Z_j(θ) = −ω_j² M − iω_j (C + C_drag,s) + K + Hᵀ[−ω_j²(A(ω_j) − A∞) − iω_j B(ω_j)]H
+    x̂_sj = Z_j⁻¹ Hᵀ X(ω_j, β_j)                    (RAO per metre, H = H(q₀(θ)))
+    P_s = Σ_p Σ_j a_sj² ½ c_p ω_j² |G_p x̂_sj|²      (mean power of each PTO p, rate ẇ = G_p q̇)
+    σ_{q,s}² = Σ_j ½ a_sj² |x̂_sj|²                  (variance of each coordinate; of a stroke with G)
+
+and the objective J(θ) = Σ_s w_s P_s / Σ_s w_s (mean absorbed power, a scatter diagram's weights
+w_s) or a user's function of these responses. The parameters are arguments of one compiled
+function (their structure, not their values, is its key), so an optimisation, a grid over
+parameters and another model with the same structure reuse one compilation.
+
+Quadratic drag −D |v| v on a hydro dof (D = ½ ρ C_D A, :mod:`mfm.loads.water`) is linearised
+stochastically (Borgman): for a Gaussian velocity of standard deviation σ_v, the linear damping
+with the same mean power is c_eq = D √(8/π) σ_v; σ_v depends on c_eq, so the pair is iterated to a
+fixed point for each sea (``drag_iterations``; the last change is reported). Everything else is
+the frequency domain's: linear about q₀, hydrodynamic coefficients of the mean wetted surface.
+
+Derivatives come from jax: forward mode when the parameters are no more than the outputs
+(objective and constraint values), reverse mode otherwise, for the cost of a jacobian is one
+pass per parameter (forward) or per output (reverse). The optimiser is SLSQP (scipy) on the
+parameters scaled to [0, 1] by their bounds, with the constraints as inequalities in every sea.
+The time domain confirms an optimum (``confirm=``): :func:`mfm.simulate_batch` of the optimised
+model in the same seas, its mean power against the spectral prediction.
+"""
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+import time as _time
+from types import SimpleNamespace
+from typing import Callable, NamedTuple
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import xarray as xr
+
+from .. import results
+from ..errors import OptimizeError
+from ..frequency.rest import _equilibrium, _static_functions, _static_jet, system_loads, water_of
+from ..loads.base import Load
+from ..loads.hydraulic_pto import HydraulicPTO
+from ..loads.mooring import PointSprings
+from ..loads.water import Water
+from ..mechanics.model import Model
+from ..validation import check_model, check_sea
+
+# kinds of tunable parameter: (where, field, what it is, units, whether it moves the equilibrium)
+_MODEL_KINDS = {"damping": ("joint damping (PTO)", "N m s/rad or N s/m", False),
+                "stiffness": ("joint stiffness (negative: reactive control)", "N m/rad or N/m", True),
+                "mass": ("body mass (ballast at the centre of mass; inertia kept)", "kg", True)}
+_PTO_KINDS = {"mu": ("hydraulic piston inertia μ", "kg", False),
+              "beta": ("hydraulic piston damping β", "N s/m", False),
+              "kappa": ("hydraulic piston stiffness κ", "N/m", True)}
+_SPRING_KINDS = {"kx": 0, "ky": 1, "kz": 2}
+# Borgman's factor: E[|v| v · v] / E[v²] = √(8/π) σ for a zero-mean Gaussian v
+_BORGMAN = math.sqrt(8.0 / math.pi)
+TRACES = {"outputs": 0}      # how often the objective was traced (tests: one per structure)
+
+
+class Target(NamedTuple):
+    """Where a tunable parameter lives: ``where`` "model" (a Model array ``field`` at ``index``)
+    or "load" (the load at ``load`` in the loads at rest, array ``field`` at ``index``, and the
+    column ``column`` of a 2-D array or -1); ``moves`` whether it moves the static equilibrium."""
+    where: str
+    field: str
+    index: int
+    load: int = -1
+    column: int = -1
+    moves: bool = False
+
+
+def tunable_parameters(model: Model, loads=None) -> dict[str, str]:
+    """Every parameter :func:`optimize` can tune, spelled as the config and the coordinates are:
+    ``"<coordinate>.damping"``, ``"<coordinate>.stiffness"`` (the joint spring–damper of that
+    coordinate), ``"<body>.mass"``, ``"<hydraulic pto>.mu"``, ``".beta"``, ``".kappa"``,
+    ``"<mooring>.kx"``, ``".ky"``, ``".kz"`` (a ``[[moorings]]`` spring's stiffness per inertial axis).
+    Returns name → "what it is (units) = its value now"."""
+    model = check_model(model)
+    targets, static = _targets(model, system_loads(model, loads))
+    return {name: f"{what} ({units}) = {_value_of(model, static, t):.6g}"
+            for name, (t, what, units) in targets.items()}
+
+
+def _static(model, loads):
+    return _static_functions(model, system_loads(model, loads))[1]
+
+
+def _targets(model, lds):
+    """name → (Target, description, units) over the model and its loads at rest (their order in
+    :func:`mfm.frequency.rest._static_functions`), and that static tuple."""
+    _, static, _ = _static_functions(model, lds)
+    out = {}
+    for k, c in enumerate(model.coordinates):
+        for f in ("damping", "stiffness"):
+            what, units, moves = _MODEL_KINDS[f]
+            out[f"{c}.{f}"] = (Target("model", f, k, moves=moves), what, units)
+    for i, b in enumerate(model.body_names):
+        what, units, moves = _MODEL_KINDS["mass"]
+        out[f"{b}.mass"] = (Target("model", "mass", i, moves=moves), what, units)
+    for li, ld in enumerate(static):
+        if isinstance(ld, HydraulicPTO):
+            for j, n in enumerate(ld.names):
+                for f, (what, units, moves) in _PTO_KINDS.items():
+                    out[f"{n}.{f}"] = (Target("load", f, j, li, -1, moves), what, units)
+        elif isinstance(ld, PointSprings):
+            names = ld.names or tuple(f"mooring{j}" for j in range(ld.stiffness.shape[0]))
+            for j, n in enumerate(names):
+                for f, col in _SPRING_KINDS.items():
+                    out[f"{n}.{f}"] = (Target("load", "stiffness", j, li, col, True),
+                                       f"linear mooring stiffness along {f[1]}", "N/m")
+    return out, static
+
+
+def _value_of(model, static, t: Target) -> float:
+    holder = model if t.where == "model" else static[t.load]
+    arr = np.asarray(getattr(holder, t.field))
+    return float(arr[t.index] if t.column < 0 else arr[t.index, t.column])
+
+
+def _set(model, static, targets, values):
+    """(model, static) with each group of targets set to its value (jax arrays: traced)."""
+    for group, v in zip(targets, values):
+        for t in group:
+            if t.where == "model":
+                model = dataclasses.replace(
+                    model, **{t.field: getattr(model, t.field).at[t.index].set(v)})
+            else:
+                ld = static[t.load]
+                arr = getattr(ld, t.field)
+                arr = arr.at[t.index].set(v) if t.column < 0 else arr.at[t.index, t.column].set(v)
+                static = static[:t.load] + (dataclasses.replace(ld, **{t.field: arr}),) \
+                    + static[t.load + 1:]
+    return model, static
+
+
+def apply(model: Model, values: dict) -> Model:
+    """``model`` with the parameters ``values`` (name → number, names of
+    :func:`tunable_parameters`) set in the model and in its config loads: what :func:`optimize`
+    returns as the optimum, ready for :func:`mfm.simulate`."""
+    model = check_model(model)
+    table, _ = _targets(model, system_loads(model))
+    loads = list(model.loads)
+    changes = {}
+    for name, v in values.items():
+        if name not in table:
+            raise KeyError(_unknown(name, table))
+        t = table[name][0]
+        if t.where == "model":
+            arr = changes.get(t.field, np.array(getattr(model, t.field), dtype=float))
+            arr[t.index] = float(v)
+            changes[t.field] = arr
+            continue
+        kind = HydraulicPTO if t.field in _PTO_KINDS else PointSprings
+        # the config load of this kind with these names (the loads at rest are the same objects)
+        held = [i for i, ld in enumerate(loads) if isinstance(ld, kind)]
+        static_same = [i for i, ld in enumerate(_static(model, None)) if isinstance(ld, kind)]
+        li = held[static_same.index(t.load)]
+        arr = np.array(getattr(loads[li], t.field), dtype=float)
+        if t.column < 0:
+            arr[t.index] = float(v)
+        else:
+            arr[t.index, t.column] = float(v)
+        loads[li] = dataclasses.replace(loads[li], **{t.field: jnp.asarray(arr)})
+    return model.replace(loads=tuple(loads), **changes)
+
+
+def _unknown(name, table):
+    kinds = sorted({n.rsplit(".", 1)[1] for n in table})
+    return (f"parameters: {name!r} is not a tunable parameter of this model; give "
+            f"'<coordinate>.damping' or '.stiffness', '<body>.mass', '<hydraulic pto>.mu', '.beta' "
+            f"or '.kappa', '<mooring>.kx', '.ky' or '.kz' (kinds here: {kinds}). Tunable here: "
+            f"{sorted(table)}")
+
+
+# ------------------------------------------------------------------------------- the problem
+class Problem(eqx.Module):
+    """Everything the compiled objective reads: the model and its loads at rest as compiled
+    (numbers only: :func:`mfm.loads.assembly.compile_view`), the baseline equilibrium, the union of
+    the seas' components (ω (U,), a² (S, U)), the water's radiation impedance per hydro dof
+    ``Zb`` (U, 6K, 6K) = −ω²(A − A∞) − iωB and excitation ``X`` (U, 6K) (per metre), the drag
+    D (6K,) per hydro dof (0 on rotations), the seas' weights (S,); static: where each parameter
+    lives, the joint PTO coordinates, the hydraulic PTO load, the water load."""
+    model: Model
+    static: tuple
+    mems: tuple
+    q0: jnp.ndarray
+    omega: jnp.ndarray
+    a2: jnp.ndarray
+    Zb: jnp.ndarray
+    X: jnp.ndarray
+    drag: jnp.ndarray
+    weights: jnp.ndarray
+    targets: tuple = eqx.field(static=True)
+    joint_ptos: tuple = eqx.field(static=True)
+    hydraulic: int = eqx.field(static=True)
+    water: int = eqx.field(static=True)
+    drag_iterations: int = eqx.field(static=True)
+
+
+class Response(NamedTuple):
+    """The spectral responses at θ (jax arrays), what a user's objective reads: ``power`` (S, P)
+    W mean power of each PTO in each sea; ``q_rms`` (S, n_q) standard deviation of each coordinate
+    about q₀ (m or rad); ``stroke_rms`` (S, P) of each PTO's displacement (m or rad);
+    ``force_rms`` (S, P) of each PTO's damping force c ẇ (N or N m); ``weights`` (S,) the seas'
+    weights normalised to sum 1; ``values`` (n_par,) the parameters; ``q0`` (n_q,) the
+    equilibrium; ``drag_change`` the last relative change of the drag linearisation (0 without
+    drag)."""
+    power: jnp.ndarray
+    q_rms: jnp.ndarray
+    stroke_rms: jnp.ndarray
+    force_rms: jnp.ndarray
+    weights: jnp.ndarray
+    values: jnp.ndarray
+    q0: jnp.ndarray
+    drag_change: jnp.ndarray
+
+
+def _newton(f, q):
+    """Newton on Q(q) = 0 from the baseline q₀ (least squares: a coordinate nothing restores
+    keeps its value), a fixed number of steps: the design parameters move q₀ by a few % of the
+    span Newton converges over quadratically; :func:`optimize` checks the residual."""
+    def step(_, q):
+        J = jax.jacfwd(f)(q)
+        return q - jnp.linalg.lstsq(J, f(q), rcond=1e-10)[0]
+    return jax.lax.fori_loop(0, 8, step, q)
+
+
+def _tangent(g, y):
+    J = jax.jacfwd(g)(y)
+    return jnp.linalg.lstsq(J, y, rcond=1e-10)[0]
+
+
+def responses(pb: Problem, values) -> Response:
+    """The spectral responses of the module docstring at parameters ``values`` (n_par,)."""
+    model, static = _set(pb.model, pb.static, pb.targets, values)
+    moves = any(t.moves for group in pb.targets for t in group)
+    if moves:
+        q0 = jax.lax.custom_root(lambda q: _static_jet(model, static, pb.mems, q).Q, pb.q0,
+                                 _newton, _tangent)
+    else:
+        q0 = pb.q0
+    jet = _static_jet(model, static, pb.mems, q0)
+    M, K, C = jet.M, -jet.dQ_dq, -jet.dQ_dqd
+    H = static[pb.water].geometry.h_matrix(jet.kin)[0]                     # (6K, n)
+    w = pb.omega[:, None, None]
+    Z = (-w**2 * M[None] - 1j * w * C[None] + K[None]
+         + jnp.einsum("ai,uab,bj->uij", H, pb.Zb, H))                      # (U, n, n)
+    F = jnp.einsum("ai,ua->ui", H, pb.X)                                   # (U, n)
+
+    def solve(c_eq):                                                       # c_eq (S, 6K)
+        Cd = jnp.einsum("ai,sa,aj->sij", H, c_eq, H)
+        Zs = Z[None] - 1j * w[None] * Cd[:, None]
+        return jnp.linalg.solve(Zs, F[None, ..., None])[..., 0]           # (S, U, n)
+
+    def sigma_v(x):                                                        # (S, 6K)
+        v = jnp.einsum("ai,sui->sua", H, x) * pb.omega[None, :, None]
+        return _safe_sqrt(jnp.sum(0.5 * pb.a2[..., None] * _abs2(v), axis=1))
+
+    S = pb.a2.shape[0]
+    c_eq = jnp.zeros((S, H.shape[0]))
+    x = solve(c_eq)
+    change = jnp.zeros(())
+    if pb.drag_iterations:
+        def fixed_point(_, carry):
+            c, _ = carry
+            c_new = pb.drag[None] * _BORGMAN * sigma_v(solve(c))
+            return c_new, jnp.max(jnp.abs(c_new - c)) / jnp.maximum(jnp.max(jnp.abs(c_new)), 1e-300)
+        c_eq, change = jax.lax.fori_loop(0, pb.drag_iterations, fixed_point, (c_eq, change))
+        x = solve(c_eq)
+    # PTO rates ẇ = G q̇: the joint dampers (coordinates), then the hydraulic pistons at q₀
+    joint = np.asarray(pb.joint_ptos, dtype=int)
+    rows = [jnp.asarray(np.eye(model.n_coordinates)[joint])] if joint.size else []
+    c = [model.damping[joint]] if joint.size else []
+    if pb.hydraulic >= 0:
+        hyd = static[pb.hydraulic]
+        rows.append(hyd._kinematics(jet.kin)[2])
+        c.append(hyd.beta)
+    G = jnp.concatenate(rows) if rows else jnp.zeros((0, model.n_coordinates))
+    c = jnp.concatenate(c) if c else jnp.zeros((0,))
+    stroke = jnp.einsum("pi,sui->sup", G, x)                               # per metre
+    half_a2 = 0.5 * pb.a2[..., None]
+    stroke_var = jnp.sum(half_a2 * _abs2(stroke), axis=1)                  # (S, P)
+    rate_var = jnp.sum(half_a2 * pb.omega[None, :, None] ** 2 * _abs2(stroke), axis=1)
+    power = c[None] * rate_var          # Σ_j a² ½ c ω² |G x̂|² (mean of c ẇ²)
+    q_rms = _safe_sqrt(jnp.sum(half_a2 * _abs2(x), axis=1))
+    weights = pb.weights / jnp.sum(pb.weights)
+    return Response(power, q_rms, _safe_sqrt(stroke_var), jnp.abs(c)[None] * _safe_sqrt(rate_var),
+                    weights, values, q0, change)
+
+
+def _abs2(z):
+    # |z|² as z z̄: smooth at z = 0, where |z| has no derivative (a coordinate a sea does not move)
+    return jnp.real(z * jnp.conj(z))
+
+
+def _safe_sqrt(v):
+    # √ with a finite derivative at 0 (a PTO that does not move in a sea)
+    ok = v > 0
+    return jnp.where(ok, jnp.sqrt(jnp.where(ok, v, 1.0)), 0.0)
+
+
+def mean_power(r: Response):
+    """The default objective: Σ_s w_s Σ_p P_sp, the weighted mean absorbed power (W)."""
+    return jnp.sum(r.weights * jnp.sum(r.power, axis=1))
+
+
+# ------------------------------------------------------------------------------- constraints
+class Limit(NamedTuple):
+    """One constraint: ``quantity`` (a coordinate or a PTO of the model) ``kind`` "rms" (standard
+    deviation) or "significant" (the significant amplitude 2σ: the mean of the highest third of a
+    narrow-band Gaussian response's amplitudes, as H_s = 4σ is of crest-to-trough heights) must
+    stay ≤ ``limit`` (m or rad) in every sea."""
+    quantity: str
+    kind: str
+    limit: float
+
+
+KINDS = {"rms": 1.0, "significant": 2.0}
+
+
+def _limits(constraints, coordinates, ptos) -> list[Limit]:
+    if constraints is None:
+        return []
+    if not isinstance(constraints, dict):
+        raise TypeError(f"constraints: {constraints!r}; give a dict quantity → {{'rms' or "
+                        "'significant': limit}, e.g. {'platform.pitch': {'rms': 0.035}}")
+    out = []
+    for q, spec in constraints.items():
+        if q not in coordinates and q not in ptos:
+            raise KeyError(f"constraints: {q!r} is neither a coordinate nor a PTO of the model; "
+                           f"coordinates: {list(coordinates)}, PTOs: {list(ptos)} (line tension "
+                           "is not a constraint of the spectral level yet)")
+        if not isinstance(spec, dict) or not spec:
+            raise TypeError(f"constraints[{q!r}]: {spec!r}; give {{'rms': limit}} or "
+                            "{'significant': limit} (m or rad)")
+        for kind, lim in spec.items():
+            if kind not in KINDS:
+                raise KeyError(f"constraints[{q!r}]: {kind!r} is not a kind of limit; give one of "
+                               f"{list(KINDS)}")
+            if not isinstance(lim, (int, float)) or not math.isfinite(lim) or lim <= 0:
+                raise ValueError(f"constraints[{q!r}][{kind!r}]: {lim!r}; give a positive, finite "
+                                 "limit (m or rad)")
+            out.append(Limit(q, kind, float(lim)))
+    return out
+
+
+def _constraint_values(r: Response, spec):
+    """Each limit's value in each sea (n_limits, S): KINDS[kind] × σ of a coordinate or a PTO."""
+    rows = []
+    for source, index, factor in spec:
+        arr = r.q_rms if source == "q" else r.stroke_rms
+        rows.append(factor * arr[:, index])
+    return jnp.stack(rows) if rows else jnp.zeros((0, r.power.shape[0]))
+
+
+def _outputs(pb, u, lower, upper, limits, scale, objective, spec):
+    """[J(θ)/scale, 1 − value/limit for each limit and sea] at θ = lower + u (upper − lower), and
+    the responses there."""
+    r = responses(pb, lower + u * (upper - lower))
+    g = 1.0 - _constraint_values(r, spec) / limits[:, None]
+    out = jnp.concatenate([jnp.atleast_1d(objective(r)) / scale, g.reshape(-1)])
+    return out, (out, r)
+
+
+@functools.partial(jax.jit, static_argnames=("objective", "spec", "forward"))
+def _evaluate(pb, u, lower, upper, limits, scale, objective, spec, forward):
+    """(outputs, their jacobian in u (n_out, n_par), the responses): one compilation per
+    structure of the problem, objective and limits (their numbers are arguments). Forward mode
+    costs one pass per parameter, reverse one per output."""
+    TRACES["outputs"] += 1
+    jac = jax.jacfwd if forward else jax.jacrev
+    J, (out, r) = jac(_outputs, argnums=1, has_aux=True)(pb, u, lower, upper, limits, scale,
+                                                         objective, spec)
+    return out, J, r
+
+
+# ------------------------------------------------------------------------------- the front door
+def _parameters(model, parameters, table):
+    """[(label, (Target, …), lower, upper)] from the user's dict name or tuple of names → (lower,
+    upper); a tuple of names is one design value shared by them (e.g. one damping for all WECs)."""
+    if not isinstance(parameters, dict) or not parameters:
+        raise TypeError(f"parameters: {parameters!r}; give a dict name → (lower, upper), names "
+                        "from mfm.studies.optimize.tunable_parameters(model), e.g. "
+                        "{'float3.angle.damping': (0.0, 50.0)}")
+    out, seen = [], set()
+    for key, bounds in parameters.items():
+        names = (key,) if isinstance(key, str) else tuple(key)
+        for n in names:
+            if not isinstance(n, str) or n not in table:
+                raise KeyError(_unknown(n, table))
+            if n in seen:
+                raise ValueError(f"parameters: {n!r} is given twice; each parameter once")
+            seen.add(n)
+        try:
+            lo, hi = (float(b) for b in bounds)
+        except (TypeError, ValueError):
+            raise ValueError(f"parameters[{key!r}]: {bounds!r}; give bounds (lower, upper)") from None
+        if not (math.isfinite(lo) and math.isfinite(hi)) or not lo < hi:
+            raise ValueError(f"parameters[{key!r}]: bounds ({lo!r}, {hi!r}); give finite bounds "
+                             "with lower < upper (the optimiser works on [0, 1] between them)")
+        out.append((" + ".join(names), tuple(table[n][0] for n in names), lo, hi,
+                    tuple(table[n][2] for n in names)[0]))
+    return out
+
+
+def _sea_union(model, seas, lds, radiation, state_space_options):
+    """ω (U,), a² (S, U), Zb (U, 6K, 6K), X (U, 6K) on the union of the seas' (β, ω) pairs."""
+    comps = [s.components(water_depth=model.hydro.water_depth, g=model.hydro.g) for s in seas]
+    pairs = np.concatenate([np.stack([c.heading, c.omega], axis=1) for c in comps])
+    union, inverse = np.unique(pairs, axis=0, return_inverse=True)
+    inverse = np.asarray(inverse).reshape(-1)
+    a2 = np.zeros((len(seas), len(union)))
+    start = 0
+    for s, c in enumerate(comps):
+        np.add.at(a2[s], inverse[start:start + len(c.omega)], c.amplitude ** 2)
+        start += len(c.omega)
+    water = water_of(lds)
+    from ..mechanics.kinematics import kinematics
+    kin = kinematics(model, jnp.zeros(model.n_coordinates), jnp.zeros(model.n_coordinates))
+    options = {"radiation": radiation, "state_space_options": state_space_options}
+    nd = 6 * len(water.geometry.body_index)
+    Zb = np.zeros((len(union), nd, nd), complex)
+    X = np.zeros((len(union), nd), complex)
+    for beta in np.unique(union[:, 0]):
+        sel = union[:, 0] == beta
+        om = union[sel, 1]
+        A_rel, B, Xb, _ = water._frequency_coefficients(kin, om, float(beta), options)
+        Zb[sel] = -om[:, None, None] ** 2 * A_rel - 1j * om[:, None, None] * B
+        X[sel] = Xb
+    return union[:, 1].copy(), a2, Zb, X, water
+
+
+def _setup(model, seas, parameters, objective, constraints, weights, loads, radiation,
+           state_space_options, drag_iterations, derivatives):
+    """The checked request as the compiled objective takes it (a namespace: the Problem ``pb``,
+    the parameters' labels, bounds and baseline, the limits, the objective function, …)."""
+    model = check_model(model)
+    if model.hydro is None:
+        raise ValueError(f"model {model.name!r} has no hydrodynamics: optimize works on the sea's "
+                         "response; give a config with a [hydro] table")
+    seas = list(seas) if isinstance(seas, (list, tuple)) else [seas]
+    if not seas:
+        raise ValueError("seas: an empty sequence; give at least one sea state of hydro.waves")
+    for i, sea in enumerate(seas):
+        check_sea(sea, f"seas[{i}]", still_water=False)
+    S = len(seas)
+    w = np.ones(S) if weights is None else np.asarray(weights, dtype=float).reshape(-1)
+    if w.shape != (S,) or not np.all(np.isfinite(w)) or np.any(w < 0) or w.sum() <= 0:
+        raise ValueError(f"weights: {weights!r}; give {S} finite weights ≥ 0, not all 0 (one per sea)")
+    if derivatives not in ("auto", "forward", "reverse"):
+        raise ValueError(f"derivatives: {derivatives!r}; give 'auto', 'forward' or 'reverse'")
+    if isinstance(objective, str):
+        if objective != "power":
+            raise ValueError(f"objective: {objective!r}; give 'power' or a function of a Response")
+        objective_fn = mean_power
+    elif callable(objective):
+        objective_fn = objective
+    else:
+        raise TypeError(f"objective: {objective!r}; give 'power' or a function of a Response")
+
+    lds = system_loads(model, loads)
+    table, _ = _targets(model, lds)
+    params = _parameters(model, parameters, table)
+    kmodel, static, mems = _static_functions(model, lds)
+    hydraulic = [i for i, ld in enumerate(static) if isinstance(ld, HydraulicPTO)]
+    if len(hydraulic) > 1:
+        raise NotImplementedError("optimize: more than one hydraulic PTO load; put the pistons "
+                                  "in one [[hydraulic_ptos]] table")
+    others = [type(ld).__name__ for ld in static if not isinstance(ld, HydraulicPTO)
+              and type(ld).linear_dampers is not Load.linear_dampers]
+    if others:
+        raise NotImplementedError(f"optimize: loads {others} add PTOs the spectral objective does "
+                                  "not know yet")
+    water_index = next(i for i, ld in enumerate(static) if isinstance(ld, Water))
+    # the joint PTOs: the coordinates damped now, and those whose damping is tuned
+    tuned = {t.index for _, grp, *_ in params for t in grp if t.where == "model" and t.field == "damping"}
+    joint = tuple(sorted({int(k) for k in np.flatnonzero(np.asarray(model.damping) > 0)} | tuned))
+    pto_names = [model.coordinates[k] for k in joint]
+    if hydraulic:
+        pto_names += list(static[hydraulic[0]].names)
+    limits = _limits(constraints, model.coordinates, pto_names)
+    spec = tuple(("q", model.coordinates.index(lm.quantity), KINDS[lm.kind])
+                 if lm.quantity in model.coordinates else
+                 ("pto", pto_names.index(lm.quantity), KINDS[lm.kind]) for lm in limits)
+    q0, _ = _equilibrium(model, lds)
+    omega, a2, Zb, X, water = _sea_union(model, seas, lds, radiation, state_space_options)
+    drag = np.zeros(Zb.shape[1])
+    D = np.asarray(water.drag)                           # (K, 3) on the translations
+    drag.reshape(-1, 6)[:, :3] = D
+    pb = Problem(kmodel, static, mems, jnp.asarray(q0), jnp.asarray(omega), jnp.asarray(a2),
+                 jnp.asarray(Zb), jnp.asarray(X), jnp.asarray(drag), jnp.asarray(w),
+                 tuple(grp for _, grp, *_ in params), joint,
+                 hydraulic[0] if hydraulic else -1, water_index,
+                 int(drag_iterations) if np.any(drag > 0) else 0)
+
+    labels = [p[0] for p in params]
+    lower = np.array([p[2] for p in params])
+    upper = np.array([p[3] for p in params])
+    baseline = np.array([_value_of(kmodel, static, p[1][0]) for p in params])
+    n_out = 1 + len(limits) * S
+    forward = derivatives == "forward" or (derivatives == "auto" and len(params) <= n_out)
+    lo_j, hi_j = jnp.asarray(lower), jnp.asarray(upper)
+    lim_j = jnp.asarray([lm.limit for lm in limits]).reshape(-1)
+    return SimpleNamespace(model=model, seas=seas, S=S, w=w, objective_fn=objective_fn, lds=lds,
+                           params=params, pb=pb, pto_names=pto_names, limits=limits, spec=spec,
+                           labels=labels, lower=lower, upper=upper, baseline=baseline,
+                           forward=forward, lo_j=lo_j, hi_j=hi_j, lim_j=lim_j)
+
+
+def _run(P, u, scale):
+    """(outputs, jacobian, responses) of the request at scaled parameters u, as numpy."""
+    out, J, r = _evaluate(P.pb, jnp.asarray(u, jnp.float64), P.lo_j, P.hi_j, P.lim_j,
+                          jnp.asarray(scale, jnp.float64), P.objective_fn, P.spec, P.forward)
+    return np.asarray(out), np.asarray(J), jax.tree_util.tree_map(np.asarray, r)
+
+
+def optimize(model: Model, seas, parameters: dict, *, objective: Callable | str = "power",
+             constraints: dict | None = None, weights=None, x0: dict | None = None,
+             loads=None, radiation: str = "database", state_space_options: dict | None = None,
+             drag_iterations: int = 40, derivatives: str = "auto", max_iter: int = 100,
+             tol: float = 1e-9, confirm: dict | None = None) -> xr.Dataset:
+    """Tune ``parameters`` of ``model`` to maximise ``objective`` over ``seas`` at the spectral
+    level (module docstring), optionally confirmed in the time domain.
+
+    parameters: dict name → (lower, upper), names of :func:`tunable_parameters` (e.g.
+        ``"float3.angle.damping"``, ``"float.stroke.stiffness"`` (negative: reactive control),
+        ``"pto.beta"``, ``"platform.mass"``, ``"mooring0.kx"``); a tuple of names as the key is
+        one value shared by them (one damping for every WEC).
+    seas: a sea state of :mod:`hydro.waves` or a sequence; ``weights`` (S,) ≥ 0 their weights
+        (a scatter diagram's probabilities or hours; default equal).
+    objective: "power" (Σ_s w_s P_s, W, the weighted mean absorbed power of every PTO) or a
+        function of a :class:`Response` returning a scalar to maximise, written with jax.numpy
+        (e.g. ``lambda r: mean_power(r) - 1e6 * jnp.max(r.q_rms[:, 4])``).
+    constraints: dict quantity → {"rms": limit} or {"significant": limit} (m or rad) for a
+        coordinate (``"platform.pitch"``) or a PTO's stroke (its name), to hold in every sea.
+    x0: starting values by name (default: the model's own, clipped to the bounds).
+    loads, radiation, state_space_options: as :func:`mfm.frequency_response`.
+    drag_iterations: fixed-point iterations of the stochastic drag linearisation (when the water
+        has drag). derivatives: "auto" (forward when parameters ≤ outputs, else reverse),
+        "forward" or "reverse". max_iter, tol: SLSQP's.
+    confirm: None, or options of :func:`mfm.simulate_batch` (``dt``, ``n_steps`` required;
+        ``integrator``, ``radiation``, ``ramp``, …; ``settle`` s discarded before averaging,
+        default half the run): the optimised model in the same seas, its mean power against the
+        spectral prediction (``time_domain_*`` variables, the relative difference printed).
+
+    Returns an xarray.Dataset: over ``parameter`` ``optimum``, ``baseline`` (the model's values),
+    ``lower``, ``upper``, ``at_bound`` ("lower", "upper" or ""), ``gradient`` (dJ/dθ at the optimum,
+    objective units per parameter unit); ``objective``, ``objective_baseline``, ``gain`` (relative);
+    over ``constraint`` ``constraint_value`` (the largest over the seas), ``constraint_value_baseline``,
+    ``constraint_limit``, ``constraint_active``; over (case, pto) ``pto_power_mean`` and
+    ``pto_power_mean_baseline`` (W), over (case, coordinate) ``q_rms``; ``iterations``,
+    ``evaluations``, ``gradient_norm`` (of the projected gradient, scaled units); provenance.
+    Raises KeyError naming an unknown parameter (with the tunable ones), ValueError for bounds,
+    and :class:`~mfm.errors.OptimizeError` (with ``last_good``) when the objective goes
+    non-finite or the constraints cannot be met.
+    """
+    start = _time.perf_counter()
+    P = _setup(model, seas, parameters, objective, constraints, weights, loads, radiation,
+               state_space_options, drag_iterations, derivatives)
+    model, seas, S, w, objective_fn, lds, params = (P.model, P.seas, P.S, P.w, P.objective_fn,
+                                                    P.lds, P.params)
+    pb, pto_names, limits, spec, labels = P.pb, P.pto_names, P.limits, P.spec, P.labels
+    lower, upper, baseline, forward = P.lower, P.upper, P.baseline, P.forward
+    start_values = np.clip(baseline, lower, upper)
+    if x0 is not None:
+        for k, v in x0.items():
+            if k not in labels:
+                raise KeyError(f"x0: {k!r} is not one of the parameters {labels}")
+            start_values[labels.index(k)] = float(v)
+        if np.any(start_values < lower) or np.any(start_values > upper):
+            raise ValueError(f"x0: {x0!r} lies outside the bounds {dict(zip(labels, zip(lower, upper)))}")
+
+    def to_u(theta):
+        return (np.asarray(theta) - lower) / (upper - lower)
+
+    def point(u):
+        return dict(zip(labels, (lower + np.asarray(u) * (upper - lower)).tolist()))
+
+    def run(u, scale):
+        return _run(P, u, scale)
+
+    u_base = to_u(baseline)
+    base_out, _, r_base = run(u_base, 1.0)
+    if not np.all(np.isfinite(base_out)):
+        raise OptimizeError(f"optimize: the objective or constraints are not finite at the model's "
+                            f"own values {point(u_base)}: {base_out.tolist()}", last_good=None)
+    scale = max(abs(float(base_out[0])), 1e-300)
+    cache = {}
+    last_good = {"u": to_u(start_values)}
+
+    def evaluate(u):
+        """(outputs, jacobian, responses) at u, computed once per point (SLSQP asks for the
+        value and the jacobian at the same points)."""
+        key = np.asarray(u).tobytes()
+        if key not in cache:
+            out, J, r = run(u, scale)
+            if not (np.all(np.isfinite(out)) and np.all(np.isfinite(J))):
+                good = point(last_good["u"])
+                raise OptimizeError(
+                    f"optimize: the objective, a constraint or a derivative went non-finite at "
+                    f"{point(u)}: outputs {out.tolist()}; the last good point was {good}. A "
+                    "parameter that removes all damping of a resonance, or a negative stiffness "
+                    "past the restoring, makes the response unbounded: narrow the bounds.",
+                    last_good=good)
+            last_good["u"] = np.array(u)
+            cache.clear()
+            cache[key] = (out, J, r)
+        return cache[key]
+
+    from scipy.optimize import minimize
+
+    cons = ([{"type": "ineq", "fun": lambda u: evaluate(u)[0][1:], "jac": lambda u: evaluate(u)[1][1:]}]
+            if limits else [])
+    res = minimize(lambda u: -evaluate(u)[0][0], to_u(start_values),
+                   jac=lambda u: -evaluate(u)[1][0], method="SLSQP",
+                   bounds=[(0.0, 1.0)] * len(params), constraints=cons,
+                   options={"maxiter": int(max_iter), "ftol": float(tol)})
+    u_opt = np.clip(res.x, 0.0, 1.0)
+    out, J, r_opt = evaluate(u_opt)
+    theta = lower + u_opt * (upper - lower)
+    if limits and -out[1:].min() > 1e-6:
+        values = np.asarray(_constraint_values(r_opt, spec)).max(axis=1)
+        raise OptimizeError(
+            "optimize: the constraints cannot be met within the bounds: at the end "
+            + ", ".join(f"{lm.kind}({lm.quantity}) = {float(v):.4g} > {lm.limit:.4g}"
+                        for lm, v in zip(limits, values) if v > lm.limit * (1 + 1e-6))
+            + f" ({res.message}); widen the bounds or relax the limits. Last point: "
+            + repr(point(u_opt)), last_good=point(u_opt))
+    if pb.drag_iterations and float(r_opt.drag_change) > 1e-6:
+        raise OptimizeError(f"optimize: the drag linearisation did not settle in {drag_iterations} "
+                            f"iterations (last relative change {float(r_opt.drag_change):.2e}); "
+                            "give more drag_iterations", last_good=point(u_opt))
+    # the projected gradient: zero where a bound holds the parameter against its pull
+    g = J[0].copy()
+    g[(u_opt <= 1e-9) & (g < 0)] = 0.0
+    g[(u_opt >= 1 - 1e-9) & (g > 0)] = 0.0
+    at_bound = np.where(u_opt <= 1e-6, "lower", np.where(u_opt >= 1 - 1e-6, "upper", ""))
+    con_opt = np.asarray(_constraint_values(r_opt, spec)).reshape(len(limits), S)
+    con_base = np.asarray(_constraint_values(r_base, spec)).reshape(len(limits), S)
+    obj = float(out[0] * scale)
+    obj_base = float(base_out[0])
+    confirm_out = None
+    if confirm is not None:
+        confirm_out = _confirm(model, seas, dict(zip(labels, theta)), params, w, r_opt, confirm)
+    settings = dict(level="spectral", seas=repr(seas), radiation=radiation, method="SLSQP",
+                    derivatives="forward" if forward else "reverse", max_iter=int(max_iter),
+                    tol=float(tol), message=str(res.message), success=bool(res.success),
+                    objective=("mean absorbed power" if objective_fn is mean_power
+                               else getattr(objective_fn, "__name__", repr(objective_fn))),
+                    drag_linearisation=("stochastic (Borgman), c_eq = D sqrt(8/pi) sigma_v"
+                                        if pb.drag_iterations else "none (no drag)"))
+    return results.optimum(
+        model, lds, seas, labels=labels, units=[p[4] for p in params], optimum=theta,
+        baseline=baseline, lower=lower, upper=upper, at_bound=at_bound,
+        gradient=J[0] * scale / (upper - lower), objective=obj, objective_baseline=obj_base,
+        limits=limits, con_opt=con_opt, con_base=con_base, pto_names=pto_names,
+        power=r_opt.power, power_base=r_base.power, q_rms=r_opt.q_rms,
+        iterations=int(res.nit), evaluations=int(res.nfev), gradient_norm=float(np.linalg.norm(g)),
+        confirm=confirm_out, settings=settings, start=start)
+
+
+def evaluate(model: Model, seas, points: dict, *, objective: Callable | str = "power",
+             constraints: dict | None = None, weights=None, loads=None,
+             radiation: str = "database", state_space_options: dict | None = None,
+             drag_iterations: int = 40) -> dict:
+    """The objective and the constraint values of :func:`optimize` at given parameter values,
+    through the same compiled function (a grid over parameters, a landscape to chart, the check
+    of an optimum): ``points`` name (or tuple of names) → values (N,) (all of one length N).
+
+    Returns dict: ``objective`` (N,), ``constraints`` (N, n_limits) their largest value over the
+    seas (m or rad), ``power`` (N, S, P) W, ``q_rms`` (N, S, n_q)."""
+    if not isinstance(points, dict) or not points:
+        raise TypeError(f"points: {points!r}; give a dict name → values (N,)")
+    arrays = {k: np.atleast_1d(np.asarray(v, dtype=float)) for k, v in points.items()}
+    N = {a.shape for a in arrays.values()}
+    if len(N) != 1 or len(next(iter(N))) != 1:
+        raise ValueError(f"points: shapes {[a.shape for a in arrays.values()]}; give 1-D arrays "
+                         "of one length")
+    # bounds only scale the parameters; any span holding the points does
+    bounds = {k: (float(a.min()) - 1.0, float(a.max()) + 1.0) for k, a in arrays.items()}
+    P = _setup(model, seas, bounds, objective, constraints, weights, loads, radiation,
+               state_space_options, drag_iterations, "auto")
+    theta = np.stack([arrays[k] for k in points], axis=1)
+    objective_v, cons, power, q_rms = [], [], [], []
+    for row in theta:
+        out, _, r = _run(P, (row - P.lower) / (P.upper - P.lower), 1.0)
+        objective_v.append(out[0])
+        cons.append(np.asarray(_constraint_values(r, P.spec)).reshape(len(P.limits), P.S).max(axis=1))
+        power.append(r.power)
+        q_rms.append(r.q_rms)
+    return {"objective": np.array(objective_v), "constraints": np.array(cons),
+            "power": np.array(power), "q_rms": np.array(q_rms)}
+
+
+def _confirm(model, seas, values, params, weights, r_opt, options):
+    """The optimised model in the same seas by :func:`mfm.simulate_batch`: each PTO's mean power
+    after ``settle`` against the spectral prediction."""
+    from ..timedomain.batch import simulate_batch
+
+    options = dict(options)
+    if "dt" not in options or "n_steps" not in options:
+        raise ValueError(f"confirm: {options!r}; give at least dt (s) and n_steps for "
+                         "mfm.simulate_batch")
+    settle = options.pop("settle", None)
+    opt_model = apply(model, {n: v for (label, grp, *_), v in zip(params, values.values())
+                              for n in label.split(" + ")})
+    hyd = any(isinstance(ld, HydraulicPTO) for ld in opt_model.loads)
+    options.setdefault("integrator", "verlet")
+    options.setdefault("radiation", "state_space_exact")
+    if hyd:
+        options["outputs"] = tuple(options.get("outputs", ())) + ("hydraulic_power",)
+    ds = simulate_batch(opt_model, seas, **options)
+    t = np.asarray(ds.time.values)
+    settle = 0.5 * float(t[0, -1]) if settle is None else float(settle)
+    keep = t[0] >= t[0, 0] + settle
+    parts = []
+    if "pto_power" in ds:
+        parts.append(np.asarray(ds.pto_power.values)[:, keep].mean(axis=1))
+    if hyd:
+        parts.append(np.asarray(ds.hydraulic_power.values)[:, keep].mean(axis=1))
+    power = np.concatenate(parts, axis=1) if parts else np.zeros((len(seas), 0))
+    wn = weights / weights.sum()
+    td = float(np.sum(wn * power.sum(axis=1)))
+    spectral = float(np.sum(wn * r_opt.power.sum(axis=1)))
+    rel = (td - spectral) / abs(spectral) if spectral else math.nan
+    print(f"optimize: time-domain mean power at the optimum {td:.6g} W against the spectral "
+          f"{spectral:.6g} W: relative difference {rel:+.3%}")
+    return {"power": power, "objective": td, "relative_difference": rel, "settle_s": settle,
+            "options": repr(options)}
