@@ -119,3 +119,46 @@ def test_bad_input_is_named(m4):
     with pytest.raises(OptimizeError, match="cannot be met") as err:
         O.optimize(m4, SEA, PAIRS, constraints={"float1.pitch": {"rms": 1e-4}})
     assert set(err.value.last_good) == {" + ".join(k) for k in PAIRS}
+
+
+def test_drag_linearisation_is_a_fixed_point_of_the_numpy_route():
+    """Stansby & Li (drag on its floats): the linearised drag c_eq = D √(8/π) σ_v that optimize
+    converges to, put on the model as plain linear dampers at the water's reference points
+    (LinearBodyMatrix), gives through the numpy spectral level (a) the same mean power and (b)
+    velocity standard deviations σ_v that reproduce c_eq (Borgman's condition). Tolerance 1e-6:
+    the fixed point's last relative change is below 1e-10 after 40 iterations; 1e-6 leaves room for
+    the two routes' round-off in the 7×7 solves."""
+    import jax.numpy as jnp
+
+    from hydro.waves import Jonswap
+    from mfm.frequency.rest import system_loads, water_of
+    from mfm.loads.body_matrix import LinearBodyMatrix
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = mfm.load("configs/stansby_li.toml")
+    sea = Jonswap(hs=2.0, tp=9.0, gamma=3.3, seed=1, omega_range=(0.3, 2.0))
+    ev = O.evaluate(m, sea, {"floatB.angle.damping": [2e9]})
+    P = O._setup(m, sea, {"floatB.angle.damping": (0.0, 4e9)}, "power", None, None, None,
+                 "database", None, 40, "auto")
+    _, _, r = O._run(P, np.array([0.5]), 1.0)
+    assert float(r.drag_change) < 1e-10
+    c_eq = r.drag_damping[0].reshape(-1, 6)                 # (K, 6): translations only
+    water = water_of(system_loads(m))
+    D = np.asarray(water.drag)
+    assert np.all(c_eq[:, 3:] == 0) and np.any(c_eq[:, :3] > 0)
+    g = water.geometry
+    dampers = tuple(LinearBodyMatrix.create(m, m.body_names[b], point=np.asarray(g.ref0[k]),
+                                            damping=np.concatenate([c_eq[k, :3], np.zeros(3)]))
+                    for k, b in enumerate(g.body_index) if np.any(c_eq[k] > 0))
+    linear = m.replace(loads=m.loads + dampers)
+    sp = mfm.spectral_response(linear, sea)
+    assert float(sp.pto_power_mean.sum()) == pytest.approx(float(ev["objective"][0]), rel=1e-6)
+    comps = sea.components(water_depth=m.hydro.water_depth, g=m.hydro.g)
+    fr = mfm.frequency_response(linear, comps.omega, heading=float(comps.heading[0]),
+                                joint_reactions=False)
+    v = fr.xi_rao.values * comps.omega[:, None]             # (n_ω, 6K) per metre
+    sigma_v = np.sqrt(np.sum(0.5 * comps.amplitude[:, None] ** 2 * np.abs(v) ** 2, axis=0))
+    expect = D * np.sqrt(8 / np.pi) * sigma_v.reshape(-1, 6)[:, :3]
+    np.testing.assert_allclose(c_eq[:, :3], expect, rtol=1e-6, atol=1e-9 * expect.max())
+    assert jnp.isfinite(r.power).all()

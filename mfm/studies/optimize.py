@@ -213,8 +213,9 @@ class Response(NamedTuple):
     about q₀ (m or rad); ``stroke_rms`` (S, P) of each PTO's displacement (m or rad);
     ``force_rms`` (S, P) of each PTO's damping force c ẇ (N or N m); ``weights`` (S,) the seas'
     weights normalised to sum 1; ``values`` (n_par,) the parameters; ``q0`` (n_q,) the
-    equilibrium; ``drag_change`` the last relative change of the drag linearisation (0 without
-    drag)."""
+    equilibrium; ``drag_damping`` (S, 6K) the linearised drag c_eq = D √(8/π) σ_v of each
+    hydro dof in each sea (N s/m; 0 on rotations and without drag); ``drag_change`` the last
+    relative change of that fixed point (0 without drag)."""
     power: jnp.ndarray
     q_rms: jnp.ndarray
     stroke_rms: jnp.ndarray
@@ -222,6 +223,7 @@ class Response(NamedTuple):
     weights: jnp.ndarray
     values: jnp.ndarray
     q0: jnp.ndarray
+    drag_damping: jnp.ndarray
     drag_change: jnp.ndarray
 
 
@@ -295,7 +297,7 @@ def responses(pb: Problem, values) -> Response:
     q_rms = _safe_sqrt(jnp.sum(half_a2 * _abs2(x), axis=1))
     weights = pb.weights / jnp.sum(pb.weights)
     return Response(power, q_rms, _safe_sqrt(stroke_var), jnp.abs(c)[None] * _safe_sqrt(rate_var),
-                    weights, values, q0, change)
+                    weights, values, q0, c_eq, change)
 
 
 def _abs2(z):
