@@ -162,3 +162,43 @@ def test_drag_linearisation_is_a_fixed_point_of_the_numpy_route():
     expect = D * np.sqrt(8 / np.pi) * sigma_v.reshape(-1, 6)[:, :3]
     np.testing.assert_allclose(c_eq[:, :3], expect, rtol=1e-6, atol=1e-9 * expect.max())
     assert jnp.isfinite(r.power).all()
+
+
+def test_line_tension_against_the_frequency_domain_and_as_a_limit():
+    """Wu & Yuan m1's catenary lines: the tension optimize limits is the frequency domain's
+    ``fairlead_tension_rao`` (σ_T = |T̂| a/√2 in a regular wave; the same linearisation by another
+    route) and T₀ the lines' own tension at the equilibrium; a "peak" limit T₀ + 2σ_T set between
+    the baseline and the unconstrained optimum holds the optimum and is met."""
+    from mfm.frequency.rest import equilibrium, system_loads
+    from mfm.loads.catenary import CatenaryLines
+    from mfm.mechanics.kinematics import kinematics
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = mfm.load("configs/wu_yuan_m1.toml")
+    sea = Regular(height=2.0, period=8.0)
+    wecs = (tuple(f"wec{i}.angle.damping" for i in range(1, 13)),)
+    free = O.optimize(m, sea, {wecs[0]: (1e6, 2e8)})
+    ev = O.evaluate(m, sea, {wecs[0]: [4.1e7, float(free.optimum[0])]})
+    P = O._setup(m, sea, {wecs[0]: (1e6, 2e8)}, "power", None, None, None, "database", None, 40,
+                 "auto")
+    _, _, r = O._run(P, (np.array([4.1e7]) - P.lower) / (P.upper - P.lower), 1.0)
+    fr = mfm.frequency_response(m, [sea.omega], heading=0.0, joint_reactions=False)
+    np.testing.assert_allclose(r.tension_rms[0], np.abs(fr.fairlead_tension_rao.values[0]) * 1.0
+                               / np.sqrt(2), rtol=1e-9)
+    lines = next(ld for ld in system_loads(m) if isinstance(ld, CatenaryLines))
+    q0 = equilibrium(m)[0]
+    zero = np.zeros(m.n_coordinates)
+    H, V, _ = lines.tensions(lines.fairleads.positions(kinematics(m, q0, zero)))
+    np.testing.assert_allclose(r.tension, np.hypot(H, V), rtol=1e-9)
+    # the most loaded line's peak at the baseline and at the free optimum
+    name = lines.names[int(np.argmax(r.tension + 2 * r.tension_rms[0]))]
+    both = O.evaluate(m, sea, {wecs[0]: [4.1e7, float(free.optimum[0])]},
+                      constraints={f"{name}.tension": {"peak": 1.0}})["constraints"][:, 0]
+    assert both[0] != both[1]
+    limit = 0.5 * (both[0] + both[1])
+    ds = O.optimize(m, sea, {wecs[0]: (1e6, 2e8)}, constraints={f"{name}.tension": {"peak": limit}})
+    assert bool(ds.constraint_active.item())
+    assert float(ds.constraint_value.item()) <= limit * (1 + 1e-9)
+    assert float(ds.objective) <= float(free.objective) * (1 + 1e-12)
+    assert ev["objective"][1] >= ev["objective"][0]

@@ -48,6 +48,7 @@ from .. import results
 from ..errors import OptimizeError
 from ..frequency.rest import _equilibrium, _static_functions, _static_jet, system_loads, water_of
 from ..loads.base import Load
+from ..loads.catenary import CatenaryLines
 from ..loads.hydraulic_pto import HydraulicPTO
 from ..loads.mooring import PointSprings
 from ..loads.water import Water
@@ -189,7 +190,7 @@ class Problem(eqx.Module):
     the seas' components (ω (U,), a² (S, U)), the water's radiation impedance per hydro dof
     ``Zb`` (U, 6K, 6K) = −ω²(A − A∞) − iωB and excitation ``X`` (U, 6K) (per metre), the drag
     D (6K,) per hydro dof (0 on rotations), the seas' weights (S,); static: where each parameter
-    lives, the joint PTO coordinates, the hydraulic PTO load, the water load."""
+    lives, the joint PTO coordinates, the hydraulic PTO load, the water load, the catenary loads."""
     model: Model
     static: tuple
     mems: tuple
@@ -205,6 +206,7 @@ class Problem(eqx.Module):
     hydraulic: int = eqx.field(static=True)
     water: int = eqx.field(static=True)
     drag_iterations: int = eqx.field(static=True)
+    lines: tuple = eqx.field(static=True, default=())
 
 
 class Response(NamedTuple):
@@ -215,7 +217,9 @@ class Response(NamedTuple):
     weights normalised to sum 1; ``values`` (n_par,) the parameters; ``q0`` (n_q,) the
     equilibrium; ``drag_damping`` (S, 6K) the linearised drag c_eq = D √(8/π) σ_v of each
     hydro dof in each sea (N s/m; 0 on rotations and without drag); ``drag_change`` the last
-    relative change of that fixed point (0 without drag)."""
+    relative change of that fixed point (0 without drag); ``tension`` (L,) each catenary line's
+    fairlead tension at q₀ and ``tension_rms`` (S, L) the standard deviation of its first-order
+    change ∂T/∂r_F · r̂_F (N)."""
     power: jnp.ndarray
     q_rms: jnp.ndarray
     stroke_rms: jnp.ndarray
@@ -225,6 +229,8 @@ class Response(NamedTuple):
     q0: jnp.ndarray
     drag_damping: jnp.ndarray
     drag_change: jnp.ndarray
+    tension: jnp.ndarray
+    tension_rms: jnp.ndarray
 
 
 def _newton(f, q):
@@ -296,8 +302,33 @@ def responses(pb: Problem, values) -> Response:
     power = c[None] * rate_var          # Σ_j a² ½ c ω² |G x̂|² (mean of c ẇ²)
     q_rms = _safe_sqrt(jnp.sum(half_a2 * _abs2(x), axis=1))
     weights = pb.weights / jnp.sum(pb.weights)
+    tension, tension_rms = _tensions(static, pb.lines, jet.kin, x, half_a2)
     return Response(power, q_rms, _safe_sqrt(stroke_var), jnp.abs(c)[None] * _safe_sqrt(rate_var),
-                    weights, values, q0, c_eq, change)
+                    weights, values, q0, c_eq, change, tension, tension_rms)
+
+
+def _tensions(static, lines, kin, x, half_a2):
+    """Fairlead tensions T = √(H² + V²) at q₀ (L,) and the standard deviation of their
+    linearisation T̂ = ∂T/∂r_F · H_F x̂ (S, L), of the catenary loads at ``lines`` (the frequency
+    domain's ``fairlead_tension_rao``)."""
+    if not lines:
+        return jnp.zeros((0,)), jnp.zeros((x.shape[0], 0))
+    T0, var = [], []
+    for li in lines:
+        ld = static[li]
+
+        def tension(p, ld=ld):
+            H, V, _ = ld.tensions(p)
+            return jnp.sqrt(H * H + V * V)
+
+        p0 = ld.fairleads.positions(kin)
+        n = p0.shape[0]
+        dT = jnp.einsum("kka->ka", jax.jacfwd(tension)(p0))                  # (L, 3)
+        Hp = ld.fairleads.h_matrix(kin)[0].reshape(n, 6, -1)[:, :3]          # (L, 3, n_q)
+        rao = jnp.einsum("ka,kai,sui->suk", dT, Hp, x)
+        T0.append(tension(p0))
+        var.append(jnp.sum(half_a2 * _abs2(rao), axis=1))
+    return jnp.concatenate(T0), _safe_sqrt(jnp.concatenate(var, axis=1))
 
 
 def _abs2(z):
@@ -318,19 +349,21 @@ def mean_power(r: Response):
 
 # ------------------------------------------------------------------------------- constraints
 class Limit(NamedTuple):
-    """One constraint: ``quantity`` (a coordinate or a PTO of the model) ``kind`` "rms" (standard
-    deviation) or "significant" (the significant amplitude 2σ: the mean of the highest third of a
-    narrow-band Gaussian response's amplitudes, as H_s = 4σ is of crest-to-trough heights) must
-    stay ≤ ``limit`` (m or rad) in every sea."""
+    """One constraint: ``quantity`` (a coordinate, a PTO of the model, or ``"<line>.tension"``
+    of a catenary mooring line) ``kind`` "rms" (standard deviation) or "significant" (the
+    significant amplitude 2σ: the mean of the highest third of a narrow-band Gaussian response's
+    amplitudes, as H_s = 4σ is of crest-to-trough heights), or for a tension also "peak" (the
+    tension at rest plus the significant amplitude, T₀ + 2σ_T), must stay ≤ ``limit`` (m, rad or
+    N) in every sea."""
     quantity: str
     kind: str
     limit: float
 
 
-KINDS = {"rms": 1.0, "significant": 2.0}
+KINDS = {"rms": 1.0, "significant": 2.0, "peak": 2.0}
 
 
-def _limits(constraints, coordinates, ptos) -> list[Limit]:
+def _limits(constraints, coordinates, ptos, lines=()) -> list[Limit]:
     if constraints is None:
         return []
     if not isinstance(constraints, dict):
@@ -338,17 +371,19 @@ def _limits(constraints, coordinates, ptos) -> list[Limit]:
                         "'significant': limit}, e.g. {'platform.pitch': {'rms': 0.035}}")
     out = []
     for q, spec in constraints.items():
-        if q not in coordinates and q not in ptos:
-            raise KeyError(f"constraints: {q!r} is neither a coordinate nor a PTO of the model; "
-                           f"coordinates: {list(coordinates)}, PTOs: {list(ptos)} (line tension "
-                           "is not a constraint of the spectral level yet)")
+        tensions = [f"{n}.tension" for n in lines]
+        if q not in coordinates and q not in ptos and q not in tensions:
+            raise KeyError(f"constraints: {q!r} is neither a coordinate, a PTO nor a catenary "
+                           f"line's tension of the model; coordinates: {list(coordinates)}, PTOs: "
+                           f"{list(ptos)}, tensions: {tensions}")
         if not isinstance(spec, dict) or not spec:
             raise TypeError(f"constraints[{q!r}]: {spec!r}; give {{'rms': limit}} or "
                             "{'significant': limit} (m or rad)")
         for kind, lim in spec.items():
-            if kind not in KINDS:
-                raise KeyError(f"constraints[{q!r}]: {kind!r} is not a kind of limit; give one of "
-                               f"{list(KINDS)}")
+            kinds = list(KINDS) if q in tensions else ["rms", "significant"]
+            if kind not in kinds:
+                raise KeyError(f"constraints[{q!r}]: {kind!r} is not a kind of limit here; give one "
+                               f"of {kinds}")
             if not isinstance(lim, (int, float)) or not math.isfinite(lim) or lim <= 0:
                 raise ValueError(f"constraints[{q!r}][{kind!r}]: {lim!r}; give a positive, finite "
                                  "limit (m or rad)")
@@ -357,11 +392,12 @@ def _limits(constraints, coordinates, ptos) -> list[Limit]:
 
 
 def _constraint_values(r: Response, spec):
-    """Each limit's value in each sea (n_limits, S): KINDS[kind] × σ of a coordinate or a PTO."""
+    """Each limit's value in each sea (n_limits, S): KINDS[kind] × σ of a coordinate, a PTO or a
+    tension, plus the tension at rest for a "peak"."""
     rows = []
-    for source, index, factor in spec:
-        arr = r.q_rms if source == "q" else r.stroke_rms
-        rows.append(factor * arr[:, index])
+    for source, index, factor, static in spec:
+        arr = {"q": r.q_rms, "pto": r.stroke_rms, "tension": r.tension_rms}[source]
+        rows.append(factor * arr[:, index] + (r.tension[index] if static else 0.0))
     return jnp.stack(rows) if rows else jnp.zeros((0, r.power.shape[0]))
 
 
@@ -490,10 +526,18 @@ def _setup(model, seas, parameters, objective, constraints, weights, loads, radi
     pto_names = [model.coordinates[k] for k in joint]
     if hydraulic:
         pto_names += list(static[hydraulic[0]].names)
-    limits = _limits(constraints, model.coordinates, pto_names)
-    spec = tuple(("q", model.coordinates.index(lm.quantity), KINDS[lm.kind])
-                 if lm.quantity in model.coordinates else
-                 ("pto", pto_names.index(lm.quantity), KINDS[lm.kind]) for lm in limits)
+    lines = tuple(i for i, ld in enumerate(static) if isinstance(ld, CatenaryLines))
+    line_names = [n for i in lines for n in static[i].names]
+    limits = _limits(constraints, model.coordinates, pto_names, line_names)
+
+    def where(lm):
+        if lm.quantity in model.coordinates:
+            return ("q", model.coordinates.index(lm.quantity), KINDS[lm.kind], False)
+        if lm.quantity in pto_names:
+            return ("pto", pto_names.index(lm.quantity), KINDS[lm.kind], False)
+        return ("tension", line_names.index(lm.quantity[:-len(".tension")]), KINDS[lm.kind],
+                lm.kind == "peak")
+    spec = tuple(where(lm) for lm in limits)
     q0, _ = _equilibrium(model, lds)
     omega, a2, Zb, X, water = _sea_union(model, seas, lds, radiation, state_space_options)
     drag = np.zeros(Zb.shape[1])
@@ -503,7 +547,7 @@ def _setup(model, seas, parameters, objective, constraints, weights, loads, radi
                  jnp.asarray(Zb), jnp.asarray(X), jnp.asarray(drag), jnp.asarray(w),
                  tuple(grp for _, grp, *_ in params), joint,
                  hydraulic[0] if hydraulic else -1, water_index,
-                 int(drag_iterations) if np.any(drag > 0) else 0)
+                 int(drag_iterations) if np.any(drag > 0) else 0, lines)
 
     labels = [p[0] for p in params]
     lower = np.array([p[2] for p in params])
