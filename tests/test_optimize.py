@@ -112,7 +112,7 @@ def test_bad_input_is_named(m4):
         O.optimize(m4, SEA, {"float3.angle.damping": (5.0, 1.0)})
     with pytest.raises(ValueError, match="finite"):
         O.optimize(m4, SEA, {"float3.angle.damping": (0.0, np.inf)})
-    with pytest.raises(KeyError, match="neither a coordinate nor a PTO"):
+    with pytest.raises(KeyError, match="neither a coordinate, a PTO nor a catenary"):
         O.optimize(m4, SEA, PAIRS, constraints={"float9.pitch": {"rms": 0.1}})
     with pytest.raises(ValueError, match="weights"):
         O.optimize(m4, [SEA, SEA], PAIRS, weights=[1.0, -1.0])
