@@ -119,6 +119,16 @@ def test_bad_input_is_named(m4):
     with pytest.raises(OptimizeError, match="cannot be met") as err:
         O.optimize(m4, SEA, PAIRS, constraints={"float1.pitch": {"rms": 1e-4}})
     assert set(err.value.last_good) == {" + ".join(k) for k in PAIRS}
+    # an objective non-finite past 10 N m s/rad, started at 20: stopped at once, and the last
+    # finite point is the model's own (6 N m s/rad on every hinge, evaluated first)
+    import jax.numpy as jnp
+
+    def nan_above_10(r):
+        return jnp.where(r.values[0] < 10.0, O.mean_power(r), jnp.nan)
+
+    with pytest.raises(OptimizeError, match="non-finite") as err:
+        O.optimize(m4, SEA, PAIRS, objective=nan_above_10, x0={" + ".join(k): 20.0 for k in PAIRS})
+    assert err.value.last_good == {" + ".join(k): 6.0 for k in PAIRS}
 
 
 def test_drag_linearisation_is_a_fixed_point_of_the_numpy_route():

@@ -642,7 +642,7 @@ def optimize(model: Model, seas, parameters: dict, *, objective: Callable | str 
                             f"own values {point(u_base)}: {base_out.tolist()}", last_good=None)
     scale = max(abs(float(base_out[0])), 1e-300)
     cache = {}
-    last_good = {"u": to_u(start_values)}
+    last_good = {"u": u_base}      # finite: checked above
 
     def evaluate(u):
         """(outputs, jacobian, responses) at u, computed once per point (SLSQP asks for the
