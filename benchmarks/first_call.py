@@ -1,0 +1,108 @@
+"""Issue 34's first-answer rows: what a new user waits for, each in a fresh process (not a test).
+
+    python benchmarks/first_call.py [--only rm3 m4 m4_cached wu_yuan]
+
+- ``rm3``: the README's first command (``mfm simulate configs/rm3.toml ...``, the run without the
+  install), compilation and fit caches empty (fresh folders). Goal ≤ 3 s.
+- ``m4``: M4 134, ``mfm.simulate`` with its defaults (RK4, state space), JONSWAP H_s 0.04 m,
+  T_p 1.2 s, 100 T_p at dt = T_p/200 (the sea of benchmarks/speed.py), empty caches. Goal ≤ 8 s.
+- ``m4_cached``: the same in a second fresh process that finds the caches the first one filled.
+  Goal ≤ 1.5 s.
+- ``wu_yuan``: ``mfm simulate configs/wu_yuan_m1_td.toml --wave regular --height 2 --period 8
+  --duration 600 --dt 0.05 --progress on --no-plot``, empty caches, with every phase line the command prints (its progress bar on stderr). Goal
+  ≤ 20 s, every phase shown.
+
+Each row's wall time is the child process's, from its start (imports and loading included), so a
+row is what the user waits for. Figures depend on the machine and its load: say which when
+quoting them.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+M4 = """
+import time, warnings
+t0 = time.perf_counter()
+import hydro, mfm
+m = mfm.load("configs/m4_134.toml")
+sea = hydro.Jonswap(hs=0.04, tp=1.2, gamma=3.3, seed=1, omega_range=(1.0, 25.0))
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    ds = mfm.simulate(m, sea, duration=120.0, dt=0.006)
+print("PHASES", round(time.perf_counter() - t0, 2), float(ds.pto_power.mean()))
+"""
+
+
+def _run(argv, env, cwd):
+    t0 = time.perf_counter()
+    r = subprocess.run(argv, cwd=cwd, env=env, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    if r.returncode:
+        sys.exit(f"{argv} failed:\n{r.stderr[-3000:]}")
+    return wall, r
+
+
+def _phases(stderr: str) -> list[str]:
+    """The distinct phase descriptions of a tqdm bar's lines (carriage returns split them)."""
+    seen = []
+    for part in re.split(r"[\r\n]", stderr):
+        m = re.match(r"\s*([^:|]{3,80}?):\s+\d+%", part)
+        if m and m.group(1).strip() not in seen:
+            seen.append(m.group(1).strip())
+    return seen
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--only", nargs="*", default=["rm3", "m4", "m4_cached", "wu_yuan"])
+    a = ap.parse_args(argv)
+    print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at the start")
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        for name in ("configs", "hydro"):
+            (tmp / name).symlink_to(ROOT / name)
+
+        def env(tag):
+            return dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg",
+                        MFM_COMPILATION_CACHE=str(tmp / f"jax-{tag}"),
+                        MFM_FIT_CACHE=str(tmp / f"fit-{tag}"))
+
+        if "rm3" in a.only:
+            line = next(ln for ln in (ROOT / "README.md").read_text().splitlines()
+                        if "mfm simulate configs/rm3.toml" in ln)
+            cmd = line.split("&&")[-1].strip().split()
+            wall, _ = _run([sys.executable, str(ROOT / "mfm_cli.py"), *cmd[1:]], env("rm3"), tmp)
+            print(f"RM3, the README's first command, empty caches: {wall:.1f} s (goal ≤ 3 s)")
+        if "m4" in a.only or "m4_cached" in a.only:
+            (tmp / "m4.py").write_text(M4)
+            wall, _ = _run([sys.executable, "m4.py"], env("m4"), tmp)
+            print(f"M4 134 simulate with defaults (120 s at dt 0.006 s), empty caches: {wall:.1f} s "
+                  "(goal ≤ 8 s)")
+            if "m4_cached" in a.only:
+                wall, _ = _run([sys.executable, "m4.py"], env("m4"), tmp)
+                print(f"M4 134, the same in a process after one that filled the caches: "
+                      f"{wall:.1f} s (goal ≤ 1.5 s)")
+        if "wu_yuan" in a.only:
+            out = tmp / "wy.nc"
+            wall, r = _run([sys.executable, str(ROOT / "mfm_cli.py"), "simulate",
+                            "configs/wu_yuan_m1_td.toml", "--wave", "regular", "--height", "2",
+                            "--period", "8", "--duration", "600", "--dt", "0.05", "--progress",
+                            "on", "--no-plot", "--out", str(out)],
+                           env("wy"), tmp)
+            phases = _phases(r.stderr)
+            print(f"Wu & Yuan m1 time domain, 600 s, empty caches: {wall:.1f} s (goal ≤ 20 s, every "
+                  f"phase shown); phases shown: {phases or 'none'}")
+    print(f"load average {os.getloadavg()[0]:.1f} at the end")
+
+
+if __name__ == "__main__":
+    main()
