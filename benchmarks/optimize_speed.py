@@ -45,12 +45,16 @@ def child_wu_yuan(repeats):
 
 
 def child_m4_matrix(repeats):
+    import numpy as np
+
+    import hydro
     import mfm
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    from power_matrix import cases
 
     m = mfm.load(str(ROOT / "configs/m4_134.toml"))
-    seas = cases()[0]
+    # the matrix of benchmarks/power_matrix.py: 10 H_s × 12 T_p, JONSWAP γ 3.3, seed 1
+    seas = [hydro.Jonswap(hs=h, tp=t, gamma=3.3, seed=1, omega_range=(1.0, 25.0))
+            for h in np.round(np.linspace(0.01, 0.06, 10), 3)
+            for t in np.round(np.linspace(0.8, 1.8, 12), 3)]
     params = {f"{c}.damping": (0.0, 30.0) for c in m.coordinates[3:]}
     t = time.perf_counter()
     ds = mfm.optimize(m, seas, params)
