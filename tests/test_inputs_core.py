@@ -230,3 +230,17 @@ def test_a_body_without_its_parent_beside_a_floating_root_is_refused(tmp_path):
     with pytest.raises(mfm.ConfigError, match="bodies 'spar' and 'float' both name the database "
                                               "body 'spar'"):
         mfm.load(two)
+
+
+def test_a_body_renamed_against_its_database_is_refused(tmp_path):
+    """M4 134 matches its bodies to the database by name: float8 renamed in the config would run
+    dry (no buoyancy, no waves) beside a database body no one uses; refused naming both, with
+    the fix."""
+    text = (CONFIGS / "m4_134.toml").read_text()
+    db = str((CONFIGS / "../hydro/data/m4_134.nc").resolve())
+    text = text.replace('"../hydro/data/m4_134.nc"', repr(db).replace("'", '"'))
+    renamed = tmp_path / "renamed.toml"
+    renamed.write_text(text.replace('name = "float8"', 'name = "float8b"', 1))
+    with pytest.raises(mfm.ConfigError, match=r"database bodies \['float8'\] are used by no config "
+                                              r"body.*\['float8b'\].*renamed.*\[bodies.hydro\]"):
+        mfm.load(renamed)

@@ -600,6 +600,16 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
         wet = [(name, h["body"], h["drag"]) for name, h in tagged]
     else:
         wet = [(b.name, b.name, np.zeros(3)) for b in bodies if b.name in available]
+        # matched by name: a database body left over while a config body found none is most
+        # likely one of them renamed (the config body would run dry: a silent wrong answer)
+        unused = [d for d in available if d not in {b.name for b in bodies}]
+        dry = [b.name for b in bodies if b.name not in available]
+        if wet and unused and dry:
+            raise ConfigError(
+                f"hydro: database bodies {unused} are used by no config body, and config bodies "
+                f"{dry} are not in the database {str(path)!r} (bodies {available}): a body "
+                "renamed? Bodies are matched by name; give each wet body a [bodies.hydro] table "
+                "with body = \"<database name>\" (with such tables, bodies without one are dry)")
     if not wet:
         raise ValueError(f"hydro: no config body is in the database {str(path)!r} (database bodies "
                          f"{available}, config bodies {[b.name for b in bodies]}); give each wet "
