@@ -577,7 +577,7 @@ def optimum(model, loads, seas, *, labels, units, optimum, baseline, lower, uppe
     }
     if confirm is not None:
         data.update(
-            time_domain_power=(("case",), confirm["power"].sum(axis=1),
+            time_domain_power=(("case",), confirm["power"],
                                {"long_name": "mean power of every PTO in the time domain at the "
                                 "optimum, after the settling time", "units": "W"}),
             time_domain_objective=((), confirm["objective"], {"units": "W"}),

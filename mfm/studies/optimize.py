@@ -389,34 +389,37 @@ def evaluate(model: Model, seas, points: dict, *, objective: Callable | str = "p
 
 
 def _confirm(model, seas, values, params, weights, r_opt, options):
-    """The optimised model in the same seas by :func:`mfm.simulate_batch`: each PTO's mean power
-    after ``settle`` against the spectral prediction."""
+    """The optimised model stepped in the same seas (Verlet with exact radiation unless
+    ``options`` say otherwise): every PTO's mean power after ``settle`` against the spectral
+    prediction. One :func:`mfm.simulate_batch` call for the seas; a model with hydraulic pistons
+    runs :func:`mfm.simulate` per sea (a batch records joint dampers only)."""
     from ..timedomain.batch import simulate_batch
+    from ..timedomain.simulation import simulate
 
     options = dict(options)
     if "dt" not in options or "n_steps" not in options:
-        raise ValueError(f"confirm: {options!r}; give at least dt (s) and n_steps for "
-                         "mfm.simulate_batch")
+        raise ValueError(f"confirm: {options!r}; give at least dt (s) and n_steps (the options of "
+                         "mfm.simulate_batch), and settle (s) if not half the run")
     settle = options.pop("settle", None)
     opt_model = apply(model, {n: v for (label, grp, *_), v in zip(params, values.values())
                               for n in label.split(" + ")})
-    hyd = any(isinstance(ld, HydraulicPTO) for ld in opt_model.loads)
     options.setdefault("integrator", "verlet")
     options.setdefault("radiation", "state_space_exact")
-    if hyd:
-        options["outputs"] = tuple(options.get("outputs", ())) + ("hydraulic_power",)
-    ds = simulate_batch(opt_model, seas, **options)
-    t = np.asarray(ds.time.values)
-    settle = 0.5 * float(t[0, -1]) if settle is None else float(settle)
-    keep = t[0] >= t[0, 0] + settle
-    parts = []
-    if "pto_power" in ds:
-        parts.append(np.asarray(ds.pto_power.values)[:, keep].mean(axis=1))
-    if hyd:
-        parts.append(np.asarray(ds.hydraulic_power.values)[:, keep].mean(axis=1))
-    power = np.concatenate(parts, axis=1) if parts else np.zeros((len(seas), 0))
+    if any(isinstance(ld, HydraulicPTO) for ld in opt_model.loads):
+        one = dict(options)
+        n_steps = int(one.pop("n_steps"))
+        runs = [simulate(opt_model, sea, duration=n_steps * float(one["dt"]), **one) for sea in seas]
+        times = [np.asarray(ds.time.values) for ds in runs]
+        powers = [np.asarray(ds.pto_power.values) for ds in runs]
+    else:
+        ds = simulate_batch(opt_model, seas, **options)
+        times = list(np.asarray(ds.time.values))
+        powers = list(np.asarray(ds.pto_power.values)) if "pto_power" in ds else \
+            [np.zeros((len(t), 0)) for t in times]
+    settle = 0.5 * float(times[0][-1] - times[0][0]) if settle is None else float(settle)
+    power = np.stack([p[t >= t[0] + settle].mean(axis=0).sum() for t, p in zip(times, powers)])
     wn = weights / weights.sum()
-    td = float(np.sum(wn * power.sum(axis=1)))
+    td = float(np.sum(wn * power))
     spectral = float(np.sum(wn * r_opt.power.sum(axis=1)))
     rel = (td - spectral) / abs(spectral) if spectral else math.nan
     print(f"optimize: time-domain mean power at the optimum {td:.6g} W against the spectral "
