@@ -215,3 +215,24 @@ def test_scenario_reading_another_configs_database_is_checked_by_its_hulls():
 
     stale, why = database_is_stale(CONFIGS / "hallak_hydro_coupled.toml")
     assert not stale and "matches the hulls" in why
+
+
+def test_peak_band_config_is_the_fully_coupled_one():
+    """configs/hallak_fwwp_peak.toml (the dense band over the power peak) copies the fully coupled
+    config: only the model's name, the database and the BEM's frequencies may differ, so an edit
+    to one config that misses the other is caught here."""
+    main, band = (tomllib.loads((CONFIGS / f"hallak_{k}.toml").read_text()) for k in ("fwwp", "fwwp_peak"))
+    for cfg in (main, band):
+        del cfg["model"]["name"], cfg["hydro"]["database"], cfg["hydro"]["bem"]["omega"]
+    assert band == main
+
+
+def test_peak_band_database_is_the_same_solve():
+    """Where the band database's frequencies are the main one's (1.06, 1.09, … 1.30 rad/s), its
+    coefficients are the main database's: the same hulls, panels and settings solved again."""
+    dbs = [hydro.bem.load(CONFIGS / f"../hydro/data/hallak_{k}.nc") for k in ("fwwp", "fwwp_peak")]
+    common = np.intersect1d(dbs[0]["omega"].values, dbs[1]["omega"].values)
+    assert len(common) == 10    # the 9 shared finite frequencies and ∞
+    for name in ("added_mass", "radiation_damping", "excitation_force"):
+        a, b = (np.asarray(db[name].sel(omega=common).values) for db in dbs)
+        np.testing.assert_allclose(b, a, rtol=0, atol=1e-9 * np.nanmax(np.abs(a)))   # no wave force at ∞ (NaN)
