@@ -432,3 +432,51 @@ def test_equilibrium_newton_to_the_analytic_angle():
     # hanging from the hinge, the torque balances m g L sin θ (either sense of the axis: |θ|)
     assert abs(float(q0[0])) == pytest.approx(math.asin(0.8), abs=2e-10), (info, float(q0[0]))
     assert info["iterations"] >= 4              # the test needs Newton's steps: it starts at 0
+
+
+# ----------------------------------------------------- a power matrix of 2 Hs × 3 Tp, out of order
+def test_power_matrix_of_a_rectangular_sweep_in_any_case_order():
+    """plot_batch's power matrix: Hs (rows) × Tp (columns), each cell the mean over the kept steps
+    of the case with that (Hs, Tp), summed over the PTOs. Cases here run Tp-major and shuffled,
+    2 Hs × 3 Tp, P = 100 Hs + Tp + 0.5 (two PTOs of ½ and ½ + the rest): the cell (i, j) must be
+    100 H_i + T_j + 0.5 exactly whatever the case order (a reshape of the case list would put
+    them in the wrong cells)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import xarray as xr
+
+    from mfm.io.plotting import plot_batch
+
+    H, T = np.array([1.0, 2.0]), np.array([6.0, 8.0, 10.0])
+    cases = [(h, t) for t in T for h in H]
+    cases = [cases[k] for k in (3, 0, 5, 1, 4, 2)]
+    hs = np.array([c[0] for c in cases])
+    tp = np.array([c[1] for c in cases])
+    P = 100 * hs + tp
+    n_step = 10
+    power = np.empty((len(cases), n_step, 2))
+    power[:, :, 0] = 0.5
+    power[:, :, 1] = P[:, None]
+    power[:, : n_step // 2, 1] = -1e6            # the discarded first half
+    ds = xr.Dataset({"pto_power": (("case", "step", "pto"), power)},
+                    coords={"hs": ("case", hs), "tp": ("case", tp), "pto": ["a", "b"]})
+    fig = plot_batch(ds, discard=0.5)
+    try:
+        M = np.asarray(fig.axes[0].collections[0].get_array()).reshape(len(H), len(T))
+    finally:
+        plt.close(fig)
+    np.testing.assert_array_equal(M, 100 * H[:, None] + T[None, :] + 0.5)
+
+
+def test_reduce_errors_are_against_the_total_power():
+    """reduce's errors (mfm.studies.fidelity, docstring of reduce): each PTO's mean power against
+    the total mean power of the reference, each standard deviation against its own. By hand:
+    PTO a 1.0 → 1.1 W and b 10 → 9 W of a total 11 W: 0.1/11 and 1/11; std 0.4 → 0.5: 0.25."""
+    from mfm.studies.fidelity import _errors
+
+    ref = {"pto_power[a]": 1.0, "pto_power[b]": 10.0, "std[x]": 0.4}
+    got = _errors({"pto_power[a]": 1.1, "pto_power[b]": 9.0, "std[x]": 0.5}, ref)
+    assert got == pytest.approx({"pto_power[a]": 0.1 / 11, "pto_power[b]": 1.0 / 11, "std[x]": 0.25},
+                                rel=1e-12)
