@@ -127,6 +127,41 @@ def test_frequency_response_at_heading(setup):
                                head.sel(coordinate="sphere.heave").values, rtol=1e-10)
 
 
+def test_spectral_statistics_of_a_spread_sea_by_two_routes(setup):
+    """q_rms of the spectral level (issue 35 item 7: it was checked only against spectral_sweep,
+    the same code) by two independent routes on a spread sea of 12 components, each its own heading:
+
+    - the hand sum σ_q² = Σ_j ½ a_j² |x̂(ω_j, β_j)|² with x̂ from mfm.frequency_response at each
+      component's own heading (one call per heading);
+    - Parseval: the standard deviation over one repeat period of the synthesised q(t) (the
+      components are distinct multiples of 2π/T_R below the Nyquist frequency, so the time mean
+      of each cross term is 0 to round-off).
+
+    Both are the same numbers summed another way: 1e-9 (round-off of 12 terms; the period mean
+    of 640 samples). A q_rms without the ½ is off by √2; RAOs of one heading for all (surge and
+    pitch ∝ cos β) by ≥ 10 % here, as the check on the spread (np.ptp of the headings) says."""
+    model, _ = setup
+    T = 32.0
+    sea = hydro.Jonswap(hs=0.1, tp=3.0, heading=0.4, spreading=hydro.Spreading(s=2.0),
+                        repeat_period=T, n_components=12, omega_range=(0.8, 5.0), seed=3)
+    c = sea.components()
+    assert np.ptp(c.heading) > 1.0 and len(np.unique(c.heading)) == len(c)
+    q0 = np.zeros(model.n_coordinates)                   # the sphere's equilibrium (m = ρV)
+    t = np.arange(640) * (T / 640)
+    ds = mfm.spectral_response(model, sea, q0=q0, t=t)
+    var = np.zeros(model.n_coordinates)
+    for w, a, b in zip(c.omega, c.amplitude, c.heading):
+        x = mfm.frequency_response(model, [w], heading=float(b), q0=q0, joint_reactions=False).rao.values[0]
+        var += 0.5 * a**2 * np.abs(x) ** 2
+    np.testing.assert_allclose(ds.q_rms.values, np.sqrt(var), rtol=1e-9)
+    np.testing.assert_allclose(ds.q.values.std(axis=0), ds.q_rms.values, rtol=1e-9)
+    # the one-heading answer differs by far more than the tolerance: the test can fail
+    x0 = mfm.frequency_response(model, c.omega, heading=float(c.heading[0]), q0=q0,
+                                joint_reactions=False).rao.values
+    one = np.sqrt(np.sum(0.5 * c.amplitude[:, None] ** 2 * np.abs(x0) ** 2, axis=0))
+    assert np.max(np.abs(one / np.sqrt(var) - 1)) > 0.1
+
+
 @pytest.mark.parametrize("s", [1.0, 4.0, 15.0])
 def test_spreading_directions_follow_cos2s(s):
     # E[cos β] = s/(s+1) for G ∝ cos^{2s}(β/2); 4e4 draws: standard error < 0.004

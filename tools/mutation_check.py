@@ -56,6 +56,15 @@ HEAD_SPREAD = (_H + "test_spreading_directions_follow_cos2s", _H + "test_spread_
 HEAD_FR = (_H + "test_frequency_response_at_heading",)
 PLUG = ("tests/test_loads_plugins.py",)
 
+# issue 35 item 7: the independent routes (tests/test_independent_routes.py and one test beside
+# the multi-heading sphere of tests/test_device_headings.py)
+_IR = "tests/test_independent_routes.py::"
+IR_WAMIT = (_IR + "test_wamit_ulen_scaling_of_a_second_body_by_hand",)
+IR_CAPY = (_IR + "test_capytaine_two_bodies_of_different_mass_about_their_rotation_centres",)
+IR_MINDET = (_IR + "test_min_det_refinement_against_the_analytic_root",)
+IR_STABLE = (_IR + "test_largest_stable_dt_of_rk4_to_its_closed_form", "tests/test_stability.py")
+IR_SPECTRAL = (_H + "test_spectral_statistics_of_a_spread_sea_by_two_routes",)
+
 MUTANTS = [
     # ---------------------------------------------------------------- PTOs (issue 16 bugs 1, 2)
     Mutant("pto-gdot-sign", "planted bug 1: the sign of (|Δv|² − ẇ²)/L in the hydraulic PTO's ġq̇ flipped",
@@ -152,6 +161,78 @@ MUTANTS = [
            "acc = (H @ ctx.qdd + bias).reshape(P, 6)[:, :3]", "acc = (H @ ctx.qdd).reshape(P, 6)[:, :3]", PLUG),
     Mutant("free-coordinates-clamped", "natural frequencies with the coordinates without stiffness clamped",
            "return Mw[ix] + Mw[np.ix_(stiff, free)] @ G, G", "return Mw[ix], G", NATFREQ + (_F + "test_sphere_pitch_natural_frequency_with_surge_free",)),
+    # ------------------------------------------- issue 35 item 7: tests that compared the code with itself
+    # Against the module's existing tests alone 18 of these 22 survived; excitation-heading-long-arc
+    # (the one-pass polar form against the two-step chain), equilibrium-early-stop (the heavy sphere's
+    # equilibrium) and the two state-space order searches were already caught.
+    # (a) derived statistics checked only against another path of the same code
+    Mutant("spectral-qrms-no-half", "spectral q_rms = √Σ a²|x̂|² (the ½ of a harmonic's variance dropped)",
+           "q_rms[i] = np.sqrt(np.sum(0.5 * a2 * np.abs(x) ** 2, axis=0))",
+           "q_rms[i] = np.sqrt(np.sum(a2 * np.abs(x) ** 2, axis=0))", IR_SPECTRAL),
+    Mutant("spectral-raos-first-heading", "spectral RAOs of a spread sea all solved at its first heading",
+           "x[sel] = _amplitudes(model, sys, union[sel, 1], float(beta), options)",
+           "x[sel] = _amplitudes(model, sys, union[sel, 1], float(union[0, 0]), options)", IR_SPECTRAL),
+    Mutant("user-spectrum-hs-rectangles", "UserSpectrum.hs by right rectangles instead of the trapezoid rule",
+           "return 4.0 * math.sqrt(float(np.trapezoid(self.S, self.omega)))",
+           "return 4.0 * math.sqrt(float(np.sum(self.S[1:] * np.diff(self.omega))))",
+           (_IR + "test_user_spectrum_hs_is_the_area_of_its_table",) + SPEC),
+    Mutant("welch-see-per-hz", "spectral_rao's S_ηη per Hz instead of per rad/s",
+           "return 2 * math.pi * f, rao, S_ee / (2 * math.pi)", "return 2 * math.pi * f, rao, S_ee",
+           (_IR + "test_welch_elevation_spectrum_integrates_to_its_variance",)),
+    Mutant("reduce-error-own-scale", "reduce's PTO error against its own mean power, not the total",
+           'scale = total if k.startswith("pto_power") else (abs(ref) or 1.0)',
+           "scale = abs(ref) or 1.0",
+           (_IR + "test_reduce_errors_are_against_the_total_power",)),
+    # (b) readers and tables tested only on the shipped shapes
+    Mutant("wamit-x-rot-by-mode-number", "WAMIT .3: a later body's forces scaled by ULEN³ as moments (mode > 3)",
+           "rot = (im % 6) >= 3", "rot = im >= 3", IR_WAMIT),
+    Mutant("wamit-kab-by-mode-number", "WAMIT .1/.hst: ULEN exponents by the mode number, not the mode of its body",
+           "rot = (np.arange(n) % 6) >= 3", "rot = np.arange(n) >= 3", IR_WAMIT),
+    Mutant("wamit-hst-ulen", "WAMIT .hst scaled by ULEN^k (the k of A, B) instead of ULEN^(k−1)",
+           "C = C * rho * g * L ** (k_ab - 1)", "C = C * rho * g * L ** k_ab", IR_WAMIT),
+    Mutant("nemoh-added-mass-transposed", "NEMOH A(ω) read transposed (zone = influenced dof)",
+           "A = np.transpose(R[:, :, 1::2], (1, 2, 0))[order]",
+           "A = np.transpose(R[:, :, 1::2], (1, 0, 2))[order]",
+           (_IR + "test_nemoh_radiation_zones_read_back_entry_by_entry",)),
+    Mutant("nemoh-excitation-reshape", "NEMOH excitation zones (heading, ω) reshaped, not transposed, to (ω, heading)",
+           "return np.transpose(Xc, (1, 0, 2))[order], np.deg2rad(beta)",
+           "return Xc.reshape(Xc.shape[1], Xc.shape[0], -1)[order], np.deg2rad(beta)",
+           (_IR + "test_nemoh_excitation_of_three_headings_by_hand",)),
+    Mutant("excitation-heading-long-arc", "excitation phase between headings along the long arc",
+           "dP = xp.remainder(P1 - P0 + math.pi, 2.0 * math.pi) - math.pi", "dP = P1 - P0",
+           (_IR + "test_heading_interpolation_takes_the_short_way_across_the_cut",)),
+    Mutant("heading-two-periodic", "two headings taken for a full circle (periodic interpolation)",
+           "covers = n >= 3 and", "covers = n >= 2 and",
+           (_IR + "test_two_headings_are_not_a_full_circle",)),
+    Mutant("power-matrix-reshape", "plot_batch's power matrix by reshaping the cases (Hs-major order assumed)",
+           "M[np.searchsorted(H, hs), np.searchsorted(T, tp)] = P.values",
+           "M[:] = P.values.reshape(len(H), len(T))",
+           (_IR + "test_power_matrix_of_a_rectangular_sweep_in_any_case_order",)),
+    Mutant("capytaine-mass-first-body", "capytaine hydrostatics: every body's gravity term with the first body's mass",
+           'm = Mfile[o, o] if Mfile is not None and Mfile[o, o] > 0 else rho * h["volume"]',
+           'm = Mfile[0, 0] if Mfile is not None and Mfile[0, 0] > 0 else rho * h["volume"]', IR_CAPY),
+    Mutant("capytaine-rotation-centre-first-body", "capytaine: every body's rotation centre the first body's",
+           "ref[b] = rc[b]", "ref[b] = rc[0]", IR_CAPY),
+    # (c) refinements checked only to stay within the step they refine
+    Mutant("min-det-unrefined", "min |det Λ| at the grid point, the parabolic refinement dropped",
+           "mins.append(grid[i] + (0.5 * h * (y0 - y2) / den if den > 0 else 0.0))",
+           "mins.append(grid[i])", IR_MINDET),
+    Mutant("min-det-refined-backwards", "min |det Λ|: the parabola's vertex taken on the wrong side",
+           "0.5 * h * (y0 - y2) / den", "0.5 * h * (y2 - y0) / den", IR_MINDET),
+    Mutant("stable-dt-short-bisection", "largest_stable_dt: a third of the bisection halvings",
+           "            for _ in range(iterations):\n                mid = 0.5 * (lo + hi)\n                lo, hi = (lo, mid) if unstable(mid)",
+           "            for _ in range(iterations // 3):\n                mid = 0.5 * (lo + hi)\n                lo, hi = (lo, mid) if unstable(mid)",
+           IR_STABLE),
+    Mutant("stable-dt-loose-stop", "largest_stable_dt's bisection stopped at 1e-6 of dt, not 1e-12",
+           "if hi - lo < 1e-12 * hi:", "if hi - lo < 1e-6 * hi:", IR_STABLE),
+    Mutant("equilibrium-early-stop", "equilibrium's Newton stopped at a residual of 1e-6 of the weights, not 1e-10",
+           "if np.abs(g).max() < tol * scale:", "if np.abs(g).max() < 1e4 * tol * scale:",
+           (_IR + "test_equilibrium_newton_to_the_analytic_angle",) + EQUIL),
+    Mutant("statespace-entry-first-passive-order", "per-entry fit: the first passive order, whatever its error",
+           "if err < target and pas:", "if pas:", ("tests/test_hydro_radiation.py",)),
+    Mutant("statespace-common-first-order", "common-pole fit: the first order of the list, whatever its error",
+           "        if err < target:\n            break", "        if True:\n            break",
+           ("tests/test_statespace_speed.py::test_common_fit_is_passive_and_within_its_error",)),
 ]
 
 IGNORE = shutil.ignore_patterns(".git", ".venv", "__pycache__", "*.pyc", ".pytest_cache", "out",
