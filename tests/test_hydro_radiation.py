@@ -305,8 +305,8 @@ def test_impulse_response_blocks_and_memory_scan(rm3):
 
 
 def _resonance_db(a, omega, w0=5.0):
-    """One dof with K(t) = e^{−at} cos(w0 t) (memory ~ 1/a): B(ω) = (2/π)⁻¹-normalised cosine
-    transform, B = ½[a/(a² + (ω − w0)²) + a/(a² + (ω + w0)²)], a resonance at w0 whose width a
+    """One dof with K(t) = e^{−at} cos(w0 t) (memory ~ 1/a), whose B(ω) = ∫K cos ωt dt is
+    ½[a/(a² + (ω − w0)²) + a/(a² + (ω + w0)²)]: a resonance at w0 whose width a
     sets the memory; B(0) = a/(a² + w0²) is small beside the peak ½/a (the engine takes B(0) = 0,
     as for a floating body)."""
     B = 0.5 * (a / (a * a + (omega - w0) ** 2) + a / (a * a + (omega + w0) ** 2))
