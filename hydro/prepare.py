@@ -251,6 +251,22 @@ class HydroSpec:
         db = self.database()
         return radiation_band(db["omega"].values, db["radiation_damping"].values, fraction)
 
+    def wave_band(self) -> tuple[float, float]:
+        """(0.2 ω_c, 2 ω_c) clipped to the grid, ω_c = √(g/L) the Froude frequency of the cube root
+        L of the largest displaced volume: where the waves act on these bodies (RM3 0.2–2.0 rad/s,
+        M4 1.2–12 rad/s). The band the state-space fit fits and the grid check judges."""
+        om = np.asarray(self.db["omega"].values)
+        wc = math.sqrt(self.g / float(np.max(self.volume)) ** (1.0 / 3.0))
+        return (max(0.2 * wc, float(om[0])), min(2.0 * wc, float(om[-1])))
+
+    def check_grid(self, memory_length: float) -> float:
+        """:func:`hydro.radiation.check_grid` of a kernel of length `memory_length` (s) as a run
+        uses it: the dofs the model moves, the wave band (:meth:`wave_band`); warns."""
+        from .radiation import check_grid
+
+        return check_grid(self.database(), memory_length, on_fail="warn", band=self.wave_band(),
+                          dofs=self.moving)
+
     def state_space(self, **options):
         """The passive state-space fit of :mod:`hydro.statespace` (cached per options). The fit
         band defaults to (0.2 ω_c, 2 ω_c) with the Froude frequency ω_c = √(g/L), L the cube root
@@ -266,9 +282,7 @@ class HydroSpec:
         many = self.body_coupling and len(self.db_names) > 2
         options.setdefault("pole_sharing", "common" if many else "entry")
         if "omega_fit" not in options:
-            om = np.asarray(self.db["omega"].values)
-            wc = math.sqrt(self.g / float(np.max(self.volume)) ** (1.0 / 3.0))
-            options["omega_fit"] = (max(0.2 * wc, float(om[0])), min(2.0 * wc, float(om[-1])))
+            options["omega_fit"] = self.wave_band()
         key = ("ss", tuple(sorted(options.items())))
         if key not in self._cache:
             from .fitcache import cached_fit
@@ -299,9 +313,7 @@ class HydroSpec:
             raise ValueError(f"stage offsets {offsets}: each must lie in [0, 1] (fractions of dt)")
         key = ("W", float(dt), n, subdivisions, offsets)
         if key not in self._cache:
-            from .radiation import check_grid
-
-            check_grid(self.database(), (n - 1) * dt, on_fail="warn")
+            self.check_grid((n - 1) * dt)
             h = dt / subdivisions
             tau = np.arange((n + 1) * subdivisions + 1) * h     # up to s + (N−1) dt + … ≤ (N+1) dt
             mv = np.asarray(self.moving)

@@ -214,17 +214,50 @@ def _ringing(d, Kpk):
     return ring, relevant, float(np.max(ring[relevant], initial=0.0))
 
 
+def _ringing_band_error(d):
+    """What the cut-off of B at ω_end does to a computation at the frequencies of the data, per
+    entry, relative to sqrt(peak B_ii · peak B_jj).
+
+    With B piecewise linear and ending at B_end, K holds the truncation term
+    T(t) = (2/π) B_end sin(ω_e t)/t (ω_e = ω_end). Its one-sided transform is
+    ∫_0^∞ T e^{−iωt} dt = B_end·[ω < ω_e] − i (B_end/π) ln|(ω_e + ω)/(ω_e − ω)|: the real part is
+    the damping as given; the imaginary part is what the cut-off adds to ω(A(ω) − A∞) of every
+    computation that uses K (a convolution of any time step, A∞ "consistent", the state-space
+    target) at the frequencies ω its motions have. Those are the database's (its waves: the
+    excitation ends at ω_max), so the error is that term at the grid's highest frequency below
+    ω_e: (2/π)|B_end| ω/ω_e for ω ≪ ω_e (tail "extrapolate", ω_e = 10³ ω_max: 6e-4 |B_end|),
+    log-large at ω_max for a plain cut ("none"). The ringing itself, at one cut-off period
+    2π/ω_e, is seen only on a time grid finer than that and averages out over a step dt ≫ 2π/ω_e
+    (Stansby & Li: ω_e = 2,500 rad/s, 2.5 ms)."""
+    om = d["om"]
+    below = om[om < d["w_end"] * (1.0 - 1e-12)]
+    if below.size == 0:
+        return np.zeros_like(d["peak"]), 0.0
+    w, we = below[-1], d["w_end"]
+    err_abs = np.abs(d["B_end"]) / np.pi * np.log((we + w) / (we - w))
+    nd = d["nd"]
+    dpk = np.diagonal(d["peak"].reshape(nd, nd))
+    scale = np.sqrt(np.outer(dpk, dpk)).ravel()
+    err = err_abs / np.where(scale > 0, scale, np.inf)
+    relevant = d["peak"] > 1e-3 * d["peak"].max()
+    return err, float(np.max(err[relevant], initial=0.0))
+
+
 def _warn_ringing(d, ring, relevant, ringing, ringing_tol, stacklevel):
-    if ringing > ringing_tol:
+    err, worst = _ringing_band_error(d)
+    if worst > ringing_tol:
         nd = d["nd"]
         labels = [str(x) for x in d["Bda"]["influenced_dof"].values]
         rlabels = [str(x) for x in d["Bda"]["radiating_dof"].values]
-        k = int(np.argmax(np.where(relevant, ring, 0)))
+        k = int(np.argmax(np.where(relevant, err, 0)))
         warnings.warn(
-            f"K(t) rings from the truncation of B at omega = {d['w_end']:.4g} rad/s: ringing amplitude "
-            f"{ringing:.3g} of max|K| at t = 2 pi/omega_max for ({labels[k // nd]}, {rlabels[k % nd]}) "
-            f"(B_end = {d['B_end'][k]:.4g}). Use tail='extrapolate' or 'taper', or compute B to higher "
-            "omega.", HydroDatabaseWarning, stacklevel=stacklevel + 1)
+            f"K(t) rings from the truncation of B at omega = {d['w_end']:.4g} rad/s: the cut-off "
+            f"changes the radiation impedance at the grid's frequencies by {worst:.3g} of "
+            f"sqrt(B_ii B_jj) for ({labels[k // nd]}, {rlabels[k % nd]}) (B_end = {d['B_end'][k]:.4g}; "
+            f"ringing amplitude {ring[k]:.3g} of max|K| at t = 2 pi/omega_end). Use "
+            "tail='extrapolate' or 'taper', or compute B to higher omega.",
+            HydroDatabaseWarning, stacklevel=stacklevel + 1)
+    return worst
 
 
 def impulse_response(db: xr.Dataset, t, *, tail: str = "extrapolate", fit_fraction: float = 0.25,
@@ -245,8 +278,10 @@ def impulse_response(db: xr.Dataset, t, *, tail: str = "extrapolate", fit_fracti
       "none": plain truncation at ω_max (for comparison; it rings).
     Ringing check: with piecewise-linear B ending at value B_end, eq. (1) contains exactly the
     truncation term (2/π) B_end sin(ω_end t)/t. attrs["ringing_ratio"] is its amplitude at one
-    cut-off period t = 2π/ω_end relative to max_t |K_ij|, the largest over the entries; a
-    warning is issued above `ringing_tol`.
+    cut-off period t = 2π/ω_end relative to max_t |K_ij|, the largest over the entries (what a
+    plot of K on a grid finer than 2π/ω_end shows); attrs["ringing_band_error"] what the cut-off
+    changes in the radiation impedance at the data's frequencies, relative to sqrt(B_ii B_jj)
+    (:func:`_ringing_band_error`): a warning is issued when that exceeds `ringing_tol`.
     """
     if tail not in ("extrapolate", "taper", "none"):
         raise ValueError(f"tail={tail!r}; accepted: 'extrapolate', 'taper', 'none'.")
@@ -266,10 +301,11 @@ def impulse_response(db: xr.Dataset, t, *, tail: str = "extrapolate", fit_fracti
                        coords={"time": t, "influenced_dof": labels, "radiating_dof": rlabels},
                        name="impulse_response")
     out.coords["tail_exponent"] = (("influenced_dof", "radiating_dof"), n_exp.reshape(nd, nd))
+    band_error = _warn_ringing(d, ring, relevant, ringing, ringing_tol, stacklevel=2)
     out.attrs.update(tail=tail, omega_max=float(om[-1]), ringing_ratio=ringing,
+                     ringing_band_error=band_error,
                      units="N s/m per s (translation); N m s per s (rotation); per dof pair",
                      equation="K(t) = (2/pi) int_0^inf B(omega) cos(omega t) d omega")
-    _warn_ringing(d, ring, relevant, ringing, ringing_tol, stacklevel=2)
     return out
 
 
@@ -304,7 +340,10 @@ def impulse_response_transform(db: xr.Dataset, t, omega, *, tail: str = "extrapo
 def _check_ringing(d, W, ringing_tol, stacklevel):
     """:func:`impulse_response`'s ringing check and warning without K for every entry: the exact
     max_t |K| (W: the cosine weights of the times) only where the bound with |K(0)| (trapezoid of
-    Bn; max|K| ≥ |K(0)|) does not clear it."""
+    Bn; max|K| ≥ |K(0)|) does not clear it, and only when the warning is due (its message
+    quotes the amplitude)."""
+    if _ringing_band_error(d)[1] <= ringing_tol:
+        return
     K0 = np.abs((2.0 / np.pi) * (filon_weights(d["nodes"], [0.0]).real @ d["Bn"])[0])
     ring, relevant, _ = _ringing(d, K0)
     need = relevant & (ring > ringing_tol)
@@ -436,33 +475,73 @@ def memory_length(K, t=None, *, rtol: float = 0.01) -> float:
     return float(tt[last + 1])
 
 
-def check_grid(db: xr.Dataset, memory_length: float, *, on_fail: str = "raise") -> float:
-    """Check that the ω grid resolves a memory of length T_K = `memory_length` (s).
+def check_grid(db: xr.Dataset, memory_length: float, *, on_fail: str = "raise", band=None,
+               dofs=None, tol: float = 0.05) -> float:
+    """Check that the ω grid resolves the memory of length T_K = `memory_length` (s) that a run
+    integrates, for the frequencies it needs.
 
-    Criterion: max Δω ≤ π / T_K. Derivation: sampling B(ω) at spacing Δω makes the cosine sum
-    (1) periodic in t with period 2π/Δω (Poisson summation: the computed K is
-    Σ_n K_even(t − 2πn/Δω)). K on [0, T_K] is free of its first alias K(2π/Δω − t) only if
-    2π/Δω − T_K ≥ T_K, i.e. Δω ≤ π/T_K. (Piecewise-linear integration damps the aliases but does
-    not remove the need to resolve B's features of width ~1/T_K.)
-    Returns the ratio max Δω · T_K / π (≤ 1 passes). on_fail: "raise" (ValueError) or "warn".
+    Aliasing. B(ω) sampled at spacing Δω and interpolated linearly gives (Poisson summation)
+    K_PL(t) = sinc²(Δω t/2) Σ_n K(t − 2πn/Δω): K on [0, t_N], t_N = π/Δω, is told apart from its
+    first alias K(2π/Δω − t); beyond t_N the grid cannot tell K from the alias. So T_K ≤ t_N
+    passes outright (the ratio returned, Δω T_K/π, is then ≤ 1).
+
+    T_K > t_N is not by itself an error: T_K is measured on K_PL, which holds the alias image of
+    K's own peak at 2π/Δω, attenuated by the sinc² of the linear interpolation to about
+    (Δω w/2π)² of the peak for a peak of width w (M4: Δω = 0.25 rad/s, w ≈ 1 s: 1.6e-3, above
+    the memory's 1e-3), so a grid that resolves K still shows T_K ≈ 2π/Δω (M4 111: 21.8 s with K
+    below 1 % of its scale from 6 s). What matters is what the run's radiation impedance takes
+    from the part of the kernel the grid cannot resolve: E = max |∫_{t_N}^{T_K} K_ij e^{−iωt} dt| /
+    sqrt(B_ii B_jj)_peak over the frequencies ω of the grid in `band` (the wave band: what the
+    run's waves excite) and the `dofs` the run moves. Whether that part is K's own memory or its
+    alias, the error it can make is of its size. It passes when E ≤ `tol`: 0.05, the asymmetry at
+    which :func:`hydro.database.validate` calls the BEM coefficients themselves unconverged
+    (same scale), below which a finer ω grid cannot make the run more accurate than its data.
+    Δω is the largest step of the grid inside `band` (a coarser step outside it aliases the
+    content of those frequencies, which stays at those frequencies).
+    Returns E/tol when T_K > t_N (≤ 1 passes). on_fail: "raise" (ValueError) or "warn".
     """
     if on_fail not in ("raise", "warn"):
         raise ValueError(f"on_fail={on_fail!r}; accepted: 'raise', 'warn'.")
     om = np.asarray(db["omega"].values, dtype=float)
     if len(om) < 2:
         raise ValueError("the database has fewer than 2 frequencies: no impulse response possible.")
+    lo, hi = (om[0], om[-1]) if band is None else (float(band[0]), float(band[1]))
     d = np.diff(om)
-    k = int(np.argmax(d))
-    ratio = float(d[k] * memory_length / np.pi)
-    if ratio > 1.0:
+    # the steps that meet the band (a segment [ω_k, ω_k+1] overlapping [lo, hi])
+    meet = (om[1:] >= lo) & (om[:-1] <= hi)
+    k = int(np.flatnonzero(meet)[np.argmax(d[meet])]) if meet.any() else int(np.argmax(d))
+    t_N = np.pi / d[k]
+    if memory_length <= t_N:
+        return float(memory_length / t_N)
+    sub = db
+    if dofs is not None:
+        sub = db.isel(influenced_dof=list(dofs), radiating_dof=list(dofs))
+    w = om[(om >= lo) & (om <= hi)]
+    # the transform of K over [t_N, T_K] on a step resolving ω_max four times (as the other
+    # transforms of K here); the truncation/ringing check is the business of impulse_response
+    step = min(0.02, np.pi / om[-1] / 4.0)
+    t = np.linspace(t_N, memory_length, max(int(np.ceil((memory_length - t_N) / step)), 1) + 1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", HydroDatabaseWarning)   # the ringing check is the caller's
+        Z = impulse_response_transform(sub, t, w)
+    B = np.asarray(sub["radiation_damping"].transpose("omega", "influenced_dof", "radiating_dof").values,
+                   dtype=float)
+    scale = _relevant_scale(np.abs(np.diagonal(B, axis1=1, axis2=2)).max(axis=0), B.shape[1])
+    E = np.abs(Z) / scale[None]
+    q = np.unravel_index(int(np.argmax(E)), E.shape)
+    err = float(E[q])
+    if err > tol:
+        labels = [str(x) for x in sub["influenced_dof"].values]
         msg = (f"the omega grid is too coarse for a memory length T_K = {memory_length:.4g} s: "
-               f"d omega = {d[k]:.4g} rad/s between {om[k]:.4g} and {om[k + 1]:.4g} rad/s exceeds "
-               f"pi/T_K = {np.pi / memory_length:.4g} rad/s. Recompute the database with a step ≤ "
-               f"{np.pi / memory_length:.4g} rad/s (or accept a shorter memory).")
+               f"d omega = {d[k]:.4g} rad/s between {om[k]:.4g} and {om[k + 1]:.4g} rad/s resolves "
+               f"K(t) up to pi/T_K = pi/{t_N:.4g} s only, and K beyond it changes the radiation "
+               f"impedance by {err:.3g} of sqrt(B_ii B_jj) for ({labels[q[1]]}, {labels[q[2]]}) at "
+               f"omega = {w[q[0]]:.4g} rad/s (tolerance {tol:g}). Recompute the database with a step "
+               f"≤ {np.pi / memory_length:.4g} rad/s (or accept a shorter memory).")
         if on_fail == "raise":
             raise ValueError(msg)
         warnings.warn(msg, HydroDatabaseWarning, stacklevel=2)
-    return ratio
+    return err / tol
 
 
 def radiation_band(omega, B, fraction: float = 0.05):

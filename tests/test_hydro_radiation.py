@@ -302,3 +302,37 @@ def test_impulse_response_blocks_and_memory_scan(rm3):
                                rtol=0, atol=1e-14 * np.abs(W).max())
     np.testing.assert_allclose(R._filon_part(t[:50], [0.0, 0.3, -2.0, 40.0], "sin"), W.imag,
                                rtol=0, atol=1e-14 * np.abs(W).max())
+
+
+def _resonance_db(a, omega, w0=5.0):
+    """One dof with K(t) = e^{−at} cos(w0 t) (memory ~ 1/a), whose B(ω) = ∫K cos ωt dt is
+    ½[a/(a² + (ω − w0)²) + a/(a² + (ω + w0)²)]: a resonance at w0 whose width a
+    sets the memory; B(0) = a/(a² + w0²) is small beside the peak ½/a (the engine takes B(0) = 0,
+    as for a floating body)."""
+    B = 0.5 * (a / (a * a + (omega - w0) ** 2) + a / (a * a + (omega + w0) ** 2))
+    return xr.Dataset({"radiation_damping": (("omega", "influenced_dof", "radiating_dof"),
+                                             B[:, None, None])},
+                      coords={"omega": omega, "influenced_dof": ["b__Heave"],
+                              "radiating_dof": ["b__Heave"]})
+
+
+def test_grid_check_on_analytic_memories():
+    om = np.arange(0.25, 25.01, 0.25)                  # Δω = 0.25: K resolved up to t_N = 12.6 s
+    t = np.arange(0.0, 400.0, 0.05)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", D.HydroDatabaseWarning)
+        short = _resonance_db(1.0, om)                 # K ∝ e^{−t}: below 1e-3 from 6.9 s
+        T_short = R.impulse_response_memory(short, t, rtol=1e-3)
+        long_ = _resonance_db(0.02, om)                # K ∝ e^{−t/50}: 0.78 of its peak at t_N
+        T_long = R.impulse_response_memory(long_, t, rtol=1e-3)
+    # the memory measured on the interpolated K counts the alias image of K's own peak at
+    # 2π/Δω = 25 s (measured T_K 23.3 s: the old check, T_K ≤ π/Δω, failed this resolved case); its
+    # share of the impedance is small (measured ratio 0.17; the unresolved case below 4.3)
+    assert T_short > np.pi / 0.25
+    assert R.check_grid(short, T_short) < 1.0
+    # K ∝ e^{−t/50} is not resolved: what lies beyond t_N is most of its impedance near w0
+    with pytest.raises(ValueError, match="too coarse"):
+        R.check_grid(long_, T_long)
+    # resolved on a grid of step 0.005 (t_N = 628 s, beyond its memory)
+    fine = _resonance_db(0.02, np.arange(0.005, 25.0, 0.005))
+    assert R.check_grid(fine, T_long) <= 1.0
