@@ -105,6 +105,17 @@ def test_time_domain_confirms_the_optimum(m4):
     assert float(ds.time_domain_objective) > float(ds.objective_baseline)
 
 
+def test_safe_sqrt_keeps_a_nan():
+    """A response gone non-finite (an equilibrium Newton diverged) reads NaN in q_rms and the
+    limits, never 0 (a met limit); √ at 0 keeps a finite derivative 0."""
+    import jax
+    import jax.numpy as jnp
+    v = jnp.array([4.0, 0.0, jnp.nan])
+    np.testing.assert_array_equal(np.isnan(O._safe_sqrt(v)), [False, False, True])
+    assert float(O._safe_sqrt(v)[0]) == 2.0 and float(O._safe_sqrt(v)[1]) == 0.0
+    assert float(jax.grad(lambda x: O._safe_sqrt(x))(0.0)) == 0.0
+
+
 def test_bad_input_is_named(m4):
     with pytest.raises(KeyError, match="float3.angle.damping"):      # lists the tunable ones
         O.optimize(m4, SEA, {"float3.damping": (0.0, 1.0)})

@@ -304,9 +304,10 @@ def _abs2(z):
 
 
 def _safe_sqrt(v):
-    # √ with a finite derivative at 0 (a PTO that does not move in a sea)
+    # √ with a finite derivative at 0 (a PTO that does not move in a sea); a NaN stays NaN (0 × v),
+    # not 0: a response gone non-finite must not read as a met rms limit
     ok = v > 0
-    return jnp.where(ok, jnp.sqrt(jnp.where(ok, v, 1.0)), 0.0)
+    return jnp.where(ok, jnp.sqrt(jnp.where(ok, v, 1.0)), 0.0 * v)
 
 
 def mean_power(r: Response):
