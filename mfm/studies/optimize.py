@@ -718,8 +718,6 @@ def _confirm(model, seas, values, params, weights, r_opt, options):
     hyd = any(isinstance(ld, HydraulicPTO) for ld in opt_model.loads)
     options.setdefault("integrator", "verlet")
     options.setdefault("radiation", "state_space_exact")
-    if hyd:
-        options["outputs"] = tuple(options.get("outputs", ())) + ("hydraulic_power",)
     ds = simulate_batch(opt_model, seas, **options)
     t = np.asarray(ds.time.values)
     settle = 0.5 * float(t[0, -1]) if settle is None else float(settle)
@@ -727,8 +725,8 @@ def _confirm(model, seas, values, params, weights, r_opt, options):
     parts = []
     if "pto_power" in ds:
         parts.append(np.asarray(ds.pto_power.values)[:, keep].mean(axis=1))
-    if hyd:
-        parts.append(np.asarray(ds.hydraulic_power.values)[:, keep].mean(axis=1))
+    if hyd:     # simulate_batch records no load diagnostics of its own: β ẇ² from q, q̇
+        parts.append(_hydraulic_power(opt_model, ds.q.values, ds.qd.values)[:, keep].mean(axis=1))
     power = np.concatenate(parts, axis=1) if parts else np.zeros((len(seas), 0))
     wn = weights / weights.sum()
     td = float(np.sum(wn * power.sum(axis=1)))
@@ -738,3 +736,16 @@ def _confirm(model, seas, values, params, weights, r_opt, options):
           f"{spectral:.6g} W: relative difference {rel:+.3%}")
     return {"power": power, "objective": td, "relative_difference": rel, "settle_s": settle,
             "options": repr(options)}
+
+
+def _hydraulic_power(model, q, qd):
+    """β ẇ² of the model's hydraulic pistons at samples q, q̇ (…, n_q) → (…, P), with the exact
+    rate ẇ = g(q) q̇ of the load's own kinematics (what :func:`mfm.simulate` records as the
+    pistons' ``pto_power``)."""
+    from ..mechanics.kinematics import kinematics
+
+    hyd = next(ld for ld in model.loads if isinstance(ld, HydraulicPTO))
+    rate = jax.jit(lambda q, qd: hyd._kinematics(kinematics(model, q, qd))[1])
+    q, qd = np.asarray(q, dtype=float), np.asarray(qd, dtype=float)
+    wd = jax.vmap(rate)(jnp.asarray(q.reshape(-1, q.shape[-1])), jnp.asarray(qd.reshape(-1, q.shape[-1])))
+    return (np.asarray(hyd.beta) * np.asarray(wd) ** 2).reshape(q.shape[:-1] + (-1,))
