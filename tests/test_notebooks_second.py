@@ -1,4 +1,4 @@
-"""The second half of the notebooks in smoke mode (tests/test_cli_notebooks.py runs the rest; the
+"""The second half of the notebooks (design, hallak_fwwp, wu_yuan) in smoke mode (tests/test_cli_notebooks.py runs the rest; the
 split lets the two pytest workers share them under --dist loadfile)."""
 import pytest
 from conftest import ROOT

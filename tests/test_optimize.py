@@ -105,6 +105,34 @@ def test_time_domain_confirms_the_optimum(m4):
     assert float(ds.time_domain_objective) > float(ds.objective_baseline)
 
 
+def test_safe_sqrt_keeps_a_nan():
+    """A response gone non-finite (an equilibrium Newton diverged) reads NaN in q_rms and the
+    limits, never 0 (a met limit); √ at 0 keeps a finite derivative 0."""
+    import jax
+    import jax.numpy as jnp
+    v = jnp.array([4.0, 0.0, jnp.nan])
+    np.testing.assert_array_equal(np.isnan(O._safe_sqrt(v)), [False, False, True])
+    assert float(O._safe_sqrt(v)[0]) == 2.0 and float(O._safe_sqrt(v)[1]) == 0.0
+    assert float(jax.grad(lambda x: O._safe_sqrt(x))(0.0)) == 0.0
+
+
+def test_confirm_reads_the_pistons_power_as_simulate_does(tmp_path):
+    """The time-domain confirmation of a hydraulic PTO (it asked simulate_batch for a
+    'hydraulic_power' output that no run records, a ValueError): β ẇ² from the samples q, q̇ with
+    the load's own kinematics against mfm.simulate's recorded piston power, on a slider whose
+    inclined piston makes ẇ = g(q) q̇ nonlinear in q: the same samples, round-off apart."""
+    from test_ptos_and_checks import _write, slider_config
+
+    data = slider_config(True)
+    data["ptos"][0]["anchor"] = [-2.0, 0.0, 0.0]        # inclined: g depends on q
+    model = mfm.load(_write(tmp_path / "pto.toml", data))
+    run = mfm.simulate(model, duration=1.0, dt=0.002, q0=[0.3])
+    p = O._hydraulic_power(model, run.q.values, run.qd.values)
+    ref = run.pto_power.sel(pto="piston").values
+    assert p.shape == (run.sizes["time"], 1) and np.ptp(ref) > 0.1 * np.abs(ref).max()
+    np.testing.assert_allclose(p[:, 0], ref, rtol=1e-10, atol=1e-12 * np.abs(ref).max())
+
+
 def test_bad_input_is_named(m4):
     with pytest.raises(KeyError, match="float3.angle.damping"):      # lists the tunable ones
         O.optimize(m4, SEA, {"float3.damping": (0.0, 1.0)})
