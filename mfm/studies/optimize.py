@@ -10,8 +10,9 @@ Derivatives come from jax: forward mode when the parameters are no more than the
 (objective and constraint values), reverse mode otherwise, for the cost of a jacobian is one
 pass per parameter (forward) or per output (reverse). The optimiser is SLSQP (scipy) on the
 parameters scaled to [0, 1] by their bounds, with the constraints as inequalities in every sea.
-The time domain confirms an optimum (``confirm=``): :func:`mfm.simulate_batch` of the optimised
-model in the same seas, its mean power against the spectral prediction.
+The time domain confirms an optimum (``confirm=``): the optimised model stepped in the same seas
+(:func:`mfm.simulate_batch`; :func:`mfm.simulate` per sea for hydraulic pistons), its mean power
+against the spectral prediction.
 """
 from __future__ import annotations
 
