@@ -170,6 +170,17 @@ def check_sea(sea, what="sea", *, still_water=True):
                         + (", or None for still water" if still_water else ""))
 
 
+def check_seas(seas) -> list:
+    """``seas`` (one sea state or a sequence of them) as a non-empty list of sea states, each
+    checked by :func:`check_sea` (no still water: these levels need waves)."""
+    seas = list(seas) if isinstance(seas, (list, tuple)) else [seas]
+    if not seas:
+        raise ValueError("seas: an empty sequence; give at least one sea state of hydro.waves")
+    for i, sea in enumerate(seas):
+        check_sea(sea, f"seas[{i}]", still_water=False)
+    return seas
+
+
 def check_model(model, what: str = "model"):
     """``model`` is an :class:`mfm.Model`; else a TypeError that says what it got and how to make
     one (a config path given where its model is meant: ``mfm.load(path)`` first)."""

@@ -354,21 +354,8 @@ def test_welch_elevation_spectrum_integrates_to_its_variance():
 
 
 # ========================================================================= (c) refinements
-MSD = """
-[model]
-name = "mass-spring"
-gravity = 9.81
-
-[[bodies]]
-name = "mass"
-mass = {m}
-com = [0.0, 0.0, 0.0]
-principal_inertia = [1.0, 1.0, 1.0]
-[bodies.joint]
-type = "prismatic"
-axis = [1.0, 0.0, 0.0]
-stiffness = {k}
-"""
+# the undamped mass–spring of test_frequency_extras' minimum of |det Λ(ω)| (damping 0)
+from test_frequency_extras import MSD  # noqa: E402
 
 
 def test_min_det_refinement_against_the_analytic_root(tmp_path):
@@ -385,7 +372,7 @@ def test_min_det_refinement_against_the_analytic_root(tmp_path):
     m, k = 3.0, 12.0
     wn = math.sqrt(k / m)
     p = tmp_path / "ms.toml"
-    p.write_text(MSD.format(m=m, k=k))
+    p.write_text(MSD.format(m=m, k=k, c=0.0))
     model = mfm.load(p)
     h = 0.01
     for delta in (0.3, -0.3, 0.2):

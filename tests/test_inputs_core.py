@@ -205,13 +205,18 @@ def test_waves_past_breaking_are_refused():
                            n_steps=10)
 
 
+def _movable_config(name, database):
+    """A shipped config's text with its relative database path made absolute, so that an edited
+    copy loads from another folder."""
+    db = str((CONFIGS / database).resolve())
+    return (CONFIGS / name).read_text().replace(f'"{database}"', repr(db).replace("'", '"'))
+
+
 def test_a_body_without_its_parent_beside_a_floating_root_is_refused(tmp_path):
     """RM3 with the float's ``parent`` left out: its slider would hang from the earth, not from the
     spar (two roots where one was meant); refused naming the body and both fixes. Said on
     purpose (parent = "earth"), it loads, and the float no longer follows the spar."""
-    text = (CONFIGS / "rm3.toml").read_text()
-    db = str((CONFIGS / "../hydro/data/rm3/rm3.out").resolve())
-    text = text.replace('"../hydro/data/rm3/rm3.out"', repr(db).replace("'", '"'))
+    text = _movable_config("rm3.toml", "../hydro/data/rm3/rm3.out")
     orphan = tmp_path / "orphan.toml"
     orphan.write_text(text.replace('parent = "spar"\n', "", 1))
     with pytest.raises(mfm.ConfigError, match=r"'float'.*prismatic joint hangs from the inertial "
@@ -236,9 +241,7 @@ def test_a_body_renamed_against_its_database_is_refused(tmp_path):
     """M4 134 matches its bodies to the database by name: float8 renamed in the config would run
     dry (no buoyancy, no waves) beside a database body no one uses; refused naming both, with
     the fix."""
-    text = (CONFIGS / "m4_134.toml").read_text()
-    db = str((CONFIGS / "../hydro/data/m4_134.nc").resolve())
-    text = text.replace('"../hydro/data/m4_134.nc"', repr(db).replace("'", '"'))
+    text = _movable_config("m4_134.toml", "../hydro/data/m4_134.nc")
     renamed = tmp_path / "renamed.toml"
     renamed.write_text(text.replace('name = "float8"', 'name = "float8b"', 1))
     with pytest.raises(mfm.ConfigError, match=r"database bodies \['float8'\] are used by no config "

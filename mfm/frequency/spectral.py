@@ -29,7 +29,7 @@ import xarray as xr
 from .. import results
 from ..loads.pto import linear_ptos, mean_absorbed_power
 from ..mechanics.model import Model
-from ..validation import check_model, check_sea
+from ..validation import check_model, check_sea, check_seas
 from .response import _amplitudes
 from .rest import linear_system
 
@@ -70,6 +70,16 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
                                                state_space_options=state_space_options), sea, t)
 
 
+def component_union(comps_list):
+    """The distinct (β, ω) pairs (U, 2) of several seas' components (sorted by heading, then
+    frequency), the index in them of every component of the seas in turn, and where each sea's
+    components start in that index ((len + 1,), cumulative): one linear solve per pair serves
+    every sea that has it."""
+    pairs = np.concatenate([np.stack([c.heading, c.omega], axis=1) for c in comps_list])
+    union, inverse = np.unique(pairs, axis=0, return_inverse=True)
+    return union, np.asarray(inverse).reshape(-1), np.cumsum([0] + [len(c.omega) for c in comps_list])
+
+
 def _union_raos(model, sys, comps_list, options):
     """The RAOs x̂ (n_j, n_q) of every sea's components from ONE linear solve per distinct heading
     over the union of their (β, ω) pairs (seas of one seed share their frequencies: the M4 134
@@ -77,16 +87,13 @@ def _union_raos(model, sys, comps_list, options):
     distinct pairs solved)."""
     if not comps_list:
         return [], 0
-    pairs = np.concatenate([np.stack([c.heading, c.omega], axis=1) for c in comps_list])
-    if pairs.size == 0:
+    union, inverse, bounds = component_union(comps_list)
+    if union.size == 0:
         return [np.zeros((0, model.n_coordinates), dtype=complex) for _ in comps_list], 0
-    union, inverse = np.unique(pairs, axis=0, return_inverse=True)
-    inverse = np.asarray(inverse).reshape(-1)
     x = np.zeros((len(union), model.n_coordinates), dtype=complex)
     for beta in np.unique(union[:, 0]):
         sel = union[:, 0] == beta
         x[sel] = _amplitudes(model, sys, union[sel, 1], float(beta), options)
-    bounds = np.cumsum([0] + [len(c.omega) for c in comps_list])
     return [x[inverse[bounds[i]:bounds[i + 1]]] for i in range(len(comps_list))], len(union)
 
 
@@ -162,11 +169,7 @@ def spectral_sweep(model: Model, seas, *, t=None, q0=None, loads=None,
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: the spectral level needs a "
                          "config with a [hydro] table")
-    seas = list(seas) if isinstance(seas, (list, tuple)) else [seas]
-    if not seas:
-        raise ValueError("seas: an empty sequence; give at least one sea state of hydro.waves")
-    for i, sea in enumerate(seas):
-        check_sea(sea, f"seas[{i}]", still_water=False)
+    seas = check_seas(seas)
     B = len(seas)
     times = _times(t, B)
     comps = [s.components(water_depth=model.hydro.water_depth, g=model.hydro.g) for s in seas]

@@ -30,13 +30,14 @@ import xarray as xr
 from .. import results
 from ..errors import OptimizeError
 from ..frequency.rest import _equilibrium, _static_functions, system_loads, water_of
+from ..frequency.spectral import component_union
 from ..loads.base import Load
 from ..loads.catenary import CatenaryLines
 from ..loads.hydraulic_pto import HydraulicPTO
 from ..loads.water import Water
 from ..mechanics.kinematics import kinematics
 from ..mechanics.model import Model
-from ..validation import check_model, check_sea
+from ..validation import check_model, check_seas
 from .design import (KINDS, Limit, Problem, Response, _constraint_values, _limits, _targets,  # noqa: F401
                      _unknown, _value_of, apply, mean_power, responses, tunable_parameters)
 
@@ -96,14 +97,10 @@ def _parameters(model, parameters, table):
 def _sea_union(model, seas, lds, radiation, state_space_options):
     """ω (U,), a² (S, U), Zb (U, 6K, 6K), X (U, 6K) on the union of the seas' (β, ω) pairs."""
     comps = [s.components(water_depth=model.hydro.water_depth, g=model.hydro.g) for s in seas]
-    pairs = np.concatenate([np.stack([c.heading, c.omega], axis=1) for c in comps])
-    union, inverse = np.unique(pairs, axis=0, return_inverse=True)
-    inverse = np.asarray(inverse).reshape(-1)
+    union, inverse, bounds = component_union(comps)
     a2 = np.zeros((len(seas), len(union)))
-    start = 0
     for s, c in enumerate(comps):
-        np.add.at(a2[s], inverse[start:start + len(c.omega)], c.amplitude ** 2)
-        start += len(c.omega)
+        np.add.at(a2[s], inverse[bounds[s]:bounds[s + 1]], c.amplitude ** 2)
     water = water_of(lds)
     kin = kinematics(model, jnp.zeros(model.n_coordinates), jnp.zeros(model.n_coordinates))
     options = {"radiation": radiation, "state_space_options": state_space_options}
@@ -127,11 +124,7 @@ def _setup(model, seas, parameters, objective, constraints, weights, loads, radi
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: optimize works on the sea's "
                          "response; give a config with a [hydro] table")
-    seas = list(seas) if isinstance(seas, (list, tuple)) else [seas]
-    if not seas:
-        raise ValueError("seas: an empty sequence; give at least one sea state of hydro.waves")
-    for i, sea in enumerate(seas):
-        check_sea(sea, f"seas[{i}]", still_water=False)
+    seas = check_seas(seas)
     S = len(seas)
     w = np.ones(S) if weights is None else np.asarray(weights, dtype=float).reshape(-1)
     if w.shape != (S,) or not np.all(np.isfinite(w)) or np.any(w < 0) or w.sum() <= 0:
