@@ -22,7 +22,7 @@ rewrote some small multiply–reduces (this also made batches of 4–128 cases 2
 
 **Compiled programs kept on disk.** A fresh Python process compiles every program again: for
 M4 134 with :func:`mfm.simulate`'s defaults that is most of its first call. mfm therefore turns on
-jax's persistent compilation cache (programs that took ≥ 1 s to compile, under
+jax's persistent compilation cache (programs that took ≥ 0.1 s to compile, under
 ``$XDG_CACHE_HOME/mfm/jax``, default ``~/.cache/mfm/jax``, at most :data:`CACHE_BYTES`, the least
 recently used dropped first), so a later process with the same model, options, jax and XLA flags
 loads them instead. The results are the same bits (the same executable). Set
@@ -107,6 +107,8 @@ LOOPS_COMPILED_WHOLE, LOOP_THRESHOLD = _set_flags()
 CACHE_ENV = "MFM_COMPILATION_CACHE"
 # the most the cache folder mfm chooses may hold (jax drops the least recently used beyond it)
 CACHE_BYTES = 2 * 2**30
+# programs that took at least this long to compile are kept (jax's default is 1 s)
+MIN_COMPILE_SECONDS = 0.1
 
 
 def default_cache_dir() -> str:
@@ -128,6 +130,10 @@ def _set_cache() -> str | None:
         return None
     path = setting or default_cache_dir()
     jax.config.update("jax_compilation_cache_dir", path)
+    if jax.config.jax_persistent_cache_min_compile_time_secs == 1.0:     # jax's default
+        # a first run also compiles a dozen programs of 0.1–0.6 s (tables, the memories' start,
+        # the radiation's samples): RM3 1.9 s of a cached first call's 7 s
+        jax.config.update("jax_persistent_cache_min_compile_time_secs", MIN_COMPILE_SECONDS)
     if jax.config.jax_compilation_cache_max_size == -1:
         try:
             import filelock  # noqa: F401  (jax bounds the cache only with it: a dependency of mfm)

@@ -30,6 +30,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .. import _programs
 from ..loads.assembly import (RK4_STAGE_OFFSETS, applied_loads, as_loads, carried_loads,
                               compile_view)
 from ..mechanics.dynamics import gravity_loads, joint_loads, mass_matrix
@@ -117,17 +118,25 @@ def _static_functions(model: Model, loads):
     return model, static, _init_memories(model, static)
 
 
+def _jet_program(model, static, mems, q):
+    """:func:`_static_jet` for these arguments' structure, from disk where an earlier process
+    traced it (:mod:`mfm._programs`): called from the host, not inside a trace."""
+    return _programs.program(_static_jet, "static_jet", (model, static, mems, q))
+
+
 def jet(model: Model, q, loads) -> _Jet:
     """The model's jet at (q, q̇ = 0) under ``loads`` at rest (:func:`_static_jet`)."""
     model, static, mems = _static_functions(model, loads)
-    return _static_jet(model, static, mems, jnp.asarray(q, jnp.float64))
+    q = jnp.asarray(q, jnp.float64)
+    return _jet_program(model, static, mems, q)(model, static, mems, q)
 
 
 def compile_jet(model: Model, loads, q):
-    """Compile :func:`jet` for these loads' structure (jit's lower/compile, for a thread beside
-    other work): a later call with loads of the same structure finds it compiled."""
+    """Compile :func:`jet` for these loads' structure (for a thread beside other work): a later
+    call with loads of the same structure finds it compiled."""
     model, static, mems = _static_functions(model, loads)
-    return _static_jet.lower(model, static, mems, jnp.asarray(q, jnp.float64)).compile()
+    q = jnp.asarray(q, jnp.float64)
+    _jet_program(model, static, mems, q).compile(model, static, mems, q)
 
 
 # ------------------------------------------------------------------------------- equilibrium
@@ -146,8 +155,9 @@ def equilibrium(model: Model, q_guess=None, *, loads=None, tol: float = 1e-10, m
 
 def _equilibrium(model, loads, q_guess=None, tol=1e-10, max_iter=50):
     keyed, static, mems = _static_functions(model, loads)
-    jet_at = lambda q: _static_jet(keyed, static, mems, q)  # noqa: E731
     q = jnp.zeros(model.n_coordinates) if q_guess is None else jnp.asarray(q_guess, jnp.float64)
+    at_q = _jet_program(keyed, static, mems, q)
+    jet_at = lambda q: at_q(keyed, static, mems, q)  # noqa: E731
     # the size of the loads that must balance: generalised weights, or the largest weight
     scale = max(float(jnp.max(jnp.abs(jet_at(q).weights))),
                 float(jnp.max(model.mass)) * float(model.gravity))

@@ -29,7 +29,8 @@ def progress_options(progress):
     if progress is True:
         return {}
     if isinstance(progress, dict):
-        return dict(progress)
+        # tqdm's own switch: a disabled bar is no bar (tqdm makes one without its clock)
+        return None if progress.get("disable") is True else dict(progress)
     raise ValueError(f"progress: {progress!r}; give False (no bar, the default), True (a bar on "
                      "stderr) or a dict of tqdm options, e.g. {'delay': 5}")
 
@@ -88,23 +89,35 @@ def _restart(bar, n: int):
     bar._ema_dn, bar._ema_dt, bar._ema_miniters = (EMA(bar.smoothing) for _ in range(3))
 
 
-def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis):
+def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis, began=None):
     """Run ``start()`` then ``chunk(carry, c)`` (``c`` blocks, from :func:`chunk_plan`) until
     ``n_blocks`` are done,
     updating ``bar`` between chunks; stops early once a chunk has a non-finite q or q̇ (the caller
     finds where). Returns the saved outputs as numpy, the initial state first, as the unchunked
-    rollout does: the same compiled steps in the same order, so the same numbers."""
+    rollout does: the same compiled steps in the same order, so the same numbers.
+
+    ``start()`` gives (carry, the initial sample's outputs), or (carry, None) where each chunk
+    gives its incoming carry's outputs first (a head: kept from the first chunk, dropped from the
+    others). ``began``: when the compilation began (``time.perf_counter()``), where it was done
+    before the call; the bar says how long it took."""
     c, n_chunks = chunk_plan(n_blocks)
     _say(bar, "compiling")
-    began = time.perf_counter()
+    if began is None:
+        began = time.perf_counter()
     carry, first = start()
-    pieces = [jax.tree_util.tree_map(lambda a: np.expand_dims(np.asarray(a), time_axis), first)]
+    headed = first is None
+    pieces = [] if headed else [
+        jax.tree_util.tree_map(lambda a: np.expand_dims(np.asarray(a), time_axis), first)]
     done = 0
     try:
         for _ in range(n_chunks):
             carry, traj = chunk(carry, c)
             take = min(c, n_blocks - done)
-            cut = (slice(None),) * time_axis + (slice(0, take),)
+            # a head is the incoming carry's sample: the run's first in the first chunk, else
+            # the previous chunk's last
+            lo = int(headed and done > 0)
+            hi = take + int(headed)
+            cut = (slice(None),) * time_axis + (slice(lo, hi),)
             traj = jax.tree_util.tree_map(lambda a: np.asarray(a)[cut], traj)
             pieces.append(traj)
             done += take

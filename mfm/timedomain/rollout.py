@@ -4,11 +4,14 @@ save_every, loads structure); vmap- and grad-friendly."""
 from __future__ import annotations
 
 import collections
+import concurrent.futures
+import time
 from typing import Sequence
 
 import jax
 import jax.numpy as jnp
 
+from .. import _programs
 from ..loads.assembly import applied_loads, as_loads, compile_view
 from ..loads.base import Load
 from ..mechanics.dynamics import evaluate
@@ -16,7 +19,7 @@ from ..mechanics.kinematics import kinematics
 from ..mechanics.model import Model
 from ..validation import positive_seconds, whole_number
 from . import integrators as _integrators
-from .progress import run_chunked
+from .progress import chunk_plan, run_chunked
 from .record import EVERY, STATE, Recording, deferred, outputs_after, saved
 
 
@@ -115,11 +118,29 @@ def _chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every, recor
     return rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, recording)
 
 
+def _headed_chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every):
+    """A chunk of a recorded run whose outputs are deferred (:func:`deferred`): the outputs of
+    the incoming carry and of the chunk's ``n_blocks`` saved carries, in one pass
+    (:func:`outputs_after`; each sample by the same vmapped program, so the same bits as the
+    run in one call). The host keeps the head of the first chunk only (the run's initial sample):
+    the start then needs no outputs program of its own, and a first run compiles one copy of the
+    outputs instead of two (RM3: the start's 4.7 of 14 s of compilation, cold)."""
+    TRACES["rollout_chunk"] += 1
+    carry_out, carries = rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every,
+                                        EVERY, keep_carries=True)
+    stacked = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), carry, carries)
+    return carry_out, outputs_after(model, loads, stacked)
+
+
 _start_jit = jax.jit(rollout_start, static_argnames=("integrator", "recording"))
 
 
 _chunk_jit = jax.jit(_chunk_impl, static_argnames=("n_blocks", "integrator", "save_every",
                                                    "recording"))
+
+
+_headed_chunk_jit = jax.jit(_headed_chunk_impl, static_argnames=("n_blocks", "integrator",
+                                                                 "save_every"))
 
 
 def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=None,
@@ -165,14 +186,70 @@ def rollout_call(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, 
 def rollout_progress(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0, bar):
     """:func:`rollout` (``record=True``) in chunks with a progress bar: numpy outputs, the same
     values; it stops early once the state is non-finite."""
+    return prepare_progress(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integrator,
+                            loads=loads, save_every=save_every, t0=t0)(bar)
+
+
+def _strong(tree):
+    """``tree``'s arrays, strongly typed (the same dtypes and values)."""
+    return jax.tree_util.tree_map(lambda a: jnp.asarray(a, a.dtype), tree)
+
+
+def prepare_progress(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0):
+    """Start a recorded run in chunks and compile its chunk, here and now; returns ``run(bar)``,
+    which makes the chunks (:func:`~.progress.run_chunked`). Compiling before the bar's run lets
+    :func:`~.simulation.simulate` do it while its checks' linearisation compiles on another
+    thread (XLA compiles without the GIL): a first run waits for the longer of the two, not
+    their sum."""
+    began = time.perf_counter()
     parts = [ld.initial_state(model) for ld in loads]
     z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
     q0, qd0 = jnp.asarray(q0, jnp.float64), jnp.asarray(qd0, jnp.float64)
     t0, dt = jnp.asarray(t0, jnp.float64), jnp.asarray(dt, jnp.float64)
     model, loads = compile_view(model, loads)
-    return run_chunked(
-        lambda: _start_jit(model, loads, q0, qd0, z0, t0, dt, integrator=integrator,
-                           recording=EVERY),
-        lambda carry, c: _chunk_jit(model, loads, carry, dt, n_blocks=c, integrator=integrator,
-                                    save_every=save_every, recording=EVERY),
-        n_steps // save_every, save_every, bar, time_axis=0)
+    n_blocks = n_steps // save_every
+    c, _ = chunk_plan(n_blocks)
+    memories = jax.eval_shape(lambda: init_memories(model, loads, t0, q0, qd0, dt))
+    # the outputs of the initial sample come with the first chunk's (its head) where they are
+    # deferred; else the start makes them, in the loop's way
+    headed = deferred((None, memories), EVERY)
+    recording = STATE if headed else EVERY
+    start_args = (model, loads, q0, qd0, z0, t0, dt)
+    start_kw = dict(integrator=integrator, recording=recording)
+    kw = dict(n_blocks=c, integrator=integrator, save_every=save_every)
+    if headed:
+        fn, name = _headed_chunk_jit, "rollout_chunk_headed"
+    else:
+        fn, name = _chunk_jit, "rollout_chunk"
+        kw["recording"] = EVERY
+    # the chunk compiles on a second thread from the start's shapes while this one compiles and
+    # runs the start: XLA compiles without the GIL, so on several cores the two overlap. Both
+    # come from disk where an earlier process traced them (mfm._programs)
+    start = _programs.program(_start_jit, "rollout_start", start_args, start_kw)
+    # the carry strongly typed, however the start was made (a saved program keeps no weak types),
+    # so that the chunk is one program, one key (the same dtypes: the same numbers)
+    shapes = jax.tree_util.tree_map(lambda a: jax.ShapeDtypeStruct(a.shape, a.dtype),
+                                    start.shapes(*start_args)[0])
+
+    def chunk_program():
+        made = _programs.program(fn, name, (model, loads, shapes, dt), kw)
+        made.compile(model, loads, shapes, dt)
+        return made
+
+    pool = concurrent.futures.ThreadPoolExecutor(1)
+    try:
+        ahead = pool.submit(chunk_program)
+        carry, first = start(*start_args)
+        carry = _strong(carry)
+        run_chunk = ahead.result()
+    finally:
+        pool.shutdown(wait=False)
+    if headed:
+        first = None
+
+    def chunk(carry, n):
+        assert n == c, (n, c)          # one chunk length: the one compiled
+        return run_chunk(model, loads, _strong(carry), dt)
+
+    return lambda bar: run_chunked(lambda: (carry, first), chunk, n_blocks, save_every, bar,
+                                   time_axis=0, began=began)

@@ -10,7 +10,7 @@ import concurrent.futures
 import numpy as np
 import xarray as xr
 
-from .. import results
+from .. import _programs, results
 from ..errors import AccuracyWarning, SimulationError, StabilityWarning  # noqa: F401  (exported)
 from ..frequency import rest
 from ..loads.assembly import as_loads
@@ -21,7 +21,8 @@ from .batch import simulate_batch  # noqa: F401  (exported)
 from .checks import (nonfinite_message, refuse_impossible, warn_accuracy, warn_stability,
                      warn_verlet_drift)
 from .progress import phase, progress_bar, progress_options
-from .rollout import rollout, rollout_call, rollout_jit, rollout_progress  # noqa: F401  (exported)
+from .rollout import (prepare_progress, rollout, rollout_call, rollout_jit,  # noqa: F401
+                      rollout_progress)
 from .setup import choose_radiation, model_loads, stage_offsets
 
 
@@ -135,13 +136,21 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                             radiation=radiation, memory=memory,
                             state_space_options=state_space_options, added_mass=added_mass,
                             integrator=integ) + extra
-        # the recorded run, compiled here: beside the jet's compile where the water builds
-        # faster than that (no fit), and before the checks' warnings
+        # the recorded run (in one call, or its start and chunk for a bar), compiled here:
+        # beside the jet's compile where the water builds faster than that (no fit), and
+        # before the checks' warnings
         run = None if progress is not None else rollout_call(
             model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
             save_every=save_every, t0=t0, z0=None, record=True)
         if run is not None:
-            rollout_jit.lower(*run[0], **run[1]).compile()
+            # from disk where an earlier process traced it (mfm._programs)
+            whole = _programs.program(rollout_jit, "rollout", run[0], run[1])
+            whole.compile(*run[0])
+        else:
+            phase(bar, "compiling")
+            run_with_bar = prepare_progress(model, q0, qd0, dt=dt, n_steps=n_steps,
+                                            integrator=integ, loads=loads, save_every=save_every,
+                                            t0=t0)
         if check_stability:
             phase(bar, "linearising at q0 for the checks")
             ahead.result()
@@ -161,10 +170,9 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
         warn_accuracy(model, sea, dt, integ)
     warn_verlet_drift(integ, free)
     if bar is None:
-        out = rollout_jit(*run[0], **run[1])
+        out = whole(*run[0])
     else:
-        out = rollout_progress(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ,
-                                loads=loads, save_every=save_every, t0=t0, bar=bar)
+        out = run_with_bar(bar)
     t, q, qd, qdd, z, iters = (np.asarray(a) for a in out[:6])
     rec = {k: np.asarray(v) for k, v in out[6].items()}
     settings = dict(duration=duration, n_steps=n_steps, save_every=int(save_every), t0=t0,

@@ -1,0 +1,351 @@
+"""Traced programs kept on disk: a later process skips jax's tracing and lowering of a run's
+programs as :mod:`mfm._xla`'s persistent cache lets it skip XLA's compilation.
+
+Why. With the compilation cache filled, a first :func:`mfm.simulate` still traces each of its
+programs (Python walking the model, its loads and the integrator: about a second each for RM3's
+start, chunk and the checks' linearisation) and lowers them to StableHLO (another half second):
+about half of the wait for a cached first answer (benchmarks/RESULTS.md, "First answers"). jax's
+own answer is :mod:`jax.export`: a traced and lowered function serialised (StableHLO bytecode),
+called later without tracing it again; its compilation then hits the persistent cache.
+
+How a program is found again. The file's name is a hash of everything that decides the
+program: the function's name; the pytree structure of its arguments with every node's type and
+static data (:func:`_fingerprint`: ints, strings, tuples, frozen dataclasses, numpy arrays by
+their bytes); the shape, dtype and weak type of each array leaf; the static arguments; the source
+of the mfm and hydro packages (every ``.py`` file and ``mfm/data``); the versions of jax, jaxlib
+and equinox; the backend and its device kind; ``XLA_FLAGS`` and the jax settings that change a
+trace; mfm's module-level settings as they are at the call (:func:`_settings`). Anything the hash cannot key with certainty (a function, a user's own Load class outside
+mfm, an object of unknown type among the static data) makes the call take the ordinary path:
+this is a cache, never a second meaning. The results are the same bits (the same program;
+tests/test_first_call.py).
+
+Where. Beside the compilation cache, in its folder ``mfm-programs`` (off with it, or alone with
+``MFM_PROGRAM_CACHE=off``); at most :data:`FOLDER_BYTES`, the least recently used dropped first.
+Serialisation needs the ``flatbuffers`` package (a dependency of mfm); without it, the ordinary
+path.
+"""
+from __future__ import annotations
+
+import dataclasses
+import enum
+import hashlib
+import os
+import pickle
+import sys
+import tempfile
+import threading
+from pathlib import Path
+
+import jax
+import numpy as np
+
+from . import _xla
+
+ENV = "MFM_PROGRAM_CACHE"
+FOLDER_BYTES = 512 * 2**20
+# modules whose types may appear in a keyed structure: their code is in the hash (mfm, hydro) or
+# their version is (jax, equinox); builtins and numpy types are keyed by value
+_KEYED_MODULES = ("mfm", "hydro", "jax", "jaxlib", "equinox", "builtins", "numpy", "collections")
+# counts of what happened, for tests and benchmarks: "loaded", "saved", "ordinary" (not keyable
+# or no cache), "failed" (export or serialisation refused; the ordinary path ran)
+COUNTS: dict = {"loaded": 0, "saved": 0, "ordinary": 0, "failed": 0}
+
+
+class _Unkeyable(Exception):
+    """Something in a program's arguments that the hash cannot key with certainty."""
+
+
+def folder() -> Path | None:
+    """The programs' folder, or None when either cache is off."""
+    if _xla.COMPILATION_CACHE is None or jax.config.jax_disable_jit:
+        return None
+    if os.environ.get(ENV, "").strip().lower() in ("off", "0", "false", "no", "none"):
+        return None
+    return Path(_xla.COMPILATION_CACHE) / "mfm-programs"
+
+
+def _type_name(t: type) -> str:
+    module = getattr(t, "__module__", "") or ""
+    if module.split(".")[0] not in _KEYED_MODULES:
+        raise _Unkeyable(f"type {module}.{t.__qualname__}")
+    return f"{module}.{t.__qualname__}"
+
+
+def _fingerprint(x, out: list) -> None:
+    """Append to ``out`` strings that determine ``x`` (static data of a pytree, a static
+    argument) or raise :class:`_Unkeyable`."""
+    if x is None or isinstance(x, (bool, int, float, complex, str, bytes)):
+        out.append(f"{type(x).__name__}:{x!r}")
+    elif isinstance(x, jax.tree_util.PyTreeDef):
+        _treedef(x, out)
+    elif isinstance(x, np.ndarray):
+        out.append(f"nd:{x.dtype.str}:{x.shape}:{hashlib.sha256(np.ascontiguousarray(x).tobytes()).hexdigest()}")
+    elif isinstance(x, np.generic):
+        out.append(f"np:{x.dtype.str}:{x.item()!r}")
+    elif isinstance(x, type):
+        out.append(f"type:{_type_name(x)}")
+    elif isinstance(x, enum.Enum):
+        out.append(f"enum:{_type_name(type(x))}.{x.name}")
+    elif isinstance(x, (tuple, list)):
+        out.append(f"{_type_name(type(x))}[{len(x)}")
+        for item in x:
+            _fingerprint(item, out)
+        out.append("]")
+    elif isinstance(x, dict):
+        out.append(f"dict[{len(x)}")
+        for k, v in x.items():
+            _fingerprint(k, out)
+            _fingerprint(v, out)
+        out.append("]")
+    elif isinstance(x, frozenset):
+        parts = []
+        for item in x:
+            one: list = []
+            _fingerprint(item, one)
+            parts.append("|".join(one))
+        out.append("frozenset{" + ",".join(sorted(parts)) + "}")
+    elif dataclasses.is_dataclass(x) and type(x).__dataclass_params__.frozen:
+        out.append(f"dc:{_type_name(type(x))}(")
+        for f in dataclasses.fields(x):
+            out.append(f.name)
+            _fingerprint(getattr(x, f.name), out)
+        out.append(")")
+    elif type(x).__name__ == "_Missing" and type(x).__module__.startswith("equinox"):
+        out.append("eqx-missing")
+    else:
+        raise _Unkeyable(f"{type(x).__module__}.{type(x).__qualname__}")
+
+
+def _treedef(td, out: list) -> None:
+    """A pytree structure, node by node: each node's type and static (auxiliary) data."""
+    children = td.children()
+    if td.num_nodes == 1 and td.num_leaves == 1:
+        out.append("*")
+        return
+    data = td.node_data()
+    if data is None:
+        out.append("node?")
+        raise _Unkeyable("a pytree node without data")
+    kind, aux = data
+    out.append(f"<{_type_name(kind)}")
+    _fingerprint(aux, out)
+    out.append(f"#{len(children)}")
+    for child in children:
+        _treedef(child, out)
+    out.append(">")
+
+
+def _leaf(x) -> str:
+    shape, dtype = np.shape(x), getattr(x, "dtype", None)
+    weak = getattr(x, "weak_type", False)
+    if dtype is None:       # a Python scalar: jax takes it as a weakly typed array
+        dtype, weak = np.asarray(x).dtype, True
+    return f"{np.dtype(dtype).str}{tuple(shape)}{'w' if weak else ''}"
+
+
+_SOURCE: str | None = None
+
+
+def _source_hash() -> str:
+    """A hash of the code that traces the programs: every .py file of mfm and hydro, and
+    mfm/data (module-level tables a trace may close over)."""
+    global _SOURCE
+    if _SOURCE is None:
+        h = hashlib.sha256()
+        here = Path(__file__).resolve().parent
+        roots = [here]
+        try:
+            import hydro
+
+            roots.append(Path(hydro.__file__).resolve().parent)
+        except ImportError:
+            pass
+        for root in roots:
+            files = [p for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts
+                     and (p.suffix == ".py" or "data" in p.relative_to(root).parts[:1]
+                          and root == here)]
+            for p in sorted(files):
+                h.update(str(p.relative_to(root.parent)).encode())
+                h.update(p.read_bytes())
+        _SOURCE = h.hexdigest()
+    return _SOURCE
+
+
+def _environment() -> list:
+    import equinox
+    import jaxlib
+
+    device = jax.devices()[0]
+    return [jax.__version__, jaxlib.__version__, equinox.__version__, device.platform,
+            getattr(device, "device_kind", ""), os.environ.get("XLA_FLAGS", ""),
+            str(jax.config.jax_enable_x64), str(jax.config.jax_default_matmul_precision),
+            str(jax.config.jax_numpy_rank_promotion), str(jax.config.jax_numpy_dtype_promotion),
+            _source_hash()]
+
+
+def _settings() -> list:
+    """mfm's and hydro's module-level settings as they are now (upper-case names holding
+    numbers, strings or tuples of them, e.g. ``record.DEFERRED_RECORD_MEMORY``): a trace may read
+    them, and a program made under other values is another program (a test that changes one
+    must not be given the program made before)."""
+    simple = (bool, int, float, str, type(None))
+    out = []
+    for mod_name, mod in sorted(sys.modules.items()):
+        if mod is None or mod_name.split(".")[0] not in ("mfm", "hydro"):
+            continue
+        for attr, value in sorted(vars(mod).items()):
+            if attr.isupper() and (isinstance(value, simple) or isinstance(value, tuple) and all(
+                    isinstance(v, simple) for v in value)):
+                out.append(f"{mod_name}.{attr}={value!r}")
+    return out
+
+
+def key(name: str, args: tuple, static: dict) -> str:
+    """The hash naming a program (see the module's docstring); raises :class:`_Unkeyable`."""
+    leaves, tree = jax.tree_util.tree_flatten(args)
+    out = [name, *_environment(), *_settings()]
+    _treedef(tree, out)
+    out.extend(_leaf(x) for x in leaves)
+    for k in sorted(static):
+        out.append(k)
+        _fingerprint(static[k], out)
+    text = "\n".join(out)
+    if os.environ.get("MFM_PROGRAM_KEYS"):
+        k = hashlib.sha256(text.encode()).hexdigest()
+        Path(os.environ["MFM_PROGRAM_KEYS"], f"{name}-{os.getpid()}-{k[:8]}.txt").write_text(text)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+_MADE: dict = {}
+_LOCK = threading.Lock()
+
+
+def program(jitted, name: str, args: tuple, static: dict | None = None) -> "Program":
+    """The :class:`Program` of ``jitted(*args, **static)``: the one this process made already
+    for that key, else one from disk, else one traced now (and saved)."""
+    static = dict(static or {})
+    where = folder()
+    try:
+        if where is None:
+            raise _Unkeyable("no cache")
+        k = key(name, args, static)
+    except _Unkeyable:
+        COUNTS["ordinary"] += 1
+        return Program(jitted, args, static, None)
+    with _LOCK:
+        made = _MADE.get(k)
+    if made is None:
+        made = Program(jitted, args, static, where / f"{name}-{k}.bin")
+        with _LOCK:
+            made = _MADE.setdefault(k, made)
+    return made
+
+
+class Program:
+    """``jitted(*args, **static)`` for arguments of one structure (that of the ``args`` given
+    when made: arrays or ``jax.ShapeDtypeStruct``s), from ``path`` where a process made it before
+    (None: the ordinary path). Call it with arrays of that structure; :meth:`compile` compiles it
+    ahead (from any thread). Made by :func:`program`."""
+
+    def __init__(self, jitted, args: tuple, static: dict, path: Path | None):
+        self._ordinary = lambda *a: jitted(*a, **static)
+        self._lower = lambda *a: jitted.lower(*a, **static)
+        self._tree = jax.tree_util.tree_structure(args)
+        self._call = None
+        if path is None:
+            return
+        try:
+            loaded = _load(path)
+        except Exception:      # an unreadable or foreign file: made anew below
+            loaded = None
+        if loaded is not None:
+            exported, self._out_tree = loaded
+            COUNTS["loaded"] += 1
+        else:
+            try:
+                exported, self._out_tree = _export(jitted, args, static, self._tree)
+                _save(path, exported, self._out_tree)
+                COUNTS["saved"] += 1
+            except Exception:  # a program jax cannot export (a host callback): the ordinary path
+                COUNTS["failed"] += 1
+                return
+        self._exported = exported
+        self._call = jax.jit(exported.call)
+
+    def _flat(self, args):
+        leaves, tree = jax.tree_util.tree_flatten(args)
+        if tree != self._tree:
+            raise ValueError("a Program is called with arguments of another structure than it "
+                             "was made for")
+        return leaves
+
+    def __call__(self, *args):
+        if self._call is None:
+            return self._ordinary(*args)
+        return jax.tree_util.tree_unflatten(self._out_tree, self._call(*self._flat(args)))
+
+    def shapes(self, *args):
+        """The outputs' structure, shapes and dtypes (ShapeDtypeStructs) for arguments like
+        ``args``: from the saved program where there is one, without tracing."""
+        if self._call is None:
+            return jax.eval_shape(self._ordinary, *args)
+        return jax.tree_util.tree_unflatten(self._out_tree, [
+            jax.ShapeDtypeStruct(a.shape, a.dtype, weak_type=a.weak_type)
+            for a in self._exported.out_avals])
+
+    def compile(self, *args) -> None:
+        """Compile for arguments like ``args`` (arrays or ShapeDtypeStructs), here and now."""
+        if self._call is None:
+            self._lower(*args).compile()
+        else:
+            self._call.lower(*self._flat(args)).compile()
+
+
+def _export(jitted, args, static, tree):
+    """jitted's program for ``args`` as a jax.export.Exported of the flat leaves, and the
+    structure of its outputs."""
+    got = {}
+
+    def flat(*leaves):
+        out = jitted(*jax.tree_util.tree_unflatten(tree, leaves), **static)
+        values, got["tree"] = jax.tree_util.tree_flatten(out)
+        return values
+
+    leaves = [jax.ShapeDtypeStruct(np.shape(x), x.dtype, weak_type=getattr(x, "weak_type", False))
+              if hasattr(x, "dtype") else x for x in jax.tree_util.tree_leaves(args)]
+    exported = jax.export.export(jax.jit(flat))(*leaves)
+    return exported, got["tree"]
+
+
+def _load(path: Path):
+    if not path.exists():
+        return None
+    blob = path.read_bytes()
+    n = int.from_bytes(blob[:8], "little")
+    out_tree = pickle.loads(blob[8:8 + n])
+    exported = jax.export.deserialize(bytearray(blob[8 + n:]))
+    os.utime(path)                     # recently used: kept longest
+    return exported, out_tree
+
+
+def _save(path: Path, exported, out_tree) -> None:
+    tree = pickle.dumps(out_tree)
+    pickle.loads(tree)                 # a structure that does not come back is not saved
+    blob = len(tree).to_bytes(8, "little") + tree + bytes(exported.serialize())
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+    with os.fdopen(fd, "wb") as f:
+        f.write(blob)
+    os.replace(tmp, path)              # whole or absent, whatever another process does
+    _trim(path.parent)
+
+
+def _trim(where: Path) -> None:
+    """Drop the least recently used files past :data:`FOLDER_BYTES`."""
+    files = sorted(where.glob("*.bin"), key=lambda p: p.stat().st_mtime)
+    total = sum(p.stat().st_size for p in files)
+    for p in files:
+        if total <= FOLDER_BYTES:
+            break
+        total -= p.stat().st_size
+        p.unlink(missing_ok=True)

@@ -1,0 +1,217 @@
+"""Issue 34, the first answer: traced programs kept on disk (mfm._programs) and a run in chunks
+that compiles one copy of its outputs.
+
+- A program saved by one process and loaded by another gives the bits of the ordinary jit call,
+  and the later process traces nothing (jax's trace counter, not a timer).
+- The key that names a program on disk changes with anything that changes the program: the
+  static data of the arguments' pytree (numpy arrays by their bytes, not their repr), the
+  shapes, dtypes and weak types of the leaves, the static arguments; what it cannot key (a
+  function, a user's own class) takes the ordinary path.
+- A damaged file is made anew, not trusted.
+"""
+from __future__ import annotations
+
+import dataclasses
+import os
+import subprocess
+import sys
+import textwrap
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from conftest import CONFIGS, ROOT
+
+from mfm import _programs
+
+
+@jax.jit
+def _affine(p, x):
+    return {"y": p["a"] @ x + p["b"], "n": jnp.sum(x)}
+
+
+def _fresh(monkeypatch, tmp_path):
+    """A program folder of this test's own and an empty in-process table."""
+    monkeypatch.setattr(_programs, "folder", lambda: tmp_path)
+    monkeypatch.setattr(_programs, "_MADE", {})
+
+
+def test_a_saved_program_gives_the_ordinary_bits(monkeypatch, tmp_path):
+    _fresh(monkeypatch, tmp_path)
+    rng = np.random.default_rng(1)
+    p = {"a": jnp.asarray(rng.normal(size=(5, 5))), "b": jnp.asarray(rng.normal(size=5))}
+    x = jnp.asarray(rng.normal(size=5))
+    before = dict(_programs.COUNTS)
+    made = _programs.program(_affine, "affine", (p, x))
+    assert _programs.COUNTS["saved"] == before["saved"] + 1
+    assert len(list(tmp_path.glob("affine-*.bin"))) == 1
+    monkeypatch.setattr(_programs, "_MADE", {})          # as a new process finds it
+    loaded = _programs.program(_affine, "affine", (p, x))
+    assert _programs.COUNTS["loaded"] == before["loaded"] + 1
+    want = _affine(p, x)
+    for got in (made(p, x), loaded(p, x)):
+        assert got.keys() == want.keys()
+        for k in want:
+            np.testing.assert_array_equal(got[k], want[k])    # the same program: the same bits
+    # the output shapes come from the saved program, as the ordinary path's eval_shape gives them
+    shapes = loaded.shapes(p, x)
+    assert {k: (v.shape, v.dtype) for k, v in shapes.items()} == {
+        k: (v.shape, v.dtype) for k, v in jax.eval_shape(_affine, p, x).items()}
+    with pytest.raises(ValueError, match="another structure"):
+        loaded({"a": p["a"]}, x)
+
+
+def test_a_damaged_file_is_made_anew(monkeypatch, tmp_path):
+    _fresh(monkeypatch, tmp_path)
+    p = {"a": jnp.eye(3), "b": jnp.ones(3)}
+    x = jnp.arange(3.0)
+    _programs.program(_affine, "affine", (p, x))
+    (path,) = tmp_path.glob("affine-*.bin")
+    path.write_bytes(path.read_bytes()[: path.stat().st_size // 2])   # a truncated write
+    monkeypatch.setattr(_programs, "_MADE", {})
+    before = dict(_programs.COUNTS)
+    again = _programs.program(_affine, "affine", (p, x))
+    assert _programs.COUNTS["saved"] == before["saved"] + 1 and (
+        _programs.COUNTS["loaded"] == before["loaded"])
+    np.testing.assert_array_equal(again(p, x)["y"], _affine(p, x)["y"])
+
+
+@dataclasses.dataclass(frozen=True)
+class _Option:
+    order: int
+    name: str
+
+
+@pytest.mark.filterwarnings("ignore:A JAX array is being set as static")
+def test_the_key_changes_with_whatever_changes_the_program(monkeypatch):
+    import equinox as eqx
+
+    # this file's own types, keyed as mfm's are (their code does not change within the test)
+    monkeypatch.setattr(_programs, "_KEYED_MODULES", _programs._KEYED_MODULES + (__name__,))
+
+    class Table(eqx.Module):          # a pytree with static data, as a Load is
+        values: jnp.ndarray
+        grid: np.ndarray = eqx.field(static=True)
+        label: str = eqx.field(static=True)
+
+    grid = np.linspace(0.0, 1.0, 5000)
+    base = (Table(jnp.ones(3), grid, "a"), jnp.zeros(4))
+    k0 = _programs.key("f", base, {"option": _Option(2, "rk4")})
+    assert k0 == _programs.key("f", base, {"option": _Option(2, "rk4")})
+    # numbers of the array leaves do not change the program: the same key
+    assert k0 == _programs.key("f", (Table(7.0 * jnp.ones(3), grid, "a"), jnp.ones(4)),
+                               {"option": _Option(2, "rk4")})
+    moved = grid.copy()
+    moved[2500] += 1e-12                  # the middle of an array numpy's repr elides
+    changed = [
+        (Table(jnp.ones(3), moved, "a"), jnp.zeros(4)),                # static array bytes
+        (Table(jnp.ones(3), grid, "b"), jnp.zeros(4)),                 # static string
+        (Table(jnp.ones(3), grid, "a"), jnp.zeros(5)),                 # a leaf's shape
+        (Table(jnp.ones(3), grid, "a"), jnp.zeros(4, jnp.float32)),    # a leaf's dtype
+        (Table(jnp.ones(3), grid, "a"), jnp.asarray(0.0) + jnp.zeros(4)[0]),  # another structure
+        (Table(jnp.ones(3), grid, "a"), jnp.zeros(4), None),          # another structure
+    ]
+    keys = {_programs.key("f", args, {"option": _Option(2, "rk4")}) for args in changed}
+    keys |= {_programs.key("f", base, {"option": _Option(3, "rk4")}),
+             _programs.key("f", base, {"option": _Option(2, "verlet")}),
+             _programs.key("g", base, {"option": _Option(2, "rk4")})}
+    assert k0 not in keys and len(keys) == len(changed) + 3
+    # a weakly typed leaf traces otherwise than a strongly typed one
+    weak, strong = jnp.asarray(1.0), jnp.asarray(1.0, jnp.float64)
+    assert weak.weak_type and not strong.weak_type
+    assert _programs.key("f", (weak,), {}) != _programs.key("f", (strong,), {})
+    assert _programs.key("f", (1.0,), {}) != _programs.key("f", (np.float64(1.0),), {})
+
+
+def test_what_the_key_cannot_name_takes_the_ordinary_path(monkeypatch, tmp_path):
+    import equinox as eqx
+
+    _fresh(monkeypatch, tmp_path)
+
+    class WithFunction(eqx.Module):
+        scale: jnp.ndarray
+        rule: object = eqx.field(static=True)
+
+    @jax.jit
+    def f(m, x):
+        return m.rule(m.scale * x)
+
+    m = WithFunction(jnp.asarray(2.0), jnp.sin)
+    with pytest.raises(_programs._Unkeyable):
+        _programs.key("f", (m, jnp.ones(2)), {})
+    before = dict(_programs.COUNTS)
+    got = _programs.program(f, "f", (m, jnp.ones(2)))(m, jnp.ones(2))
+    assert _programs.COUNTS["ordinary"] == before["ordinary"] + 1
+    assert not list(tmp_path.iterdir())
+    np.testing.assert_array_equal(got, jnp.sin(2.0 * jnp.ones(2)))
+
+    class Local:                      # a type outside mfm, hydro, jax, equinox, numpy
+        pass
+
+    with pytest.raises(_programs._Unkeyable, match="Local"):
+        _programs.key("f", (), {"rule": Local})
+
+
+# A first run through the command line in two processes sharing the caches: the second loads
+# the run's programs (start, chunk, the checks' linearisation) instead of tracing them, and its
+# dataset has the bits of a run with no cache at all.
+SCRIPT = textwrap.dedent("""
+    import sys, warnings
+    import jax, mfm, hydro, numpy as np
+    from mfm import _programs
+    from jax._src import monitoring
+    traced = []
+    monitoring.register_event_duration_secs_listener(
+        lambda name, dur, **kw: traced.append(dur) if name.endswith("jaxpr_trace_duration") else None)
+    m = mfm.load(sys.argv[1])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = mfm.simulate(m, None, duration=0.6, dt=0.01, q0={"upper.angle": 0.4},
+                          progress=True)
+        whole = mfm.simulate(m, None, duration=0.6, dt=0.01, q0={"upper.angle": 0.4})
+    ds.to_netcdf(sys.argv[2])
+    whole.to_netcdf(sys.argv[2] + ".whole.nc")
+    print("COUNTS", _programs.COUNTS["loaded"], _programs.COUNTS["saved"], sum(traced))
+""")
+
+
+def test_a_second_process_loads_the_programs_and_gives_the_same_bits(tmp_path):
+    import xarray as xr
+
+    script = tmp_path / "run.py"
+    script.write_text(SCRIPT)
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MFM_COMPILATION_CACHE=str(tmp_path / "jax"))
+    env.pop("JAX_COMPILATION_CACHE_DIR", None)      # this test's own, empty, caches
+    cfg = str(CONFIGS / "double_pendulum.toml")
+    runs = []
+    for k, cache in enumerate(("on", "on", "off")):
+        e = dict(env, MFM_COMPILATION_CACHE="off") if cache == "off" else env
+        r = subprocess.run([sys.executable, str(script), cfg, str(tmp_path / f"{k}.nc")],
+                           env=e, capture_output=True, text=True, timeout=600)
+        assert r.returncode == 0, r.stderr[-3000:]
+        line = next(ln for ln in r.stdout.splitlines() if ln.startswith("COUNTS"))
+        runs.append(tuple(float(v) for v in line.split()[1:]))
+    (l0, s0, _), (l1, s1, trace1), (l2, s2, trace2) = runs
+    assert l0 == 0 and s0 >= 3          # the first saves start, chunk, linearisation, whole run
+    assert l1 == s0 and s1 == 0         # the second loads every one and saves none
+    assert l2 == 0 and s2 == 0          # no cache: the ordinary path
+    # tracing left: the small eager helpers (tables, memories), not the run's programs
+    assert trace1 < 0.5 * trace2, (trace1, trace2)
+    ref = xr.open_dataset(tmp_path / "2.nc")
+    for k in (0, 1):
+        for name in (f"{k}.nc", f"{k}.nc.whole.nc"):
+            got = xr.open_dataset(tmp_path / name)
+            for var in ("q", "qd", "qdd", "joint_force", "kinetic_energy"):
+                np.testing.assert_array_equal(got[var].values, ref[var].values, err_msg=name)
+
+
+def test_a_disabled_bar_is_no_bar():
+    """tqdm's own ``disable=True`` (tqdm then makes a bar without its clock) runs the plain way."""
+    import mfm
+
+    m = mfm.load(CONFIGS / "double_pendulum.toml")
+    kw = dict(duration=0.3, dt=0.01, q0={"upper.angle": 0.4})
+    np.testing.assert_array_equal(mfm.simulate(m, progress={"disable": True}, **kw).q.values,
+                                  mfm.simulate(m, **kw).q.values)
