@@ -45,7 +45,12 @@ NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 # the suite runs with --dist loadfile: one file's tests stay on one worker, so the notebooks are
 # split over two files (these run from tests/test_notebooks_second.py) to use both workers;
 # every other notebook, a new one included, runs here
-SECOND = ("design", "hallak_fwwp", "wu_yuan")   # design: 4.3 min smoke (mostly compiling), 2 loaded cores
+SECOND = ("design", "hallak_fwwp", "wu_yuan")
+# design smoke (mostly compiling: one structure per model, Hallak's κ, which moves q₀, the heaviest),
+# `time nice -n 10 python -m pytest -n 0 tests/test_notebooks_second.py -k design`, 2 cores:
+# with its q-factors and heading sweep, 172 s CPU / 4.8 min wall under a load of 5–8 and 187 s CPU /
+# 7.6 min wall under a load of 7–9.5 (before them and before forward-mode derivatives for Stansby &
+# Li and Hallak: 211 s CPU / 4.3 min at a load of 7–8); about 3 min of CPU, so ≤ 3 min wall only unloaded
 FIRST = [p for p in NOTEBOOKS if p.stem not in SECOND]
 
 
