@@ -12,7 +12,10 @@ pass per parameter (forward) or per output (reverse). The optimiser is SLSQP (sc
 parameters scaled to [0, 1] by their bounds, with the constraints as inequalities in every sea.
 The time domain confirms an optimum (``confirm=``): the optimised model stepped in the same seas
 (:func:`mfm.simulate_batch`; :func:`mfm.simulate` per sea for hydraulic pistons), its mean power
-against the spectral prediction.
+against the spectral prediction. The equilibrium q₀(θ) of every evaluated point must balance the
+loads to EQUILIBRIUM_TOL (1e-6) of the largest weight (:func:`mfm.studies.design._newton`, damped):
+a point without one raises :class:`~mfm.errors.OptimizeError` (``evaluate``: NaN there). From the
+command line: ``mfm optimize`` (:func:`mfm.io.cli.cmd_optimize`).
 """
 from __future__ import annotations
 
