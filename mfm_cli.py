@@ -116,6 +116,34 @@ def build_parser():
                    f"taken {PROGRESS_DELAY_TTY:g} s, elsewhere (a log, a pipe) once it has taken "
                    f"{PROGRESS_DELAY_LOG:g} s, refreshed every {PROGRESS_INTERVAL_LOG:g} s")
     p.set_defaults(func="cmd_simulate")
+    p = sub.add_parser("optimize", help="tune PTO, mooring, mass or controller parameters to "
+                       "maximise the mean absorbed power in a sea (spectral level, exact "
+                       "derivatives); print the optimum, write it as NetCDF")
+    p.add_argument("config")
+    p.add_argument("--param", action="append", required=True, metavar="NAME[=LO:HI]",
+                   help="a tunable parameter and its bounds, repeatable, e.g. "
+                   "--param float3.angle.damping=0:30; NAME alone: from half to twice the model's "
+                   "value; NAME1,NAME2=LO:HI: one value shared by them. The names: "
+                   "mfm.studies.optimize.tunable_parameters(model)")
+    p.add_argument("--constraint", action="append", metavar="QUANTITY.KIND=LIMIT",
+                   help="a limit to hold, repeatable: KIND rms or significant of a coordinate or a "
+                   "PTO stroke (m or rad), or peak of '<line>.tension' (N), e.g. "
+                   "--constraint float1.pitch.rms=0.03")
+    for flag, kw in (("--wave", dict(choices=["regular", "jonswap"], required=True,
+                                     help="sea state")),
+                     ("--height", dict(type=POSITIVE, help="regular wave height H, m")),
+                     ("--period", dict(type=POSITIVE, help="regular wave period T, s")),
+                     ("--hs", dict(type=POSITIVE, help="JONSWAP significant wave height, m")),
+                     ("--tp", dict(type=POSITIVE, help="JONSWAP peak period, s")),
+                     ("--gamma", dict(type=_number("a number ≥ 1", minimum=1.0, strict=False),
+                                      default=3.3, help="JONSWAP peak enhancement (default 3.3)")),
+                     ("--seed", dict(type=_count(0), default=0, help="random phases seed")),
+                     ("--components", dict(type=_count(1), help="number of wave components")),
+                     ("--heading", dict(type=FINITE, default=0.0, help="wave heading, degrees"))):
+        p.add_argument(flag, **kw)
+    p.add_argument("--max-iter", type=_count(1), default=100, help="SLSQP iterations (default 100)")
+    p.add_argument("--out", default="out/optimum.nc", help="NetCDF output (default out/optimum.nc)")
+    p.set_defaults(func="cmd_optimize")
     p = sub.add_parser("rao", help="frequency-domain RAOs and natural frequencies (NetCDF)")
     p.add_argument("config")
     p.add_argument("--omega-min", type=POSITIVE, required=True, help="rad/s, > 0")

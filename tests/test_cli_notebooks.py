@@ -41,6 +41,55 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
     assert "bodies[0] ('a').mass" in capsys.readouterr().err
 
 
+def test_cli_optimize_as_the_readme_writes_it(tmp_path, capsys):
+    """README § Design by gradient's `mfm optimize` line, run as written (--out moved to tmp):
+    the heave limit active and met, and the optimum's heave rms again by the numpy spectral route
+    (mfm.spectral_response of the model with that damping; 1e-6 relative: SLSQP meets an active
+    limit to its tolerance 1e-9 of the scaled objective, the two routes agree to round-off)."""
+    import shlex
+
+    import numpy as np
+
+    import mfm
+    from hydro.waves import Regular
+
+    line = next(ln for ln in (ROOT / "README.md").read_text().splitlines()
+                if ln.startswith("mfm optimize configs/sphere.toml"))
+    argv = shlex.split(line)[1:]
+    nc = tmp_path / "optimum.nc"
+    argv[argv.index("--out") + 1] = str(nc)
+    argv[1] = str(CONFIGS / "sphere.toml")
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "sphere.heave.damping:" in out and "rms(sphere.heave): 0.1 ≤ 0.1 (active" in out
+    ds = xr.open_dataset(nc)
+    assert bool(ds.constraint_active.item()) and ds.attrs["command"]
+    c = float(ds.optimum.item())
+    assert 0.0 < c < 20000.0
+    m = mfm.load(CONFIGS / "sphere.toml")
+    damped = m.replace(damping=np.where(np.array(m.coordinates) == "sphere.heave", c, m.damping))
+    sp = mfm.spectral_response(damped, Regular(height=0.5, period=2.5))
+    assert float(sp.q_rms.sel(coordinate="sphere.heave")) == pytest.approx(0.1, rel=1e-6)
+    assert float(ds.objective) == pytest.approx(float(sp.pto_power_mean.sum()), rel=1e-9)
+
+
+def test_cli_optimize_errors_are_one_line(tmp_path, capsys):
+    base = ["optimize", str(CONFIGS / "sphere.toml"), "--wave", "regular", "--height", "0.5",
+            "--period", "2.5", "--out", str(tmp_path / "o.nc")]
+    assert main(base + ["--param", "sphere.damping=0:1"]) == 2
+    err = capsys.readouterr().err
+    assert "--param 'sphere.damping=0:1'" in err and "sphere.heave.damping" in err
+    assert main(base + ["--param", "sphere.heave.damping=0-1"]) == 2
+    assert "is not LO:HI" in capsys.readouterr().err
+    assert main(base + ["--param", "sphere.heave.damping"]) == 2       # the model's value is 0
+    assert "no span; give bounds" in capsys.readouterr().err
+    assert main(base + ["--param", "sphere.heave.damping=0:1e4", "--constraint", "heave=0.1"]) == 2
+    assert "expected QUANTITY.KIND=LIMIT" in capsys.readouterr().err
+    with pytest.raises(SystemExit, match="--wave regular needs --height"):
+        main(["optimize", str(CONFIGS / "sphere.toml"), "--wave", "regular",
+              "--param", "sphere.heave.damping=0:1e4", "--out", str(tmp_path / "o.nc")])
+
+
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 # the suite runs with --dist loadfile: one file's tests stay on one worker, so the notebooks are
 # split over two files (these run from tests/test_notebooks_second.py) to use both workers;

@@ -224,3 +224,116 @@ def test_line_tension_against_the_frequency_domain_and_as_a_limit():
     assert float(ds.constraint_value.item()) <= limit * (1 + 1e-9)
     assert float(ds.objective) <= float(free.objective) * (1 + 1e-12)
     assert ev["objective"][1] >= ev["objective"][0]
+
+
+def test_damped_newton_reaches_the_equilibrium_the_undamped_one_misses(m4):
+    """float3 at 12 × its mass: the undamped Newton of 8 steps from the baseline equilibrium (the
+    engine's own solver with max_iter=8 takes exactly those steps) does not converge; the damped
+    Newton of optimize does, to the root the engine's solver reaches in 50 steps from the same
+    start (an independent route: numpy lstsq Newton, its own stopping test). Tolerance 1e-9 rad or
+    m: both roots are converged to ~1e-15 of the weights, J is well conditioned there."""
+    from mfm.frequency.rest import equilibrium
+
+    b = float(m4.mass[2])
+    q_base = equilibrium(m4)[0]
+    heavy = O.apply(m4, {"float3.mass": 12 * b})
+    with pytest.raises(ValueError, match="no static equilibrium"):
+        equilibrium(heavy, q_base, max_iter=8)
+    q_engine = equilibrium(heavy, q_base, max_iter=50)[0]
+    P = O._setup(m4, SEA, {"float3.mass": (0.0, 20 * b)}, "power", None, None, None, "database",
+                 None, 40, "forward")
+    out, J, r = O._run(P, np.array([12 / 20]), 1.0)
+    assert float(r.equilibrium_residual) < 1e-12
+    np.testing.assert_allclose(r.q0, q_engine, atol=1e-9)
+    assert np.isfinite(out).all() and np.isfinite(J).all()
+    # the spectral power about that equilibrium by the numpy route
+    assert out[0] == pytest.approx(_spectral_power(m4, {"float3.mass": 12 * b}), rel=1e-9)
+
+
+def test_no_equilibrium_is_refused_with_the_parameters_and_the_residual():
+    """The sphere 10 % heavier than the water it displaces, with a heave spring −K₃₃ that cancels
+    its hydrostatic heave stiffness: Q_heave = ρgV − mg ≠ 0 for every heave, no equilibrium
+    exists. optimize refuses it by name (the values, the residual, the cause) with the last point
+    that had one; evaluate returns NaN there with the residual."""
+    from mfm.frequency.rest import linear_system
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = mfm.load("configs/sphere.toml")
+    heave = m.coordinates.index("sphere.heave")
+    K33 = float(linear_system(m).K[heave, heave])
+    assert K33 > 0
+    mass = float(m.mass[0])
+    sea = Regular(height=0.5, period=6.0)
+    params = {"sphere.mass": (0.5 * mass, 2.0 * mass), "sphere.heave.stiffness": (-K33, K33)}
+    with pytest.raises(OptimizeError, match="no static equilibrium") as err:
+        O.optimize(m, sea, params, x0={"sphere.mass": 1.1 * mass, "sphere.heave.stiffness": -K33})
+    msg = str(err.value)
+    # the residual is the unbalanced 0.1 m g over the largest weight 1.1 m g: 1/11 (3 digits)
+    assert "max|Q(q0)| = 0.0909 " in msg and "sphere.heave.stiffness" in msg and "capsizes" in msg
+    assert err.value.last_good == {"sphere.mass": mass, "sphere.heave.stiffness": 0.0}
+    ev = O.evaluate(m, sea, {"sphere.mass": [mass, 1.1 * mass],
+                             "sphere.heave.stiffness": [0.0, -K33]})
+    assert ev["equilibrium_residual"][0] < 1e-12 and ev["equilibrium_residual"][1] > 0.05
+    assert np.isfinite(ev["objective"][0]) and np.isnan(ev["objective"][1])
+
+
+def test_control_stiffness_acts_about_the_equilibrium(m4):
+    """float3 at twice its mass (its hinge at rest at 0.17 rad, not at the config's rest 0):
+    a controller stiffness k_c about q₀ leaves the equilibrium where it is (against the engine's
+    equilibrium, 1e-10 rad: both converged to ~1e-15 of the weights), and the objective and its
+    derivative in k_c are those of the numpy spectral route for the same model with a joint spring
+    k_c whose rest angle is q₀ (an independent construction of the same force): value 1e-9
+    relative (two routes' round-off and q₀ to 1e-12), derivative against central differences,
+    h = 1e-3 of the hydrostatic hinge stiffness (truncation ~1e-7 relative) at 1e-5. apply()
+    writes the same spring for the time domain; another k_c, mass or model does not retrace."""
+    from mfm.frequency.rest import equilibrium, linear_system
+
+    b = float(m4.mass[2])
+    heavy = O.apply(m4, {"float3.mass": 2 * b})
+    q0 = equilibrium(heavy)[0]
+    i = heavy.coordinates.index("float3.angle")
+    assert abs(q0[i]) > 0.1
+    Kh = float(linear_system(heavy, q0).K[i, i])
+    kc = -0.3 * Kh                                     # reactive: cancels 30 % of the restoring
+    names = ["float3.angle.control_stiffness", "float3.angle.damping", "float3.mass"]
+    bounds = {"float3.angle.control_stiffness": (-Kh, Kh), "float3.angle.damping": (0.0, 20.0),
+              "float3.mass": (0.5 * b, 3 * b)}
+    P = O._setup(m4, SEA, bounds, "power", None, None, None, "database", None, 40, "forward")
+    assert "float3.angle.control_stiffness" in O.tunable_parameters(m4)
+
+    def run(values):
+        th = np.array([values[n] for n in names])
+        return O._run(P, (th - P.lower) / (P.upper - P.lower), 1.0)
+
+    at = {"float3.angle.control_stiffness": kc, "float3.angle.damping": 6.0, "float3.mass": 2 * b}
+    out, J, r = run(at)
+    before = O.TRACES["outputs"]
+    _, _, r0 = run({**at, "float3.angle.control_stiffness": 0.0})
+    np.testing.assert_allclose(r.q0, q0, atol=1e-10)
+    np.testing.assert_array_equal(r.q0, r0.q0)          # not in the equilibrium at all
+
+    def numpy_power(k):
+        stiff = np.array(heavy.stiffness, dtype=float)
+        rest = np.array(heavy.rest, dtype=float)
+        stiff[i], rest[i] = k, q0[i]
+        sprung = heavy.replace(stiffness=stiff, rest=rest)
+        return float(mfm.spectral_response(sprung, SEA).pto_power_mean.sum())
+
+    assert out[0] == pytest.approx(numpy_power(kc), rel=1e-9)
+    assert r0.power.sum() == pytest.approx(numpy_power(0.0), rel=1e-9)
+    assert abs(out[0] - float(r0.power.sum())) > 1e-3 * out[0]      # it does act
+    h = 1e-3 * Kh
+    fd = (numpy_power(kc + h) - numpy_power(kc - h)) / (2 * h)
+    grad = J[0, 0] / (P.upper[0] - P.lower[0])
+    assert grad == pytest.approx(fd, rel=1e-5)
+    # apply(): the joint spring about q₀ the time domain steps
+    applied = O.apply(m4, {"float3.mass": 2 * b, "float3.angle.control_stiffness": kc})
+    assert float(applied.stiffness[i]) == pytest.approx(kc, rel=1e-15)
+    assert float(applied.rest[i]) == pytest.approx(q0[i], abs=1e-10)
+    # other numbers, another model of the same structure: one compilation
+    O._run(P, np.array([0.2, 0.7, 0.4]), 1.0)
+    P2 = O._setup(m4.set_mass("float2", float(m4.mass[1]) * 1.05), SEA, bounds, "power", None,
+                  None, None, "database", None, 40, "forward")
+    O._run(P2, np.array([0.3, 0.5, 0.5]), 1.0)
+    assert O.TRACES["outputs"] == before

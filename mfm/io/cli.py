@@ -1,4 +1,4 @@
-"""Command line: ``mfm info | simulate | rao | hydro | plot``: the commands.
+"""Command line: ``mfm info | simulate | optimize | rao | hydro | plot``: the commands.
 
 The parser and the entry point are in the top-level module :mod:`mfm_cli` (importing this module
 imports the ``mfm`` package, and with it jax): it calls the commands here, and nothing here
@@ -125,7 +125,7 @@ def cmd_info(args):
     print("  " + _restoring_text(", ".join(no_restoring(model))))
 
 
-def _sea(args):
+def _sea(args, command="simulate"):
     import numpy as np
 
     import hydro
@@ -133,15 +133,15 @@ def _sea(args):
     if args.wave is None:
         for flag in ("height", "period", "hs", "tp"):
             if getattr(args, flag) is not None:
-                raise SystemExit(f"mfm simulate: --{flag} needs --wave regular or --wave jonswap")
+                raise SystemExit(f"mfm {command}: --{flag} needs --wave regular or --wave jonswap")
         return None
     heading = float(np.deg2rad(args.heading))
     if args.wave == "regular":
         if args.height is None or args.period is None:
-            raise SystemExit("mfm simulate: --wave regular needs --height (m) and --period (s)")
+            raise SystemExit(f"mfm {command}: --wave regular needs --height (m) and --period (s)")
         return hydro.Regular(height=args.height, period=args.period, heading=heading)
     if args.hs is None or args.tp is None:
-        raise SystemExit("mfm simulate: --wave jonswap needs --hs (m) and --tp (s)")
+        raise SystemExit(f"mfm {command}: --wave jonswap needs --hs (m) and --tp (s)")
     kw = {}
     if args.components is not None:
         kw["n_components"] = args.components
@@ -204,6 +204,95 @@ def cmd_simulate(args):
 
         save_result_plot(ds, png)
         print(f"  figure -> {png}")
+
+
+def _bounds(items, model):
+    """``--param NAME[=LO:HI]`` items as optimize's parameters: name (or a tuple of names,
+    comma-separated: one shared value) → (lower, upper); NAME alone spans half to twice the
+    model's value (a positive one: a damping, a mass, a stiffness of the config)."""
+    from ..studies.design import _targets, _unknown, _value_of
+    from ..frequency.rest import system_loads
+
+    table, static = _targets(model, system_loads(model))
+    out = {}
+    for item in items:
+        key, sep, span = item.partition("=")
+        names = tuple(n.strip() for n in key.split(","))
+        for n in names:
+            if n not in table:
+                raise KeyError(f"--param {item!r}: " + _unknown(n, table))
+        if sep:
+            lo, colon, hi = span.partition(":")
+            try:
+                bounds = (float(lo), float(hi))
+            except ValueError:
+                raise ValueError(f"--param {item!r}: {span!r} is not LO:HI (two numbers, e.g. "
+                                 f"{names[0]}=0:30)") from None
+            if not colon:
+                raise ValueError(f"--param {item!r}: give the bounds as LO:HI, e.g. {names[0]}=0:30")
+        else:
+            v = _value_of(model, static, table[names[0]][0])
+            if not v > 0:
+                raise ValueError(f"--param {item!r}: the model's value is {v:g}, so half to twice "
+                                 f"it is no span; give bounds, e.g. {names[0]}=LO:HI")
+            bounds = (0.5 * v, 2.0 * v)
+        out[names[0] if len(names) == 1 else names] = bounds
+    return out
+
+
+def _constraints(items):
+    """``--constraint QUANTITY.KIND=LIMIT`` items as optimize's constraints."""
+    out = {}
+    for item in items or []:
+        key, sep, lim = item.partition("=")
+        quantity, dot, kind = key.strip().rpartition(".")
+        if not sep or not dot:
+            raise ValueError(f"--constraint {item!r}: expected QUANTITY.KIND=LIMIT, e.g. "
+                             "float1.pitch.rms=0.03 (KIND rms, significant or, of a line's "
+                             "tension, peak)")
+        try:
+            value = float(lim)
+        except ValueError:
+            raise ValueError(f"--constraint {item!r}: {lim!r} is not a number") from None
+        out.setdefault(quantity, {})[kind] = value
+    return out
+
+
+def cmd_optimize(args):
+    import numpy as np
+
+    from hydro.database import write_netcdf
+
+    from ..studies.optimize import optimize
+
+    out = _writable(args.out)
+    model = load(args.config)
+    sea = _sea(args, "optimize")
+    parameters = _bounds(args.param, model)
+    constraints = _constraints(args.constraint)
+    t0 = time.perf_counter()
+    ds = optimize(model, sea, parameters, constraints=constraints or None, max_iter=args.max_iter)
+    wall = time.perf_counter() - t0
+    command = "mfm " + " ".join(sys.argv[1:]) if sys.argv[1:] else "mfm optimize"
+    ds = results.with_command(ds, command)
+    write_netcdf(ds, out)
+    print(f"{model.name}: optimum of the mean absorbed power in {sea!r} in {wall:.1f} s "
+          f"({int(ds.iterations)} iterations, including compilation) -> {out}")
+    for k, name in enumerate(ds.parameter.values):
+        bound = str(ds.at_bound.values[k])
+        print(f"  {name:>32s}: {float(ds.optimum[k]):.6g} {ds.parameter_unit.values[k]} (model's "
+              f"{float(ds.baseline[k]):.6g}; bounds {float(ds.lower[k]):g}:{float(ds.upper[k]):g}"
+              + (f", at the {bound} bound)" if bound else ")"))
+    gain = (f"gain {float(ds.gain):+.2%}" if float(ds.objective_baseline) else
+            "the model's own values absorb nothing")
+    print(f"  mean absorbed power {float(ds.objective):.6g} W (model's "
+          f"{float(ds.objective_baseline):.6g} W): {gain}")
+    for k, c in enumerate(ds.constraint.values):
+        state = "active" if bool(ds.constraint_active[k]) else "inactive"
+        print(f"  {c}: {float(ds.constraint_value[k]):.6g} ≤ {float(ds.constraint_limit[k]):.6g} "
+              f"({state}; model's {float(ds.constraint_value_baseline[k]):.6g})")
+    if ds.sizes["constraint"] and not np.any(ds.constraint_active.values):
+        print("  no constraint active at the optimum")
 
 
 # a run whose every coordinate and rate stays within this of zero (m, rad, m/s, rad/s) stayed at

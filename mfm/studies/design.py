@@ -4,14 +4,15 @@ what :func:`mfm.optimize` (:mod:`mfm.studies.optimize`) differentiates and searc
 For each sea s with components a_sj at (ω_j, β_j) (the union of every sea's pairs):
 
     q₀(θ):  Q(q₀, 0; θ) = 0                        (the static equilibrium; implicit derivative)
-    M, K, C at q₀(θ)                               (the jet of :mod:`mfm.frequency.rest`)
+    M, K, C at q₀(θ)                               (the jet of :mod:`mfm.frequency.rest`;
+                                                    K + diag(k_c): controllers about q₀)
     Z_j(θ) = −ω_j² M − iω_j (C + C_drag,s) + K + Hᵀ[−ω_j²(A(ω_j) − A∞) − iω_j B(ω_j)]H
     x̂_sj = Z_j⁻¹ Hᵀ X(ω_j, β_j)                    (RAO per metre, H = H(q₀(θ)))
     P_s = Σ_p Σ_j a_sj² ½ c_p ω_j² |G_p x̂_sj|²      (mean power of each PTO p, rate ẇ = G_p q̇)
     σ_{q,s}² = Σ_j ½ a_sj² |x̂_sj|²                  (variance of each coordinate; of a stroke with G)
 
 the frequency domain's equations (:mod:`mfm.frequency.response`, :mod:`mfm.frequency.spectral`),
-written in jax so that θ — joint dampings and stiffnesses, body masses, hydraulic μ, β, κ, linear
+written in jax so that θ — joint dampings and stiffnesses, controller stiffnesses about q₀, body masses, hydraulic μ, β, κ, linear
 mooring stiffnesses, named as the config and the coordinates are (:func:`tunable_parameters`) —
 are arguments of one compiled function (their structure, not their values, is its key).
 
@@ -33,7 +34,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..frequency.rest import _static_functions, _static_jet, system_loads
+from ..frequency.rest import _static_functions, _static_jet, _static_parts, system_loads
 from ..loads.hydraulic_pto import HydraulicPTO
 from ..loads.mooring import PointSprings
 from ..mechanics.model import Model
@@ -47,12 +48,17 @@ _PTO_KINDS = {"mu": ("hydraulic piston inertia μ", "kg", False),
               "beta": ("hydraulic piston damping β", "N s/m", False),
               "kappa": ("hydraulic piston stiffness κ", "N/m", True)}
 _SPRING_KINDS = {"kx": 0, "ky": 1, "kz": 2}
+# a controller's spring about the operating point: −k_c (q − q₀(θ)), in K of the linearisation
+# only (it exerts nothing at q₀, so it never moves the equilibrium); the config has none (0)
+_CONTROL = ("control_stiffness", "controller stiffness about the equilibrium q0 (negative: "
+            "reactive control)", "N m/rad or N/m")
 # Borgman's factor: E[|v| v · v] / E[v²] = √(8/π) σ for a zero-mean Gaussian v
 _BORGMAN = math.sqrt(8.0 / math.pi)
 
 
 class Target(NamedTuple):
-    """Where a tunable parameter lives: ``where`` "model" (a Model array ``field`` at ``index``)
+    """Where a tunable parameter lives: ``where`` "model" (a Model array ``field`` at ``index``),
+    "control" (the controller stiffness of coordinate ``index``, :class:`Problem`'s ``control``)
     or "load" (the load at ``load`` in the loads at rest, array ``field`` at ``index``, and the
     column ``column`` of a 2-D array or -1); ``moves`` whether it moves the static equilibrium."""
     where: str
@@ -66,7 +72,9 @@ class Target(NamedTuple):
 def tunable_parameters(model: Model, loads=None) -> dict[str, str]:
     """Every parameter :func:`optimize` can tune, spelled as the config and the coordinates are:
     ``"<coordinate>.damping"``, ``"<coordinate>.stiffness"`` (the joint spring–damper of that
-    coordinate), ``"<body>.mass"``, ``"<hydraulic pto>.mu"``, ``".beta"``, ``".kappa"``,
+    coordinate: −k (q − rest), about the config's rest, so it moves the equilibrium),
+    ``"<coordinate>.control_stiffness"`` (a controller's spring −k_c (q − q₀) about the
+    equilibrium: it adds k_c to K of the linearisation and leaves q₀ where it is), ``"<body>.mass"``, ``"<hydraulic pto>.mu"``, ``".beta"``, ``".kappa"``,
     ``"<mooring>.kx"``, ``".ky"``, ``".kz"`` (a ``[[moorings]]`` spring's stiffness per inertial axis).
     Returns name → "what it is (units) = its value now"."""
     model = check_model(model)
@@ -88,6 +96,7 @@ def _targets(model, lds):
         for f in ("damping", "stiffness"):
             what, units, moves = _MODEL_KINDS[f]
             out[f"{c}.{f}"] = (Target("model", f, k, moves=moves), what, units)
+        out[f"{c}.{_CONTROL[0]}"] = (Target("control", _CONTROL[0], k), *_CONTROL[1:])
     for i, b in enumerate(model.body_names):
         what, units, moves = _MODEL_KINDS["mass"]
         out[f"{b}.mass"] = (Target("model", "mass", i, moves=moves), what, units)
@@ -106,15 +115,20 @@ def _targets(model, lds):
 
 
 def _value_of(model, static, t: Target) -> float:
+    if t.where == "control":
+        return 0.0                  # a config has no controller spring: the model's own value is 0
     holder = model if t.where == "model" else static[t.load]
     arr = np.asarray(getattr(holder, t.field))
     return float(arr[t.index] if t.column < 0 else arr[t.index, t.column])
 
 
 def _set(model, static, targets, values):
-    """(model, static) with each group of targets set to its value (jax arrays: traced)."""
+    """(model, static) with each group of targets set to its value (jax arrays: traced); the
+    controller stiffnesses are :func:`_control`'s."""
     for group, v in zip(targets, values):
         for t in group:
+            if t.where == "control":
+                continue
             if t.where == "model":
                 model = dataclasses.replace(
                     model, **{t.field: getattr(model, t.field).at[t.index].set(v)})
@@ -127,17 +141,60 @@ def _set(model, static, targets, values):
     return model, static
 
 
+def _control(pb, values):
+    """The controller stiffnesses k_c (n_q,) at ``values``: Problem's ``control`` with each
+    "control" target set (traced)."""
+    k = pb.control
+    for group, v in zip(pb.targets, values):
+        for t in group:
+            if t.where == "control":
+                k = k.at[t.index].set(v)
+    return k
+
+
 def apply(model: Model, values: dict) -> Model:
     """``model`` with the parameters ``values`` (name → number, names of
     :func:`tunable_parameters`) set in the model and in its config loads: what :func:`optimize`
-    returns as the optimum, ready for :func:`mfm.simulate`."""
+    returns as the optimum, ready for :func:`mfm.simulate`.
+
+    A controller stiffness k_c of coordinate i about the equilibrium q₀ (of the model with the
+    other values set) joins the joint spring −k (q − r) as one spring of the same force,
+    −k (q − r) − k_c (q − q₀) = −(k + k_c)(q − r'), r' = (k r + k_c q₀)/(k + k_c): the time
+    domain steps exactly that force (its equilibrium stays q₀)."""
     model = check_model(model)
     table, _ = _targets(model, system_loads(model))
+    for name in values:
+        if name not in table:
+            raise KeyError(_unknown(name, table))
+    control = {table[n][0].index: (n, float(v)) for n, v in values.items()
+               if table[n][0].where == "control"}
+    model = _apply(model, {n: v for n, v in values.items() if table[n][0].where != "control"},
+                   table)
+    if not any(kc for _, kc in control.values()):
+        return model
+    from ..frequency.rest import equilibrium
+
+    q0 = np.asarray(equilibrium(model)[0])
+    k = np.array(model.stiffness, dtype=float)
+    rest = np.array(model.rest, dtype=float)
+    for i, (name, kc) in control.items():
+        if kc == 0.0:
+            continue
+        if k[i] + kc == 0.0:
+            raise ValueError(f"{name} = {kc!r} cancels the joint stiffness {k[i]!r} of "
+                             f"{model.coordinates[i]!r}: the sum is a constant force, not a joint "
+                             "spring the time domain can step; give a controller stiffness other "
+                             f"than {-k[i]!r} (or tune '{model.coordinates[i]}.stiffness')")
+        rest[i] = (k[i] * rest[i] + kc * q0[i]) / (k[i] + kc)
+        k[i] += kc
+    return model.replace(stiffness=jnp.asarray(k), rest=jnp.asarray(rest))
+
+
+def _apply(model, values, table):
+    """``model`` with model and load parameters set (numpy: no tracing), :func:`apply`'s part."""
     loads = list(model.loads)
     changes = {}
     for name, v in values.items():
-        if name not in table:
-            raise KeyError(_unknown(name, table))
         t = table[name][0]
         if t.where == "model":
             arr = changes.get(t.field, np.array(getattr(model, t.field), dtype=float))
@@ -161,7 +218,7 @@ def apply(model: Model, values: dict) -> Model:
 def _unknown(name, table):
     kinds = sorted({n.rsplit(".", 1)[1] for n in table})
     return (f"parameters: {name!r} is not a tunable parameter of this model; give "
-            f"'<coordinate>.damping' or '.stiffness', '<body>.mass', '<hydraulic pto>.mu', '.beta' "
+            f"'<coordinate>.damping', '.stiffness' or '.control_stiffness', '<body>.mass', '<hydraulic pto>.mu', '.beta' "
             f"or '.kappa', '<mooring>.kx', '.ky' or '.kz' (kinds here: {kinds}). Tunable here: "
             f"{sorted(table)}")
 
@@ -172,7 +229,8 @@ class Problem(eqx.Module):
     (numbers only: :func:`mfm.loads.assembly.compile_view`), the baseline equilibrium, the union of
     the seas' components (ω (U,), a² (S, U)), the water's radiation impedance per hydro dof
     ``Zb`` (U, 6K, 6K) = −ω²(A − A∞) − iωB and excitation ``X`` (U, 6K) (per metre), the drag
-    D (6K,) per hydro dof (0 on rotations), the seas' weights (S,); static: where each parameter
+    D (6K,) per hydro dof (0 on rotations), the seas' weights (S,), the controller stiffnesses
+    ``control`` (n_q,) (0: none; the tuned ones are set by :func:`_control`); static: where each parameter
     lives, the joint PTO coordinates, the hydraulic PTO load, the water load, the catenary loads."""
     model: Model
     static: tuple
@@ -190,6 +248,7 @@ class Problem(eqx.Module):
     water: int = eqx.field(static=True)
     drag_iterations: int = eqx.field(static=True)
     lines: tuple = eqx.field(static=True, default=())
+    control: jnp.ndarray | None = None
 
 
 class Response(NamedTuple):
@@ -202,7 +261,8 @@ class Response(NamedTuple):
     hydro dof in each sea (N s/m; 0 on rotations and without drag); ``drag_change`` the last
     relative change of that fixed point (0 without drag); ``tension`` (L,) each catenary line's
     fairlead tension at q₀ and ``tension_rms`` (S, L) the standard deviation of its first-order
-    change ∂T/∂r_F · r̂_F (N)."""
+    change ∂T/∂r_F · r̂_F (N); ``equilibrium_residual`` max|Q(q₀)| over the force scale (the
+    largest generalised or body weight): above EQUILIBRIUM_TOL no equilibrium was reached."""
     power: jnp.ndarray
     q_rms: jnp.ndarray
     stroke_rms: jnp.ndarray
@@ -214,16 +274,64 @@ class Response(NamedTuple):
     drag_change: jnp.ndarray
     tension: jnp.ndarray
     tension_rms: jnp.ndarray
+    equilibrium_residual: jnp.ndarray = 0.0
 
 
-def _newton(f, q):
-    """Newton on Q(q) = 0 from the baseline q₀ (least squares: a coordinate nothing restores
-    keeps its value), a fixed number of steps: the design parameters move q₀ by a few % of the
-    span Newton converges over quadratically; :func:`optimize` checks the residual."""
-    def step(_, q):
+# the equilibrium Newton: at most this many steps, stopped once max|Q| < NEWTON_TOL × the force
+# scale (round-off of Q is ~1e-16 of it; quadratic convergence reaches 1e-12 a step or two after
+# 1e-6), each step halved up to NEWTON_HALVINGS times until ‖Q‖ decreases (Armijo, c = 1e-4)
+NEWTON_STEPS, NEWTON_TOL, NEWTON_HALVINGS = 40, 1e-12, 12
+# the equilibrium is accepted when max|Q(q₀)| ≤ EQUILIBRIUM_TOL × the force scale (the largest
+# generalised weight or body weight): the acceptance of the engine's own equilibrium
+# (:func:`mfm.frequency.rest.equilibrium`); a converged Newton leaves ~1e-12, one that found no
+# equilibrium (a body that sinks or capsizes, a spring that leaves no balance) O(1e-2 … 1)
+EQUILIBRIUM_TOL = 1e-6
+
+
+def _force_scale(model, weights):
+    """The size of the loads that must balance (N or N m): the largest generalised weight
+    |Bᵀ m g| or the largest body weight m g (as :func:`mfm.frequency.rest.equilibrium`)."""
+    return jnp.maximum(jnp.max(jnp.abs(weights)), jnp.max(model.mass) * model.gravity)
+
+
+def _newton(f, q, scale):
+    """Damped Newton on Q(q) = 0 from the baseline q₀: the step d = −J⁺Q (least squares: a
+    coordinate nothing restores keeps its value) times α = 1, ½, ¼, … (at most NEWTON_HALVINGS
+    halvings), the first α with ‖Q(q + αd)‖ ≤ (1 − 10⁻⁴ α)‖Q(q)‖ (Armijo on ‖Q‖²'s descent
+    direction; a non-finite Q counts as no decrease, the smallest α is taken if none decreases),
+    until max|Q| < NEWTON_TOL · ``scale`` or NEWTON_STEPS steps. A full step from far away can
+    overshoot into a region where Q is wild (a float flipped over, a catenary off its table) and
+    diverge; the halving keeps each step a descent. Run by ``lax.custom_root``, which
+    differentiates the root implicitly (q₀' = −J⁻¹ ∂Q/∂θ), never through these loops.
+    :func:`responses` reports the residual and :func:`optimize` refuses one above
+    EQUILIBRIUM_TOL."""
+    def norm(g):
+        n = jnp.sqrt(jnp.sum(g * g))
+        return jnp.where(jnp.isfinite(n), n, jnp.inf)
+
+    def step(carry):
+        k, q, g = carry
         J = jax.jacfwd(f)(q)
-        return q - jnp.linalg.lstsq(J, f(q), rcond=1e-10)[0]
-    return jax.lax.fori_loop(0, 8, step, q)
+        d = -jnp.linalg.lstsq(J, g, rcond=1e-10)[0]
+        n0 = norm(g)
+
+        def shorter(c):
+            a, h, _ = c
+            return a * 0.5, h + 1, norm(f(q + a * 0.5 * d))
+
+        def worse(c):
+            a, h, n = c
+            return (n > (1.0 - 1e-4 * a) * n0) & (h < NEWTON_HALVINGS)
+
+        a, _, _ = jax.lax.while_loop(worse, shorter, (jnp.ones(()), 0, norm(f(q + d))))
+        q_new = q + a * d
+        return k + 1, q_new, f(q_new)
+
+    def going(carry):
+        k, _, g = carry
+        return (k < NEWTON_STEPS) & ~(jnp.max(jnp.abs(g)) < NEWTON_TOL * scale)
+
+    return jax.lax.while_loop(going, step, (0, q, f(q)))[1]
 
 
 def _tangent(g, y):
@@ -236,12 +344,17 @@ def responses(pb: Problem, values) -> Response:
     model, static = _set(pb.model, pb.static, pb.targets, values)
     moves = any(t.moves for group in pb.targets for t in group)
     if moves:
-        q0 = jax.lax.custom_root(lambda q: _static_jet(model, static, pb.mems, q).Q, pb.q0,
-                                 _newton, _tangent)
+        zero = jnp.zeros_like(pb.q0)
+        scale = _force_scale(model, _static_jet(model, static, pb.mems, pb.q0).weights)
+        q0 = jax.lax.custom_root(lambda q: _static_parts(model, static, pb.mems, q, zero)[0],
+                                 pb.q0, lambda f, q: _newton(f, q, scale), _tangent)
     else:
         q0 = pb.q0
     jet = _static_jet(model, static, pb.mems, q0)
-    M, K, C = jet.M, -jet.dQ_dq, -jet.dQ_dqd
+    residual = jnp.max(jnp.abs(jet.Q)) / _force_scale(model, jet.weights)
+    # the controller −k_c (q − q₀) adds k_c on K's diagonal and nothing to Q(q₀)
+    k_c = _control(pb, values) if pb.control is not None else 0.0
+    M, K, C = jet.M, -jet.dQ_dq + jnp.diag(k_c * jnp.ones(model.n_coordinates)), -jet.dQ_dqd
     H = static[pb.water].geometry.h_matrix(jet.kin)[0]                     # (6K, n)
     w = pb.omega[:, None, None]
     Z = (-w**2 * M[None] - 1j * w * C[None] + K[None]
@@ -287,7 +400,7 @@ def responses(pb: Problem, values) -> Response:
     weights = pb.weights / jnp.sum(pb.weights)
     tension, tension_rms = _tensions(static, pb.lines, jet.kin, x, half_a2)
     return Response(power, q_rms, _safe_sqrt(stroke_var), jnp.abs(c)[None] * _safe_sqrt(rate_var),
-                    weights, values, q0, c_eq, change, tension, tension_rms)
+                    weights, values, q0, c_eq, change, tension, tension_rms, residual)
 
 
 def _tensions(static, lines, kin, x, half_a2):

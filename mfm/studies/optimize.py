@@ -12,7 +12,10 @@ pass per parameter (forward) or per output (reverse). The optimiser is SLSQP (sc
 parameters scaled to [0, 1] by their bounds, with the constraints as inequalities in every sea.
 The time domain confirms an optimum (``confirm=``): the optimised model stepped in the same seas
 (:func:`mfm.simulate_batch`; :func:`mfm.simulate` per sea for hydraulic pistons), its mean power
-against the spectral prediction.
+against the spectral prediction. The equilibrium q₀(θ) of every evaluated point must balance the
+loads to EQUILIBRIUM_TOL (1e-6) of the largest weight (:func:`mfm.studies.design._newton`, damped):
+a point without one raises :class:`~mfm.errors.OptimizeError` (``evaluate``: NaN there). From the
+command line: ``mfm optimize`` (:func:`mfm.io.cli.cmd_optimize`).
 """
 from __future__ import annotations
 
@@ -38,8 +41,9 @@ from ..loads.water import Water
 from ..mechanics.kinematics import kinematics
 from ..mechanics.model import Model
 from ..validation import check_model, check_seas
-from .design import (KINDS, Limit, Problem, Response, _constraint_values, _limits, _targets,  # noqa: F401
-                     _unknown, _value_of, apply, mean_power, responses, tunable_parameters)
+from .design import (EQUILIBRIUM_TOL, KINDS, Limit, Problem, Response,  # noqa: F401
+                     _constraint_values, _limits, _targets, _unknown, _value_of, apply, mean_power,
+                     responses, tunable_parameters)
 
 TRACES = {"outputs": 0}      # how often the objective was traced (tests: one per structure)
 
@@ -181,7 +185,8 @@ def _setup(model, seas, parameters, objective, constraints, weights, loads, radi
                  jnp.asarray(Zb), jnp.asarray(X), jnp.asarray(drag), jnp.asarray(w),
                  tuple(grp for _, grp, *_ in params), joint,
                  hydraulic[0] if hydraulic else -1, water_index,
-                 int(drag_iterations) if np.any(drag > 0) else 0, lines)
+                 int(drag_iterations) if np.any(drag > 0) else 0, lines,
+                 control=jnp.zeros(model.n_coordinates))
 
     labels = [p[0] for p in params]
     lower = np.array([p[2] for p in params])
@@ -195,6 +200,23 @@ def _setup(model, seas, parameters, objective, constraints, weights, loads, radi
                            params=params, pb=pb, pto_names=pto_names, limits=limits, spec=spec,
                            labels=labels, lower=lower, upper=upper, baseline=baseline,
                            forward=forward, lo_j=lo_j, hi_j=hi_j, lim_j=lim_j)
+
+
+def _check_equilibrium(P, r, values, last_good):
+    """Raise :class:`OptimizeError` when the equilibrium Newton of :func:`mfm.studies.design.
+    responses` stopped with max|Q(q₀)| above EQUILIBRIUM_TOL of the force scale: the response
+    there would be the linearisation about a point that is no equilibrium."""
+    res = float(r.equilibrium_residual)
+    if res <= EQUILIBRIUM_TOL:        # NaN fails this too
+        return
+    q0 = dict(zip(P.model.coordinates, np.round(np.asarray(r.q0, dtype=float), 6).tolist()))
+    raise OptimizeError(
+        f"optimize: no static equilibrium at {values}: the damped Newton stopped at max|Q(q0)| = "
+        f"{res:.3g} of the largest weight (accepted: <= {EQUILIBRIUM_TOL:g}), at q0 = {q0}. A mass "
+        "its buoyancy cannot carry sinks, a centre of mass too high or a negative stiffness past "
+        "the restoring capsizes, a mooring or joint stiffness out of range leaves no balance: "
+        "narrow the bounds of the parameters that move the equilibrium (stiffness, mass, kappa, "
+        f"mooring k). The last point with an equilibrium was {last_good}.", last_good=last_good)
 
 
 def _run(P, u, scale):
@@ -213,7 +235,9 @@ def optimize(model: Model, seas, parameters: dict, *, objective: Callable | str 
     level (the equations of :mod:`mfm.studies.design`), optionally confirmed in the time domain.
 
     parameters: dict name → (lower, upper), names of :func:`tunable_parameters` (e.g.
-        ``"float3.angle.damping"``, ``"float.stroke.stiffness"`` (negative: reactive control),
+        ``"float3.angle.damping"``, ``"float.stroke.control_stiffness"`` (a controller's spring
+        about the equilibrium; negative: reactive control), ``"float.stroke.stiffness"`` (the
+        joint spring about the config's rest: it moves the equilibrium),
         ``"pto.beta"``, ``"platform.mass"``, ``"mooring0.kx"``); a tuple of names as the key is
         one value shared by them (one damping for every WEC).
     seas: a sea state of :mod:`hydro.waves` or a sequence; ``weights`` (S,) ≥ 0 their weights
@@ -271,10 +295,16 @@ def optimize(model: Model, seas, parameters: dict, *, objective: Callable | str 
 
     u_base = to_u(baseline)
     base_out, _, r_base = run(u_base, 1.0)
+    _check_equilibrium(P, r_base, point(u_base), None)
     if not np.all(np.isfinite(base_out)):
         raise OptimizeError(f"optimize: the objective or constraints are not finite at the model's "
                             f"own values {point(u_base)}: {base_out.tolist()}", last_good=None)
-    scale = max(abs(float(base_out[0])), 1e-300)
+    # the objective is scaled by its size for SLSQP (its tolerances are absolute); a model with
+    # no damping absorbs nothing at its own values, so then the size at the middle of the bounds
+    scale = abs(float(base_out[0]))
+    if not scale > 0:
+        mid = run(np.full(len(params), 0.5), 1.0)[0][0]
+        scale = abs(float(mid)) if np.isfinite(mid) and mid != 0 else 1.0
     cache = {}
     last_good = {"u": u_base}      # finite: checked above
 
@@ -284,6 +314,7 @@ def optimize(model: Model, seas, parameters: dict, *, objective: Callable | str 
         key = np.asarray(u).tobytes()
         if key not in cache:
             out, J, r = run(u, scale)
+            _check_equilibrium(P, r, point(u), point(last_good["u"]))
             if not (np.all(np.isfinite(out)) and np.all(np.isfinite(J))):
                 good = point(last_good["u"])
                 raise OptimizeError(
@@ -358,7 +389,9 @@ def evaluate(model: Model, seas, points: dict, *, objective: Callable | str = "p
     of an optimum): ``points`` name (or tuple of names) → values (N,) (all of one length N).
 
     Returns dict: ``objective`` (N,), ``constraints`` (N, n_limits) their largest value over the
-    seas (m or rad), ``power`` (N, S, P) W, ``q_rms`` (N, S, n_q)."""
+    seas (m or rad), ``power`` (N, S, P) W, ``q_rms`` (N, S, n_q), ``equilibrium_residual`` (N,)
+    (max|Q(q₀)| over the force scale); at a point whose residual exceeds EQUILIBRIUM_TOL (no
+    equilibrium reached) every value is NaN, not the linearisation about a point that is none."""
     if not isinstance(points, dict) or not points:
         raise TypeError(f"points: {points!r}; give a dict name → values (N,)")
     arrays = {k: np.atleast_1d(np.asarray(v, dtype=float)) for k, v in points.items()}
@@ -371,15 +404,20 @@ def evaluate(model: Model, seas, points: dict, *, objective: Callable | str = "p
     P = _setup(model, seas, bounds, objective, constraints, weights, loads, radiation,
                state_space_options, drag_iterations, "auto")
     theta = np.stack([arrays[k] for k in points], axis=1)
-    objective_v, cons, power, q_rms = [], [], [], []
+    objective_v, cons, power, q_rms, residual = [], [], [], [], []
     for row in theta:
         out, _, r = _run(P, (row - P.lower) / (P.upper - P.lower), 1.0)
-        objective_v.append(out[0])
-        cons.append(np.asarray(_constraint_values(r, P.spec)).reshape(len(P.limits), P.S).max(axis=1))
-        power.append(r.power)
-        q_rms.append(r.q_rms)
+        res = float(r.equilibrium_residual)
+        bad = np.nan if not res <= EQUILIBRIUM_TOL else 1.0      # NaN × a value: no equilibrium
+        objective_v.append(out[0] * bad)
+        cons.append(np.asarray(_constraint_values(r, P.spec)).reshape(len(P.limits), P.S).max(axis=1)
+                    * bad)
+        power.append(r.power * bad)
+        q_rms.append(r.q_rms * bad)
+        residual.append(res)
     return {"objective": np.array(objective_v), "constraints": np.array(cons),
-            "power": np.array(power), "q_rms": np.array(q_rms)}
+            "power": np.array(power), "q_rms": np.array(q_rms),
+            "equilibrium_residual": np.array(residual)}
 
 
 def _confirm(model, seas, values, params, weights, r_opt, options):
