@@ -9,7 +9,8 @@ jax.config.update("jax_enable_x64", True)
 
 # sea states, spectra and excitation time series
 from hydro.waves import (  # noqa: E402,F401
-    Jonswap, MeasuredElevation, PiersonMoskowitz, Regular, Spreading, UserSpectrum, WaveComponents,
+    Jonswap, MeasuredElevation, PiersonMoskowitz, Regular, SeaStateWarning, Spreading, UserSpectrum,
+    WaveComponents,
     elevation, ramp, wavenumber,
 )
 from hydro.excitation import (  # noqa: E402,F401

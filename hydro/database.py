@@ -200,7 +200,9 @@ KNOWN_DATA_ISSUES = {
     "wu_yuan_m3.nc": {("radiation_damping", "wec6__Sway", "wec6__Roll"): 0.12},
     "wu_yuan_m4.nc": {("radiation_damping", "wec6__Sway", "wec6__Roll"): 0.12},
     "wu_yuan_m5.nc": {("radiation_damping", "wec3__Surge", "wec3__Pitch"): 0.12},
-    "wu_yuan_wec.nc": {("radiation_damping", "wec__Surge", "wec__Pitch"): 0.12},
+    # the lone WEC over its band (0.2-2.5 rad/s): the same WEC's coupling, largest at 1.8 rad/s
+    # against the band's damping peaks (0.0551; 0.022 at 1.257 rad/s)
+    "wu_yuan_wec.nc": {("radiation_damping", "wec__Surge", "wec__Pitch"): 0.06},
 }
 _SHIPPED = Path(__file__).resolve().parent / "data"
 _WARNED: set = set()          # (database, message): each warning once per database per process

@@ -181,6 +181,28 @@ def check_seas(seas) -> list:
     return seas
 
 
+def check_sea_in_grid(comps, sea, grid, what: str = "sea", *, rtol: float = 0.0):
+    """The components ``comps`` (a hydro.waves.WaveComponents) of ``sea`` inside the database's
+    frequency grid ``grid`` (rad/s, finite, ascending; an end within ``rtol`` of it counts as
+    inside, as hydro.excitation.GRID_RTOL), else a ValueError naming ``what``, the sea, how many
+    components and what fraction of its energy Σa² lie outside, and the fix. The frequency domain
+    needs a RAO at every component, and the database has none beyond its grid."""
+    w = np.asarray(comps.omega, dtype=float)
+    lo, hi = float(grid[0]), float(grid[-1])
+    out = (w < lo * (1.0 - rtol)) | (w > hi * (1.0 + rtol))
+    if not out.any():
+        return
+    e = np.asarray(comps.amplitude, dtype=float) ** 2
+    frac = float(e[out].sum() / e.sum()) if e.sum() > 0 else 1.0
+    raise ValueError(
+        f"{what}: {sea} has {int(out.sum())} of its {w.size} wave components (ω "
+        f"{w[out].min():.4g}–{w[out].max():.4g} rad/s, a fraction {frac:.3g} of its energy Σa²) "
+        f"outside the database's frequency grid [{lo:.6g}, {hi:.6g}] rad/s, where it has no "
+        f"coefficients; accepted: every component inside the grid. Give the sea "
+        f"omega_range=(ω_min, ω_max) inside [{lo:.6g}, {hi:.6g}], or regenerate the database over "
+        f"a wider band")
+
+
 def check_model(model, what: str = "model"):
     """``model`` is an :class:`mfm.Model`; else a TypeError that says what it got and how to make
     one (a config path given where its model is meant: ``mfm.load(path)`` first)."""

@@ -247,3 +247,88 @@ def test_a_body_renamed_against_its_database_is_refused(tmp_path):
     with pytest.raises(mfm.ConfigError, match=r"database bodies \['float8'\] are used by no config "
                                               r"body.*\['float8b'\].*renamed.*\[bodies.hydro\]"):
         mfm.load(renamed)
+
+
+# ---- a frequency grid that makes no sense for the question (issue 35 item 6) -------------------
+
+
+def test_a_sea_outside_the_database_is_refused_naming_the_sea(rm3):
+    """The frequency domain needs a RAO at each component: a sea with components beyond the
+    database's grid (RM3: 0.02–5.2 rad/s) is refused by spectral_response and spectral_sweep,
+    naming the sea (not an ``omega`` the caller never passed), the share of its energy outside and
+    the fix; the same sea cut to the grid runs."""
+    from mfm.frequency.spectral import spectral_sweep
+
+    wide = hydro.Jonswap(hs=2.0, tp=8.0, omega_range=(0.3, 8.0))
+    with pytest.raises(ValueError, match=r"^sea: JONSWAP Hs 2 m, Tp 8 s.* of its 200 wave "
+                                         r"components .* outside the database's frequency grid "
+                                         r"\[0\.02, 5\.2\] rad/s.*omega_range"):
+        mfm.spectral_response(rm3, wide)
+    with pytest.raises(ValueError, match=r"^seas\[1\]: JONSWAP Hs 2 m, Tp 8 s"):
+        spectral_sweep(rm3, [SEA, wide])
+    ok = spectral_sweep(rm3, [SEA, hydro.Jonswap(hs=2.0, tp=8.0, omega_range=(0.3, 5.0))])
+    assert np.all(np.isfinite(ok["q_rms"].values))
+
+
+def test_a_sea_band_that_drops_most_of_the_spectrum_warns():
+    """omega_range cutting most of a spectrum's energy leaves a sea far below the stated Hs:
+    a SeaStateWarning with the fraction kept. The fraction against scipy's adaptive quadrature
+    (an independent route); the default band and the cut bands the shipped studies use do not
+    warn (they keep >= 0.94)."""
+    import warnings
+
+    from scipy import integrate
+
+    cut = hydro.Jonswap(hs=2.0, tp=8.0, omega_range=(2.0, 3.0))
+    wp = 2 * np.pi / 8.0
+    ref = (integrate.quad(cut.spectrum, 2.0, 3.0, epsrel=1e-12)[0]
+           / sum(integrate.quad(cut.spectrum, a, b, epsrel=1e-12, limit=400)[0]
+                 for a, b in ((1e-3, wp), (wp, np.inf))))
+    # the trapezoid rule on 4001 geometric points against quad: measured 5e-7 relative; 1e-5
+    assert cut.band_energy_fraction() == pytest.approx(ref, rel=1e-5)
+    with pytest.warns(hydro.SeaStateWarning, match=r"omega_range=\(2, 3\) rad/s keeps a fraction "
+                                                   r"0\.0154 .*Hs = 0\.124 × the stated"):
+        c = cut.components()
+    # the discretised sea holds that fraction (200 bins over a smooth band: 1e-3)
+    assert np.sum(c.amplitude**2) / 2 == pytest.approx(ref * 2.0**2 / 16, rel=1e-3)
+    # a table cut to half its triangle keeps 0.5 exactly
+    tri = hydro.UserSpectrum(omega=[0.5, 1.0, 1.5], S=[0.0, 1.0, 0.0], omega_range=(1.0, 1.5))
+    assert tri.band_energy_fraction() == pytest.approx(0.5, rel=1e-12)
+    with pytest.warns(hydro.SeaStateWarning, match="keeps a fraction 0.5 "):
+        tri.components()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", hydro.SeaStateWarning)
+        for sea in (hydro.Jonswap(hs=2.0, tp=8.0), hydro.PiersonMoskowitz(hs=2.0, tp=8.0),
+                    *(hydro.Jonswap(hs=0.04, tp=tp, omega_range=(1.0, 25.0)) for tp in (0.8, 1.8)),
+                    *(hydro.Jonswap(hs=2.0, tp=tp, omega_range=(0.2, 2.0)) for tp in (8.0, 16.0)),
+                    hydro.Jonswap(hs=2.0, tp=7.0, omega_range=(0.35, 2.0))):
+            sea.components()
+
+
+@pytest.mark.parametrize("bem, match", [
+    ({"omega": [0.5, 1.0, 1.0, 2.0]}, r"hydro\.bem\.omega\[2\]: 1 rad/s repeats omega\[1\] = 1"),
+    ({"omega": [0.5, 2.0, 1.0]}, r"hydro\.bem\.omega\[2\]: 1 rad/s is below omega\[1\] = 2.*"
+                                 r"increasing order"),
+    ({"omega": [0.5, float("nan")]}, r"hydro\.bem\.omega\[1\]: nan is not a finite number"),
+    ({"omega": [0.0, 1.0]}, r"hydro\.bem\.omega\[0\]: 0\.0 must be > 0"),
+    ({"omega_min": 0.5, "omega_max": 2.0, "n_omega": 1},
+     r"hydro\.bem\.n_omega: 1 with omega_min = 0\.5 and omega_max = 2 rad/s solves omega_min only"),
+    ({"omega_min": 2.0, "omega_max": 0.5, "n_omega": 10}, r"hydro\.bem\.omega_max: 0\.5 must be > omega_min"),
+    ({"omega_min": 1.0, "omega_max": 1.0, "n_omega": 10}, r"hydro\.bem\.omega_max: 1\.0 must be > omega_min"),
+])
+def test_a_bem_frequency_list_that_is_a_typo_is_refused(bem, match):
+    """[hydro.bem] for `mfm hydro`: hydro.bem.solve sorts and de-duplicates its ω, so a repeat or a
+    step back in a hand-typed list, or n_omega = 1 under a band, would solve other frequencies than
+    the config shows; each is refused naming the key, the value and the fix."""
+    from mfm.io.bemgen import bem_settings
+
+    with pytest.raises(mfm.ConfigError, match=match):
+        bem_settings({"dx": 0.1, **bem})
+
+
+def test_a_one_frequency_bem_grid_stated_as_such_is_accepted():
+    from mfm.io.bemgen import bem_settings
+
+    one = bem_settings({"dx": 0.1, "omega_min": 0.8, "omega_max": 0.8, "n_omega": 1})
+    assert one["kwargs"]["omega"].tolist() == [0.8]
+    assert bem_settings({"dx": 0.1, "omega": [0.8]})["kwargs"]["omega"].tolist() == [0.8]

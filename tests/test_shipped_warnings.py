@@ -28,12 +28,10 @@ WET = sorted(p for p in [*CONFIGS.glob("*.toml"), *CONFIGS.glob("sensitivity/*.t
              if "[hydro]" in p.read_text())
 DT, N_STEPS = 0.01, 1000          # mfm simulate's defaults: --dt 0.01 --duration 10
 
-# ours, and rightly warned: the Wu & Yuan single-WEC database has the paper's 10 wave periods
-# (d omega 0.21 rad/s: K resolved to 15 s) for frequency-domain runs; a convolution's kernel
-# beyond 15 s changes its heave impedance by 0.118 of B_33 (tolerance 0.05). Left: a finer grid
-# (a BEM re-run of the WEC); until then its time-domain run warns, and this test asserts it does
-# (a fixed database fails the assertion below: then drop it here).
-RIGHTLY_WARNED = {"wu_yuan_wec.toml": "grid too coarse for a time-domain kernel (10 periods)"}
+# ours, and rightly warned: none. (The Wu & Yuan single-WEC database was here while it held only
+# the paper's 10 wave periods, d omega 0.21 rad/s; it now holds them among a 0.05 rad/s band,
+# hydro/data/README.md. A database put here must warn: the assertion below fails once it is fixed.)
+RIGHTLY_WARNED: dict[str, str] = {}
 
 
 @pytest.mark.slow            # ≈ 2–6 s a config on a shared 2-core machine (load and memory)

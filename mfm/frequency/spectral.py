@@ -29,7 +29,7 @@ import xarray as xr
 from .. import results
 from ..loads.pto import linear_ptos, mean_absorbed_power
 from ..mechanics.model import Model
-from ..validation import check_model, check_sea, check_seas
+from ..validation import check_model, check_sea, check_sea_in_grid, check_seas
 from .response import _amplitudes
 from .rest import linear_system
 
@@ -65,9 +65,22 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
         if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)):
             raise ValueError(f"t: shape {t.shape}; give a non-empty 1-D array of finite times (s)")
     # one sea is the one-case sweep (one place for the synthesis), relabelled over time
-    return results.spectral_one(spectral_sweep(model, [sea], t=t, q0=q0, loads=loads,
-                                               radiation=radiation,
-                                               state_space_options=state_space_options), sea, t)
+    return results.spectral_one(_sweep(model, [sea], ["sea"], t=t, q0=q0, loads=loads,
+                                       radiation=radiation,
+                                       state_space_options=state_space_options), sea, t)
+
+
+def _check_in_grid(model, seas, labels):
+    """The seas' components (one WaveComponents each), each checked to lie inside the model's
+    database grid (:func:`mfm.validation.check_sea_in_grid`, naming the sea by its label)."""
+    from hydro.excitation import GRID_RTOL
+
+    grid = np.asarray(model.hydro.database()["omega"].values, dtype=float)
+    grid = np.sort(grid[np.isfinite(grid)])
+    comps = [s.components(water_depth=model.hydro.water_depth, g=model.hydro.g) for s in seas]
+    for c, s, what in zip(comps, seas, labels):
+        check_sea_in_grid(c, s, grid, what, rtol=GRID_RTOL)
+    return comps
 
 
 def component_union(comps_list):
@@ -170,9 +183,16 @@ def spectral_sweep(model: Model, seas, *, t=None, q0=None, loads=None,
         raise ValueError(f"model {model.name!r} has no hydrodynamics: the spectral level needs a "
                          "config with a [hydro] table")
     seas = check_seas(seas)
+    return _sweep(model, seas, [f"seas[{i}]" for i in range(len(seas))], t=t, q0=q0, loads=loads,
+                  radiation=radiation, state_space_options=state_space_options, start=start)
+
+
+def _sweep(model, seas, labels, *, t, q0, loads, radiation, state_space_options, start=None):
+    """:func:`spectral_sweep` of checked ``seas``, each named by its label in errors."""
+    start = _time.perf_counter() if start is None else start
     B = len(seas)
     times = _times(t, B)
-    comps = [s.components(water_depth=model.hydro.water_depth, g=model.hydro.g) for s in seas]
+    comps = _check_in_grid(model, seas, labels)
     options = {"radiation": radiation, "state_space_options": state_space_options}
     sys = linear_system(model, q0, loads=loads)
     solve_start = _time.perf_counter()

@@ -139,6 +139,14 @@ def bem_settings(raw: dict | None, *, hydro: dict | None = None, gravity: float 
         if not isinstance(om, list) or not om:
             raise ConfigError(f"{w}.omega: {om!r} is not a non-empty list of frequencies (rad/s)")
         omega = np.array([_num(v, f"{w}.omega[{i}]") for i, v in enumerate(om)])
+        # a list typed by hand: a repeat or a step back is a typo (hydro.bem.solve would sort and
+        # de-duplicate it silently, solving fewer frequencies than the list shows)
+        for i in range(1, len(omega)):
+            if omega[i] <= omega[i - 1]:
+                what = "repeats" if omega[i] == omega[i - 1] else "is below"
+                raise ConfigError(f"{w}.omega[{i}]: {omega[i]:g} rad/s {what} omega[{i - 1}] = "
+                                  f"{omega[i - 1]:g}; accepted: strictly increasing frequencies "
+                                  f"(rad/s). Remove the repeat or put the list in increasing order")
     else:
         if len(grid) != 3:
             missing = sorted({"omega_min", "omega_max", "n_omega"} - set(grid))
@@ -149,6 +157,12 @@ def bem_settings(raw: dict | None, *, hydro: dict | None = None, gravity: float 
         n = _num(raw["n_omega"], f"{w}.n_omega", integer=True)
         if hi < lo or (n > 1 and hi == lo):
             raise ConfigError(f"{w}.omega_max: {hi} must be > omega_min ({lo})")
+        if n == 1 and hi != lo:
+            # linspace(lo, hi, 1) is [lo]: omega_max would be dropped without a word
+            raise ConfigError(f"{w}.n_omega: 1 with omega_min = {lo:g} and omega_max = {hi:g} "
+                              f"rad/s solves omega_min only; accepted: n_omega >= 2 for a grid "
+                              f"from omega_min to omega_max, or n_omega = 1 with omega_max = "
+                              f"omega_min (one frequency; or omega = [{lo:g}])")
         omega = np.linspace(lo, hi, n)
     hd = raw.get("headings_deg", [0.0])
     if isinstance(hd, numbers.Real) and not isinstance(hd, bool):

@@ -113,8 +113,8 @@ def wec_alone_power(H, periods=None, *, heading_deg: float = 0.0, model=None, q0
                     radiation: str = "database") -> xr.DataArray:
     """P_s^i: the mean power (W) of each of the 12 WECs operating alone (module docstring), in a
     regular wave of height ``H`` (m) and heading ``heading_deg`` (deg; the seed's 0: waves
-    travelling to +x) at the periods ``periods`` (s; default the seed's ten, those of the
-    database).
+    travelling to +x) at the periods ``periods`` (s; default the seed's ten, 2π/ω for the ten ω of
+    wu_yuan_layout.omega_list, which the database holds exactly among its band).
 
     P_s^i(T) = pto_power(ω = 2π/T, β − α_i) · (H/2)², pto_power from
     ``mfm.frequency_response(model, ω, β − α_i, radiation=radiation)`` (W per m² of amplitude).
@@ -133,8 +133,8 @@ def wec_alone_power(H, periods=None, *, heading_deg: float = 0.0, model=None, q0
     model = wec_alone_model() if model is None else model
     db = model.hydro.db
     if periods is None:
-        w = np.asarray(db["omega"].values, dtype=float)
-        omega = np.sort(w[np.isfinite(w)])[::-1]             # ascending period
+        # the seed's ten ω, exactly as the database holds them among its band (wu_yuan_layout)
+        omega = np.asarray(layout.omega_list(), dtype=float)[::-1]   # ascending period
     else:
         T = np.atleast_1d(np.asarray(periods, dtype=float))
         if T.ndim != 1 or T.size == 0 or not np.all(np.isfinite(T)) or np.any(T <= 0):

@@ -55,6 +55,10 @@ TD_BAND = (0.25, 3.0, 56)   # rad/s: the time domain's band database (omega_min,
 TD_STEP = (TD_BAND[1] - TD_BAND[0]) / (TD_BAND[2] - 1)
 TD_MODELS = (1,)            # the models with a time-domain twin (wu_yuan_m<m>_td.toml)
 WEC_HEADINGS = (-120.0, 0.0, 120.0)   # deg: the lone WEC's database (rows 2, 3, 1; see wec_config_text)
+# the lone WEC's band for the time domain (omega_min, omega_max, n) [D]: step 0.05 rad/s (widest
+# step left beside a seed period 0.059 rad/s: K(t) resolved to π/0.059 = 53 s; wec_omega_list);
+# up to 2.5 rad/s, below the hull's first irregular frequency (2.66 rad/s), as there is no lid
+WEC_BAND = (0.2, 2.5, 47)
 
 
 def panel_radius(r, dx):
@@ -153,7 +157,20 @@ def vec(v, nd=6):
 
 
 def omega_list():
+    """The seed's ten ω = 2π/T (rad/s, rounded to 1e-6, ascending): the frequency-domain databases'."""
     return sorted(round(2 * math.pi / T, 6) for T in PERIODS)
+
+
+def wec_omega_list():
+    """The lone WEC's ω (rad/s, ascending): the seed's ten (:func:`omega_list`, exactly) and the
+    band WEC_BAND, less each band point within a quarter step of a seed ω (so no two frequencies
+    are closer than that; the widest step is then at most 1.25 steps)."""
+    lo, hi, n = WEC_BAND
+    seed = omega_list()
+    step = (hi - lo) / (n - 1)
+    band = [round(lo + k * step, 6) for k in range(n)]
+    keep = [w for w in band if min(abs(w - s) for s in seed) > step / 4]
+    return sorted(seed + keep)
 
 
 def lines():
@@ -451,9 +468,12 @@ WEC_ALONE = """\
 #   those three headings.
 # BEM [D]: the WEC alone, its CoG at the origin (one body of revolution on the z axis: capytaine's
 #   rotation symmetry), reference point the CoG; the ten periods of the seed (T = 5, 6, 7, 8, 8.3,
-#   9, 10, 11, 11.4, 12 s) + ∞; depth 60 m, finite where kh < 5, deep water above and at ∞;
-#   ρ 1025, g 9.81; panels dx {dx_wec:g} m as in the platform configs; no lid (first irregular
-#   frequency 2.66 rad/s > 1.257), as in wu_yuan_m1..m5.nc.
+#   9, 10, 11, 11.4, 12 s, the frequency-domain study's) and a band for the time domain's
+#   radiation memory K(t): ω = {b_lo:g}–{b_hi:g} rad/s step {b_step:g} less the points within a
+#   quarter step of a seed period ({n_w} frequencies; widest step {dw_max:.3g} rad/s: K(t) resolved
+#   to π/Δω = {tk:.0f} s) + ∞; depth 60 m, finite where kh < 5, deep water above and at ∞; ρ 1025, g 9.81;
+#   panels dx {dx_wec:g} m as in the platform configs; no lid (first irregular frequency
+#   2.66 rad/s > {b_hi:g}), as in wu_yuan_m1..m5.nc.
 
 [model]
 name = "Wu-Yuan WEC alone"
@@ -465,12 +485,12 @@ database = "{database}"   # made by `mfm hydro configs/wu_yuan_wec.toml --thread
 rho = 1025.0                # kg/m³ [A]
 
 [hydro.bem]
-omega = {omega}   # rad/s: 2π/T, T = 12, 11.4, 11, 10, 9, 8.3, 8, 7, 6, 5 s [S]
+omega = {omega}   # rad/s: 2π/T, T = 12, 11.4, 11, 10, 9, 8.3, 8, 7, 6, 5 s [S], and the band (see above) [D]
 headings_deg = {headings}   # rows 2, 3, 1 (see above)
 water_depth = 60.0          # m [S]
 deep_water_kh = 5.0         # finite depth below kh = 5, deep water above [D]
 dx = {dx_wec}                    # m [D]
-lid = false                 # first irregular frequency 2.66 rad/s > 1.257
+lid = false                 # first irregular frequency 2.66 rad/s > {b_hi:g}
 symmetry = "auto"           # rotation (one body of revolution on the z axis)
 infinite_frequency = true
 
@@ -512,7 +532,10 @@ def wec_config_text(alpha_deg: float = 0.0, database: str = "../hydro/data/wu_yu
     r_wec, n_wec = panel_radius(R_WEC, DX_WEC)
     note = "" if alpha_deg == 0 else f", the arm turned by {alpha_deg:g}° about z"
     return WEC_ALONE.format(
-        n_wec=n_wec, r_wec=r_wec, pre=PRELOAD, dx_wec=DX_WEC, omega=vec(omega_list()),
+        n_wec=n_wec, r_wec=r_wec, pre=PRELOAD, dx_wec=DX_WEC, omega=vec(wec_omega_list()),
+        b_lo=WEC_BAND[0], b_hi=WEC_BAND[1], b_step=(WEC_BAND[1] - WEC_BAND[0]) / (WEC_BAND[2] - 1),
+        n_w=len(wec_omega_list()), dw_max=float(np.diff(wec_omega_list()).max()),
+        tk=math.pi / float(np.diff(wec_omega_list()).max()),
         headings="[" + ", ".join(f(h) for h in WEC_HEADINGS) + "]", database=database,
         inertia="[" + ", ".join(vec(r, 1) for r in I) + "]", axis=vec(axis, 9), point=vec(hinge),
         preload=f"{PRELOAD:.1f}", alpha_note=note)
