@@ -38,6 +38,7 @@ from ..frequency.rest import _static_functions, _static_jet, _static_parts, syst
 from ..loads.hydraulic_pto import HydraulicPTO
 from ..loads.mooring import PointSprings
 from ..mechanics.model import Model
+from ..results import coordinate_units
 from ..validation import check_model
 
 # kinds of tunable parameter: (where, field, what it is, units, whether it moves the equilibrium)
@@ -92,11 +93,16 @@ def _targets(model, lds):
     :func:`mfm.frequency.rest._static_functions`), and that static tuple."""
     _, static, _ = _static_functions(model, lds)
     out = {}
+    units_of = coordinate_units(model)
     for k, c in enumerate(model.coordinates):
+        # the coordinate's own units: a hinge's N m s/rad, a slider's N s/m
+        rotation = units_of[k] == "rad"
         for f in ("damping", "stiffness"):
             what, units, moves = _MODEL_KINDS[f]
-            out[f"{c}.{f}"] = (Target("model", f, k, moves=moves), what, units)
-        out[f"{c}.{_CONTROL[0]}"] = (Target("control", _CONTROL[0], k), *_CONTROL[1:])
+            out[f"{c}.{f}"] = (Target("model", f, k, moves=moves), what,
+                               units.split(" or ")[0 if rotation else 1])
+        out[f"{c}.{_CONTROL[0]}"] = (Target("control", _CONTROL[0], k), _CONTROL[1],
+                                     _CONTROL[2].split(" or ")[0 if rotation else 1])
     for i, b in enumerate(model.body_names):
         what, units, moves = _MODEL_KINDS["mass"]
         out[f"{b}.mass"] = (Target("model", "mass", i, moves=moves), what, units)
