@@ -98,10 +98,7 @@ def rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_ev
     if deferred(carry, recording):
         # the initial sample's outputs in the same pass as the others': one copy of the outputs'
         # program to compile, not two (M4 134: ~4 s of a first call)
-        _, carries = rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every,
-                                    recording, keep_carries=True)
-        stacked = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), carry, carries)
-        return outputs_after(model, loads, stacked)
+        return _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every)[1]
     first = saved(model, loads, *carry, recording)
     _, traj = rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, recording)
     return jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), first, traj)
@@ -118,18 +115,24 @@ def _chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every, recor
     return rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, recording)
 
 
-def _headed_chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every):
-    """A chunk of a recorded run whose outputs are deferred (:func:`deferred`): the outputs of
-    the incoming carry and of the chunk's ``n_blocks`` saved carries, in one pass
-    (:func:`outputs_after`; each sample by the same vmapped program, so the same bits as the
-    run in one call). The host keeps the head of the first chunk only (the run's initial sample):
-    the start then needs no outputs program of its own, and a first run compiles one copy of the
-    outputs instead of two (RM3: the start's 4.7 of 14 s of compilation, cold)."""
-    TRACES["rollout_chunk"] += 1
+def _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every):
+    """``n_blocks`` blocks of a recorded run whose outputs are deferred (:func:`deferred`): the
+    last carry, and the outputs of the incoming carry (the head) and of the blocks' saved
+    carries in one pass (:func:`outputs_after`: each sample by the same vmapped program, so a
+    run in one call and in chunks give the same bits)."""
     carry_out, carries = rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every,
                                         EVERY, keep_carries=True)
     stacked = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), carry, carries)
     return carry_out, outputs_after(model, loads, stacked)
+
+
+def _headed_chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every):
+    """A chunk of a recorded run whose outputs are deferred (:func:`_blocks_with_head`). The
+    host keeps the head of the first chunk only (the run's initial sample): the start then needs
+    no outputs program of its own, and a first run compiles one copy of the outputs instead of
+    two (RM3: the start's 4.7 of 14 s of compilation, cold)."""
+    TRACES["rollout_chunk"] += 1
+    return _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every)
 
 
 _start_jit = jax.jit(rollout_start, static_argnames=("integrator", "recording"))
@@ -181,13 +184,6 @@ def rollout_call(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, 
             jnp.asarray(dt, jnp.float64))
     return args, dict(n_steps=int(n_steps), integrator=integ, save_every=int(save_every),
                       record=Recording.of(record))
-
-
-def rollout_progress(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0, bar):
-    """:func:`rollout` (``record=True``) in chunks with a progress bar: numpy outputs, the same
-    values; it stops early once the state is non-finite."""
-    return prepare_progress(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integrator,
-                            loads=loads, save_every=save_every, t0=t0)(bar)
 
 
 def _strong(tree):

@@ -21,8 +21,7 @@ from .batch import simulate_batch  # noqa: F401  (exported)
 from .checks import (nonfinite_message, refuse_impossible, warn_accuracy, warn_stability,
                      warn_verlet_drift)
 from .progress import phase, progress_bar, progress_options
-from .rollout import (prepare_progress, rollout, rollout_call, rollout_jit,  # noqa: F401
-                      rollout_progress)
+from .rollout import prepare_progress, rollout, rollout_call, rollout_jit  # noqa: F401
 from .setup import choose_radiation, model_loads, stage_offsets
 
 
