@@ -146,36 +146,43 @@ def _read(path: Path):
             pass
 
 
+def write_whole(path: Path, write) -> None:
+    """Write a cache file whole or not at all: ``write(f)`` into a file beside ``path`` (its
+    folder made), then renamed onto it (another process may read it now); the aside file is
+    removed if anything fails, and the error raised."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            write(f)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
 def _write(folder: Path, path: Path, fit) -> None:
     global _warned
-    tmp = None
     try:
-        folder.mkdir(parents=True, exist_ok=True)
-        # a whole file or none: written aside, then renamed (another process may read it now)
-        fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
-        with os.fdopen(fd, "wb") as f:
-            pickle.dump(_to_plain(fit), f, protocol=pickle.HIGHEST_PROTOCOL)
-        os.replace(tmp, path)
-        tmp = None
-        _trim(folder)
+        write_whole(path, lambda f: pickle.dump(_to_plain(fit), f,
+                                                protocol=pickle.HIGHEST_PROTOCOL))
+        trim(folder)
     except Exception as e:            # the cache is a shortcut: never the reason a run fails
         if not _warned:
             warnings.warn(f"the state-space fit cache {folder} cannot be written ({e}); fits are "
                           "kept in this process only. Set MFM_FIT_CACHE to a writable folder, or "
                           "to off", RuntimeWarning, stacklevel=4)
             _warned = True
-    finally:
-        if tmp is not None:
-            try:
-                os.unlink(tmp)
-            except OSError:
-                pass
 
 
-def _trim(folder: Path, limit: int = CACHE_BYTES) -> None:
-    """Drop the least recently used fits until the folder holds at most ``limit`` bytes."""
+def trim(folder: Path, limit: int = CACHE_BYTES, pattern: str = "*.pkl") -> None:
+    """Drop the least recently used files matching ``pattern`` (the fits by default) until they
+    hold at most ``limit`` bytes."""
     files = []
-    for p in folder.glob("*.pkl"):
+    for p in folder.glob(pattern):
         try:
             st = p.stat()
         except OSError:

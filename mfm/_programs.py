@@ -32,12 +32,13 @@ import hashlib
 import os
 import pickle
 import sys
-import tempfile
 import threading
 from pathlib import Path
 
 import jax
 import numpy as np
+
+from hydro import fitcache
 
 from . import _xla
 
@@ -124,7 +125,6 @@ def _treedef(td, out: list) -> None:
         return
     data = td.node_data()
     if data is None:
-        out.append("node?")
         raise _Unkeyable("a pytree node without data")
     kind, aux = data
     out.append(f"<{_type_name(kind)}")
@@ -153,17 +153,10 @@ def _source_hash() -> str:
     if _SOURCE is None:
         h = hashlib.sha256()
         here = Path(__file__).resolve().parent
-        roots = [here]
-        try:
-            import hydro
-
-            roots.append(Path(hydro.__file__).resolve().parent)
-        except ImportError:
-            pass
-        for root in roots:
+        for root in (here, Path(fitcache.__file__).resolve().parent):    # mfm/, hydro/
             files = [p for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts
-                     and (p.suffix == ".py" or "data" in p.relative_to(root).parts[:1]
-                          and root == here)]
+                     and (p.suffix == ".py"
+                          or root == here and p.relative_to(root).parts[0] == "data")]
             for p in sorted(files):
                 h.update(str(p.relative_to(root.parent)).encode())
                 h.update(p.read_bytes())
@@ -209,11 +202,7 @@ def key(name: str, args: tuple, static: dict) -> str:
     for k in sorted(static):
         out.append(k)
         _fingerprint(static[k], out)
-    text = "\n".join(out)
-    if os.environ.get("MFM_PROGRAM_KEYS"):
-        k = hashlib.sha256(text.encode()).hexdigest()
-        Path(os.environ["MFM_PROGRAM_KEYS"], f"{name}-{os.getpid()}-{k[:8]}.txt").write_text(text)
-    return hashlib.sha256(text.encode()).hexdigest()
+    return hashlib.sha256("\n".join(out).encode()).hexdigest()
 
 
 _MADE: dict = {}
@@ -332,20 +321,7 @@ def _save(path: Path, exported, out_tree) -> None:
     tree = pickle.dumps(out_tree)
     pickle.loads(tree)                 # a structure that does not come back is not saved
     blob = len(tree).to_bytes(8, "little") + tree + bytes(exported.serialize())
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-    with os.fdopen(fd, "wb") as f:
-        f.write(blob)
-    os.replace(tmp, path)              # whole or absent, whatever another process does
-    _trim(path.parent)
-
-
-def _trim(where: Path) -> None:
-    """Drop the least recently used files past :data:`FOLDER_BYTES`."""
-    files = sorted(where.glob("*.bin"), key=lambda p: p.stat().st_mtime)
-    total = sum(p.stat().st_size for p in files)
-    for p in files:
-        if total <= FOLDER_BYTES:
-            break
-        total -= p.stat().st_size
-        p.unlink(missing_ok=True)
+    # whole or absent, whatever another process does; the least recently used dropped past
+    # FOLDER_BYTES (the fit cache's two helpers)
+    fitcache.write_whole(path, lambda f: f.write(blob))
+    fitcache.trim(path.parent, FOLDER_BYTES, "*.bin")

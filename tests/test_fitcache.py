@@ -126,7 +126,7 @@ def test_the_folder_is_trimmed_least_recently_used_first(tmp_path):
         p.write_bytes(b"x" * 100)
         os.utime(p, (1000 + k, 1000 + k))
     (tmp_path / "other.txt").write_bytes(b"x" * 1000)     # not a fit: left alone
-    FC._trim(tmp_path, limit=250)
+    FC.trim(tmp_path, limit=250)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["middle.pkl", "new.pkl", "other.txt"]
 
 
