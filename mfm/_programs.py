@@ -241,6 +241,11 @@ class Program:
         self._lower = lambda *a: jitted.lower(*a, **static)
         self._tree = jax.tree_util.tree_structure(args)
         self._call = None
+        # what compile() made, and for which arguments: called directly while they match (a
+        # jit called afterwards with concrete arrays lowers them anew, with other sharding
+        # annotations than the abstract ones compile() saw, and compiles the program again: RM3's
+        # chunk, 5 s of a cold first run)
+        self._compiled = None
         if path is None:
             return
         try:
@@ -269,9 +274,14 @@ class Program:
         return leaves
 
     def __call__(self, *args):
-        if self._call is None:
+        compiled = self._compiled
+        if compiled is not None and _signature(args) == compiled[0]:
+            out = compiled[1](*(args if self._call is None else self._flat(args)))
+        elif self._call is None:
             return self._ordinary(*args)
-        return jax.tree_util.tree_unflatten(self._out_tree, self._call(*self._flat(args)))
+        else:
+            out = self._call(*self._flat(args))
+        return out if self._call is None else jax.tree_util.tree_unflatten(self._out_tree, out)
 
     def shapes(self, *args):
         """The outputs' structure, shapes and dtypes (ShapeDtypeStructs) for arguments like
@@ -283,11 +293,22 @@ class Program:
             for a in self._exported.out_avals])
 
     def compile(self, *args) -> None:
-        """Compile for arguments like ``args`` (arrays or ShapeDtypeStructs), here and now."""
+        """Compile for arguments like ``args`` (arrays or ShapeDtypeStructs), here and now; a
+        later call with arguments of the same structure, shapes, dtypes and weak types runs
+        that executable."""
         if self._call is None:
-            self._lower(*args).compile()
+            compiled = self._lower(*args).compile()
         else:
-            self._call.lower(*self._flat(args)).compile()
+            compiled = self._call.lower(*self._flat(args)).compile()
+        self._compiled = (_signature(args), compiled)
+
+
+def _signature(args) -> tuple:
+    """What an executable compiled for ``args`` requires of the arguments it is called with:
+    their structure (static data included) and each leaf's shape, dtype and weak type."""
+    leaves, tree = jax.tree_util.tree_flatten(args)
+    return tree, tuple((np.shape(x), np.dtype(getattr(x, "dtype", type(x))),
+                        bool(getattr(x, "weak_type", False))) for x in leaves)
 
 
 def _export(jitted, args, static, tree):

@@ -215,3 +215,51 @@ def test_a_disabled_bar_is_no_bar():
     kw = dict(duration=0.3, dt=0.01, q0={"upper.angle": 0.4})
     np.testing.assert_array_equal(mfm.simulate(m, progress={"disable": True}, **kw).q.values,
                                   mfm.simulate(m, **kw).q.values)
+
+
+@pytest.mark.parametrize("kept", [True, False], ids=["saved program", "ordinary path"])
+def test_a_compiled_program_is_not_compiled_again_when_called(monkeypatch, tmp_path, kept):
+    """compile() from shapes (as a run compiles its chunk on another thread), then a call with
+    arrays of those shapes (committed to the device, as a program's outputs are) runs that
+    executable: XLA compiles once (counted by jax's events, not timed). The call used to lower
+    the concrete arrays anew, with other sharding annotations, and compile again."""
+    _fresh(monkeypatch, tmp_path)
+    if not kept:
+        monkeypatch.setattr(_programs, "folder", lambda: None)
+    scale = 3.0 if kept else 5.0          # a program of each case's own, compiled nowhere else
+
+    @jax.jit
+    def fn(p, x):
+        return {"y": p["a"] @ x + scale * p["b"]}
+
+    rng = np.random.default_rng(2)
+    put = lambda a: jax.device_put(a, jax.devices()[0])       # noqa: E731  (committed)
+    p = {"a": put(rng.normal(size=(7, 7))), "b": put(rng.normal(size=7))}
+    x = put(rng.normal(size=7))
+    shapes = jax.tree_util.tree_map(lambda a: jax.ShapeDtypeStruct(a.shape, a.dtype), (p, x))
+    compiles = []   # XLA compilations, or the persistent cache's answers in their stead
+
+    def listen(event, duration, **_):
+        if event == "/jax/core/compile/backend_compile_duration":
+            compiles.append(event)
+
+    def hit(event, **_):
+        if event == "/jax/compilation_cache/cache_hits":
+            compiles.append(event)
+
+    jax.monitoring.register_event_duration_secs_listener(listen)
+    jax.monitoring.register_event_listener(hit)
+    try:
+        made = _programs.program(fn, "affine7", shapes)
+        made.compile(*shapes)
+        assert len(compiles) == 1
+        got = made(p, x)
+        assert len(compiles) == 1, "the call compiled the program again"
+    finally:
+        jax.monitoring.unregister_event_duration_listener(listen)
+        jax.monitoring.unregister_event_listener(hit)
+    np.testing.assert_array_equal(got["y"], fn(p, x)["y"])
+    if not kept:
+        # arguments of other shapes: the jit's own path, which compiles for them
+        small = ({"a": p["a"][:3, :3], "b": p["b"][:3]}, x[:3])
+        np.testing.assert_array_equal(made(*small)["y"], fn(*small)["y"])
