@@ -53,10 +53,11 @@ def _run(argv, env, cwd):
 
 
 def _phases(stderr: str) -> list[str]:
-    """The distinct phase descriptions of a tqdm bar's lines (carriage returns split them)."""
+    """The distinct phases a tqdm bar's lines said (carriage returns split them): the text after
+    its rate in the bracket ("[00:05<?, ?step/s, compiling]"), the steps' own counts left out."""
     seen = []
     for part in re.split(r"[\r\n]", stderr):
-        m = re.match(r"\s*([^:|]{3,80}?):\s+\d+%", part)
+        m = re.search(r"\|\s*\d+/\d+ \[[^,\]]*, [^,\]]*/s, ([^\]]+)\]", part)
         if m and m.group(1).strip() not in seen:
             seen.append(m.group(1).strip())
     return seen
