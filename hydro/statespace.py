@@ -396,7 +396,9 @@ def _enforce_passivity_common(poles, C, keys, nk, s_fit, w_fit, w_max, max_iter=
         elif it - best[2] >= 10:
             return best[1], it
         lift = np.maximum(rel * scale[:, None] - lam, 0.0)               # (n_g, nk)
-        dH = np.einsum("kia,ka,kja->kij", V, lift, V)
+        # V diag(lift) Vᵀ per grid point as a batched product (BLAS): numpy's einsum of the
+        # three operands loops in C without it, 8x slower at Wu & Yuan's 90 dofs
+        dH = (V * lift[:, None, :]) @ V.transpose(0, 2, 1)
         Cc = Cc + solve_triangular(Rm, Qg.T @ (dH[:, I, J] * gw[:, None])) / sc[:, None]
     return best[1], max_iter
 
