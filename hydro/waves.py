@@ -488,8 +488,12 @@ class _SpectralSea:
         """∫ S dω over :attr:`band` / ∫₀^∞ S dω: the fraction of the spectrum's variance that the
         discretisation keeps (the sea's Hs is √ of it times the stated one)."""
         lo, hi = self.band
-        total = self._variance(0.0, math.inf)
+        total = self._total_variance()
         return self._variance(lo, hi) / total if total > 0.0 else 1.0
+
+    def _total_variance(self) -> float:
+        """∫₀^∞ S dω (m²): by quadrature here; where it is Hs²/16 by construction, that."""
+        return self._variance(0.0, math.inf)
 
     def _variance(self, lo: float, hi: float) -> float:
         """∫_lo^hi S dω (m²) of a peaked spectrum: the trapezoid rule on 4001 points spaced
@@ -625,6 +629,10 @@ class Jonswap(_PeakSea):
         self._check_common()
         object.__setattr__(self, "_a_gamma", jonswap_normalisation(gamma, self.normalisation))
 
+    def _total_variance(self) -> float:
+        # A_γ is made so (to scipy quad's 1e-12), so a batch of seas skips one quadrature each
+        return self.hs**2 / 16.0 if self.normalisation == "exact" else super()._total_variance()
+
     def spectrum(self, omega) -> np.ndarray:
         """S(ω) in m² s/rad for ω in rad/s (any shape; 0 for ω <= 0)."""
         w = np.asarray(omega, dtype=np.float64)
@@ -640,6 +648,9 @@ class PiersonMoskowitz(_PeakSea):
     def __post_init__(self):
         self._check_hs_tp()
         self._check_common()
+
+    def _total_variance(self) -> float:
+        return self.hs**2 / 16.0
 
     def spectrum(self, omega) -> np.ndarray:
         """S(ω) in m² s/rad for ω in rad/s (any shape; 0 for ω <= 0)."""
