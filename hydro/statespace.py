@@ -36,8 +36,6 @@ from types import MappingProxyType
 
 import numpy as np
 import xarray as xr
-from scipy.linalg import solve_triangular
-from scipy.optimize import nnls
 
 from .radiation import filon_weights, impulse_response, impulse_response_transform, memory_length
 
@@ -303,6 +301,9 @@ def _enforce_passivity(fits, done, nd, dpk, dof_ok, s_fit, w_fit, w_max, max_ite
             Ms, ds = M / sc[:, None], delta / sc
             Gm = Ms @ Ms.T
             L = np.linalg.cholesky(Gm + 1e-12 * np.trace(Gm) / len(Gm) * np.eye(len(Gm)))
+            from scipy.linalg import solve_triangular
+            from scipy.optimize import nnls     # here: scipy.optimize is ~0.4 s of importing mfm
+
             mu, _ = nnls(L.T, solve_triangular(L, ds, lower=True), maxiter=50 * len(Gm))
             y = Ms.T @ mu
             if np.min(Ms @ y - ds) < -1e-6 * max(1.0, float(np.abs(ds).max())):
@@ -362,6 +363,8 @@ def _enforce_passivity_common(poles, C, keys, nk, s_fit, w_fit, w_max, max_iter=
     (data too sparse for the order, e.g. a 10-frequency database: the fit swings between its
     points) or after ``max_iter``, it returns the iterate of largest min λ.
     """
+    from scipy.linalg import solve_triangular
+
     grid = _passivity_grid(w_max)
     Pg = _basis(1j * grid, poles).real                                   # (n_g, n_c)
     Pf = _basis(s_fit, poles) * w_fit[:, None]
