@@ -644,3 +644,36 @@ def test_moordyn_slow_limit_is_the_quasi_static_line(lines):
           f"local tension (up to {T_max / 1e3:.0f} kN)")
     assert T_max > 1.5 * math.hypot(*catenary_forces(X0, Z0, L, EA, W))     # it did pull
     assert worst < 0.03
+
+
+def test_tables_are_kept_on_disk_and_read_back_bit_for_bit(monkeypatch, tmp_path):
+    """A table made once is read back by a later process (here: the process's table forgotten)
+    without MoorPy, the same bits; another line, or the cache off, makes its own."""
+    from mfm.loads import catenary
+
+    monkeypatch.setenv("MFM_FIT_CACHE", str(tmp_path))
+    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})
+    calls = []
+    real = catenary.catenary_forces
+    monkeypatch.setattr(catenary, "catenary_forces", lambda *a: calls.append(a) or real(*a))
+    args = (775.5, 75.0, (2.0, 1.0), (1.0, 1.0), 800.0, 1.243e9, 2972.43, 0.0)
+    made = catenary.build_table(*args)
+    n = len(calls)
+    assert n == 5 * 4 and len(list((tmp_path / "mooring-tables").glob("*.npz"))) == 1
+    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})          # as a new process finds it
+    again = catenary.build_table(*args)
+    assert len(calls) == n                                     # MoorPy not called
+    for a, b in zip(made, again):
+        np.testing.assert_array_equal(a, b)
+    catenary.build_table(*args[:4], 801.0, *args[5:])          # another length: its own table
+    assert len(calls) == 2 * n and len(list((tmp_path / "mooring-tables").glob("*.npz"))) == 2
+    # a damaged file is made again
+    for p in (tmp_path / "mooring-tables").glob("*.npz"):
+        p.write_bytes(b"not a table")
+    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})
+    np.testing.assert_array_equal(catenary.build_table(*args)[2], made[2])
+    assert len(calls) == 3 * n
+    monkeypatch.setenv("MFM_FIT_CACHE", "off")
+    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})
+    catenary.build_table(*args)
+    assert len(calls) == 4 * n

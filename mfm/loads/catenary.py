@@ -32,7 +32,11 @@ Yuan line its error is at most 3.2e-4 of the local tension anywhere in it (at th
 where H → 0) and 1.8e-5 of the rest tension within ±20 m × ±10 m, and its derivative (the
 stiffness) agrees with a finite difference of MoorPy within 6e-5 there, 4e-6 at rest
 (``tests/test_catenary.py``); refine ``table_step`` for more. Tables are cached by their
-parameters (six lines of one geometry cost one table: ~2,500 MoorPy calls, 3–5 s).
+parameters (six lines of one geometry cost one table: ~2,500 MoorPy calls, 3–5 s), in the process
+and on disk beside the radiation fits (:mod:`hydro.fitcache`'s folder, ``mooring-tables``; off
+with ``MFM_FIT_CACHE=off``), named by the sha256 of the parameters, this module's source and the
+MoorPy, numpy and scipy versions: a later process reads Wu & Yuan's tables (11 s of its
+``mfm.load`` on 2 cores) back, the same to the last bit.
 
 Outside the table nothing is clipped or extrapolated: the force is NaN, so a run that takes a
 fairlead out stops as non-finite and :meth:`CatenaryLines.describe_nonfinite` names the line, its
@@ -116,6 +120,11 @@ def build_table(x0, z0, extent, step, length, EA, weight, seabed_friction):
                                              seabed_friction))
     if key in _TABLE_CACHE:
         return _TABLE_CACHE[key]
+    path = _table_file(key)
+    table = _read_table(path)
+    if table is not None:
+        _TABLE_CACHE[key] = table
+        return table
     xs, zs = _axis(x0, extent[0], step[0]), _axis(z0, extent[1], step[1])
     F = np.array([[catenary_forces(x, z, length, EA, weight, seabed_friction) for z in zs]
                   for x in xs])                                     # (nx, nz, 2)
@@ -125,7 +134,62 @@ def build_table(x0, z0, extent, step, length, EA, weight, seabed_friction):
     hx, hz = xs[1] - xs[0], zs[1] - zs[0]
     coef = np.stack([F, hx * Fx, hz * Fz, hx * hz * Fxz], axis=2)
     _TABLE_CACHE[key] = (xs, zs, coef)
+    _write_table(path, (xs, zs, coef))
     return xs, zs, coef
+
+
+# the most the tables' folder may hold (Wu & Yuan's table: 81 × 31 × 4 × 2 doubles, 160 kB)
+TABLES_BYTES = 64 * 2**20
+
+
+def _table_file(key):
+    """The disk cache's file of the table ``key`` (None when the fit cache is off): named by
+    the sha256 of the key, this module's source and the versions that make its numbers."""
+    import hashlib
+    from importlib.metadata import version
+    from pathlib import Path
+
+    from hydro import fitcache
+
+    folder = fitcache.cache_dir()
+    if folder is None:
+        return None
+    h = hashlib.sha256(repr((key, MOORPY_TOL)).encode())
+    h.update(Path(__file__).read_bytes())
+    for package in ("moorpy", "numpy", "scipy"):
+        h.update(f"{package} {version(package)}".encode())
+    return folder / "mooring-tables" / f"{h.hexdigest()}.npz"
+
+
+def _read_table(path):
+    """(xs, zs, coef) from ``path``, or None (no cache, no file, or one that cannot be read:
+    the table is made again and written anew)."""
+    if path is None:
+        return None
+    try:
+        with np.load(path) as f:
+            table = (f["xs"], f["zs"], f["coef"])
+        path.touch()                   # recently used: dropped last
+        return table
+    except Exception:
+        return None
+
+
+def _write_table(path, table) -> None:
+    if path is None:
+        return
+    from hydro import fitcache
+
+    xs, zs, coef = table
+    try:
+        fitcache.write_whole(path, lambda f: np.savez(f, xs=xs, zs=zs, coef=coef))
+        fitcache.trim(path.parent, TABLES_BYTES, "*.npz")
+    except Exception as e:            # the cache is a shortcut: never the reason a load fails
+        import warnings
+
+        warnings.warn(f"the mooring tables' cache {path.parent} cannot be written ({e}); the "
+                      "table is kept in this process only. Set MFM_FIT_CACHE to a writable "
+                      "folder, or to off", RuntimeWarning, stacklevel=3)
 
 
 def _hermite(t):
