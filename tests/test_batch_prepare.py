@@ -64,7 +64,7 @@ def test_each_case_gets_the_water_build_water_makes_alone(m4, n_steps):
         alone = carried_loads(m4, sea, dt=dt, duration=n_steps * dt, ramp=ramp,
                               radiation="state_space_exact", stage_offsets=offs)[0]
         one = cases.case(b)[0]
-        for name in ("E", "G", "H", "CE", "CG", "CH", "dt", "p", "C", "A_inf"):
+        for name in ("E", "G", "H", "CE", "RM", "CG", "CH", "dt", "p", "C", "A_inf"):
             a, r = np.asarray(getattr(one.rad, name)), np.asarray(getattr(alone.rad, name))
             np.testing.assert_allclose(a, r, rtol=0, atol=1e-13 * max(np.abs(r).max(), 1e-300),
                                        err_msg=name)
@@ -89,13 +89,15 @@ def test_radiation_for_many_steps_equals_one_step_at_a_time(m4):
     offs = stage_offsets("rk4")
     dts = np.array([0.004, 0.007, 0.004, 0.009])
     rad, batched = strategy_many(spec, "state_space_exact", dts, stage_offsets=offs)
-    assert batched.E and batched.CE and batched.dt and not batched.p and not batched.A_inf
+    assert batched.E and batched.CE and batched.dt and not batched.p and not batched.A_inf \
+        and not batched.RM
     ss = StateSpace.build(spec, None)
     for b, dt in enumerate(dts):
         one = ExactStateSpace.from_state_space(ss, dt, offs)
         for name in ("E", "G", "H", "CE", "CG", "CH", "dt"):
             np.testing.assert_array_equal(np.asarray(getattr(rad, name))[b],
                                           np.asarray(getattr(one, name)), err_msg=name)
+        np.testing.assert_array_equal(rad.RM, one.RM)   # the output map: one for every dt
     # the strategies that do not follow dt are shared whole
     _, shared = strategy_many(spec, "state_space", dts, stage_offsets=offs)
     assert not any(np.asarray(x).any() for x in __import__("jax").tree_util.tree_leaves(shared))

@@ -270,8 +270,12 @@ class ExactStateSpace(StateSpace):
     ``E``, ``G``, ``H`` (2, n_b, n_p): e^{p dt}, dt φ₁, dt φ₂ of the full step as (re, im), with the
     states in blocks (:func:`_blocks`): block b holds the n_p states driven by the input dof
     ``block_inputs[b]`` (padded with states that stay zero), so each input is read once and
-    broadcast along its block instead of gathered per state. ``CE`` (n_c, n_out, 2 n_b n_p): the
-    output maps Re(R e^{p c dt} ·) of the stage offsets c ∈ ``matvec_stages`` on [Re z; Im z];
+    broadcast along its block instead of gathered per state. ``CE`` (n_c, 2, n_b, n_p):
+    e^{p c dt} of the stage offsets c ∈ ``matvec_stages``, and ``RM`` (n_out, 2 n_b n_p) the
+    residues' output map [Re R, −Im R] on [Re w; Im w]: Yₙ[c] = RM [Re w; Im w], w = e^{p c dt} zₙ.
+    RM does not follow dt, so a batch of cases of their own dt shares it: each case carries its
+    n_x factors, not an n_out × 2n_x matrix (M4 134: 370 kB per case, read at every step of
+    every case), and the cases' products with RM are one matrix product.
     ``CG``, ``CH`` (S + 1, n_out, n_b): Re(R hφ₁), Re(R hφ₂) summed over each block, per stage
     offset and the full step (last). Memory: (tₙ, Re zₙ, Im zₙ, uₙ, Yₙ), z (n_b, n_p), u (n_b,),
     Y (S, n_out)."""
@@ -279,6 +283,7 @@ class ExactStateSpace(StateSpace):
     G: jnp.ndarray = None
     H: jnp.ndarray = None
     CE: jnp.ndarray = None
+    RM: jnp.ndarray = None
     CG: jnp.ndarray = None
     CH: jnp.ndarray = None
     dt: jnp.ndarray = None
@@ -305,7 +310,10 @@ class ExactStateSpace(StateSpace):
                   E[0] * zi + E[1] * zr + G[1] * un + H[1] * du)
         rows = [None] * len(self.stage_offsets)
         if self.matvec_stages:
-            Yc = self.CE @ jnp.concatenate([zr.reshape(-1), zi.reshape(-1)])
+            er, ei = self.CE[:, 0], self.CE[:, 1]                        # (n_c, n_b, n_p)
+            w = jnp.concatenate([(er * zr - ei * zi).reshape(len(er), -1),
+                                 (er * zi + ei * zr).reshape(len(er), -1)], axis=1)
+            Yc = w @ self.RM.T                                           # (n_c, n_out)
             for k, s in enumerate(self.matvec_stages):
                 rows[s] = Yc[k]
         for s, c in enumerate(self.stage_offsets):
@@ -338,10 +346,10 @@ class ExactStateSpace(StateSpace):
     @classmethod
     def from_state_space(cls, ss: StateSpace, dt, stage_offsets):
         """The exact update of ``ss``'s states for steps of ``dt`` and stages at ``stage_offsets``."""
-        arrays, static = cls._arrays(ss, np.asarray([float(dt)]), stage_offsets)
+        arrays, shared = cls._arrays(ss, np.asarray([float(dt)]), stage_offsets)
         return cls(p=ss.p, C=ss.C, A_inf=ss.A_inf, inputs=ss.inputs, outputs=ss.outputs,
                    options=ss.options, report=ss.report,
-                   **{k: jnp.asarray(v[0]) for k, v in arrays.items()}, **static)
+                   **{k: jnp.asarray(v[0]) for k, v in arrays.items()}, **shared)
 
     @classmethod
     def from_state_space_many(cls, ss: StateSpace, dts, stage_offsets):
@@ -350,17 +358,17 @@ class ExactStateSpace(StateSpace):
         leading axis of D, the same numbers as D single builds (elementwise, in the same order).
         Returns (strategy, batched): ``batched`` a pytree of bools like it, True on those
         arrays."""
-        arrays, static = cls._arrays(ss, np.asarray(dts, dtype=float), stage_offsets)
+        arrays, shared = cls._arrays(ss, np.asarray(dts, dtype=float), stage_offsets)
         out = cls(p=ss.p, C=ss.C, A_inf=ss.A_inf, inputs=ss.inputs, outputs=ss.outputs,
-                  options=ss.options, report=ss.report, **arrays, **static)
+                  options=ss.options, report=ss.report, **arrays, **shared)
         batched = jax.tree_util.tree_map(lambda _: False, out)
         return out, eqx.tree_at(lambda r: tuple(getattr(r, k) for k in arrays), batched,
                                 tuple(True for _ in arrays))
 
     @staticmethod
     def _arrays(ss: StateSpace, dts, stage_offsets):
-        """The arrays of the class docstring for each step of ``dts`` (D,), with a leading axis
-        of D, and the static fields."""
+        """The arrays of the class docstring that follow dt, for each step of ``dts`` (D,) with a
+        leading axis of D, and the fields every dt shares (RM and the static ones)."""
         offsets = tuple(float(c) for c in stage_offsets)
         p = np.asarray(ss.p[:, 0]) + 1j * np.asarray(ss.p[:, 1])
         h = dts[:, None, None] * np.asarray(offsets + (1.0,))[None, :, None]     # (D, S + 1, 1)
@@ -369,7 +377,6 @@ class ExactStateSpace(StateSpace):
         n_b, n_x = len(block_inputs), len(ss.inputs)
         C = np.asarray(ss.C)
         Rc = C[:, :n_x] - 1j * C[:, n_x:]                 # the complex residues R: F = −Re(R z)
-        D = dts.shape[0]
 
         def blocks(a):
             # (..., n_x) -> (..., n_b, n_p); padded states get zeros (they stay zero)
@@ -392,16 +399,16 @@ class ExactStateSpace(StateSpace):
         # stages after the step's start need a product with the states; one at the start does not
         # where a stage at the end gives it (see the class docstring)
         matvec = tuple(s for s, c in enumerate(offsets) if c != 0.0 or 1.0 not in offsets)
-        er, ei = blocks(e[:, list(matvec)].real), blocks(e[:, list(matvec)].imag)   # (D, n_c, n_b, n_p)
-        er, ei = er[:, :, None], ei[:, :, None]
-        flat = (D, len(matvec), C.shape[0], n_b * n_p)        # columns in the order of [Re z; Im z]
-        # Re(R e) and −Im(R e) elementwise (the output maps of the class docstring)
-        CE = np.concatenate([(Rr * er - Ri * ei).reshape(flat), -(Rr * ei + Ri * er).reshape(flat)],
-                            axis=-1)
+        em = e[:, list(matvec)]
+        CE = np.stack([blocks(em.real), blocks(em.imag)], axis=2)         # (D, n_c, 2, n_b, n_p)
+        # the output map of [Re w; Im w], shared by every dt: Re(R w) = Re R Re w − Im R Im w
+        n_out = C.shape[0]
+        RM = np.concatenate([Rr.reshape(n_out, -1), -Ri.reshape(n_out, -1)], axis=1)
         arrays = dict(E=split(e[:, -1]), G=split(h[:, -1] * phi1[:, -1]),
                       H=split(h[:, -1] * phi2[:, -1]), CE=CE, CG=per_block(h * phi1),
                       CH=per_block(h * phi2), dt=np.asarray(dts, dtype=np.float64))
-        return arrays, dict(block_inputs=block_inputs, matvec_stages=matvec, stage_offsets=offsets)
+        return arrays, dict(RM=jnp.asarray(RM), block_inputs=block_inputs, matvec_stages=matvec,
+                            stage_offsets=offsets)
 
 
 def _blocks(inputs):
