@@ -262,8 +262,9 @@ class ExactStateSpace(StateSpace):
 
         F_c = −(Yₙ[c] + (R G_c) uₙ + (R H_c)(u_c − uₙ)),   Yₙ[c] = Re(R e^{p c dt} zₙ),
 
-    with Yₙ computed once per step where zₙ is (:meth:`update_memory`), one product of the states
-    with ``CE`` for the stages after the step's start, and none for a stage at its start (c = 0:
+    with Yₙ computed once per step where zₙ is (:meth:`update_memory`), one product of
+    e^{p c dt} zₙ with ``RM`` for the stages after the step's start, and none for a stage at its
+    start (c = 0:
     Yₙ₊₁[0] = Re(R zₙ₊₁) follows from the stage at its end, c = 1, by the same linearity). The
     stages themselves cost (n_out × n_in) products, not a pass over the states.
 
