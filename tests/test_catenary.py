@@ -24,7 +24,8 @@ from scipy.optimize import brentq
 import mfm
 from mfm.io.config import parse_config
 from mfm.loads import CatenaryLines, JointLoad
-from mfm.loads.catenary import catenary_forces, linearise_lines
+from mfm.frequency.rest import linearise_lines
+from mfm.loads.catenary import catenary_forces
 from mfm.mechanics.tree import ConfigError
 
 mp = pytest.importorskip("moorpy")
