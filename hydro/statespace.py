@@ -265,6 +265,9 @@ def _enforce_passivity(fits, done, nd, dpk, dof_ok, s_fit, w_fit, w_max, max_ite
     Returns the number of iterations used.
     """
     D = 1.0 / np.sqrt(np.where(dof_ok, dpk, np.inf))
+    from scipy.linalg import solve_triangular
+    from scipy.optimize import nnls     # here, not at the top: ~0.4 s of every import of mfm
+
     ok = np.asarray(dof_ok, bool)
     grid = _passivity_grid(w_max)
     keys = list(done)
@@ -301,9 +304,6 @@ def _enforce_passivity(fits, done, nd, dpk, dof_ok, s_fit, w_fit, w_max, max_ite
             Ms, ds = M / sc[:, None], delta / sc
             Gm = Ms @ Ms.T
             L = np.linalg.cholesky(Gm + 1e-12 * np.trace(Gm) / len(Gm) * np.eye(len(Gm)))
-            from scipy.linalg import solve_triangular
-            from scipy.optimize import nnls     # here: scipy.optimize is ~0.4 s of importing mfm
-
             mu, _ = nnls(L.T, solve_triangular(L, ds, lower=True), maxiter=50 * len(Gm))
             y = Ms.T @ mu
             if np.min(Ms @ y - ds) < -1e-6 * max(1.0, float(np.abs(ds).max())):

@@ -101,8 +101,9 @@ def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis, began=None):
     others). ``began``: when the compilation began (``time.perf_counter()``), where it was done
     before the call; the bar says how long it took."""
     c, n_chunks = chunk_plan(n_blocks)
-    _say(bar, "compiling")
     if began is None:
+        # compiled by the first calls below; else before this call, under its own phase
+        _say(bar, "compiling")
         began = time.perf_counter()
     carry, first = start()
     headed = first is None
