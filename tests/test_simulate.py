@@ -4,6 +4,7 @@ import pytest
 import xarray as xr
 from conftest import CONFIGS
 
+import hydro
 import mfm
 from mfm.io.config import parse_config
 
@@ -65,20 +66,75 @@ def test_auto_radiation_takes_the_cheaper_and_says_why():
     # the convolution's work n_steps × stage offsets × (T_K/dt) lags × n² against the limit (the
     # history sum is formed once per step for each stage offset: RK4 3, Verlet 2): M4 134 (24
     # moved dofs, T_K ≈ 39 s) over 100 T_p at T_p/200 with RK4 is 2e11 multiply–adds (minutes):
-    # the state space; 200 steps of it (2e9) and RM3's 2000 steps (5e7): the convolution.
-    from mfm.timedomain.setup import AUTO_CONVOLUTION_LIMIT, choose_radiation
+    # the state space; 200 steps of it (2e9) and RM3's 2000 steps (5e7): the convolution. The
+    # state space's states are integrated by RK4 where its error in the fitted modes is ≤ 1e-3
+    # (M4 134 at dt 0.006: poles to |p| dt 0.09, ~2e-5), advanced exactly by Verlet (no
+    # amplification factor declared) and by RK4 at a step too coarse for its poles.
+    from mfm.timedomain.setup import (AUTO_CONVOLUTION_LIMIT, STATE_SPACE_TOLERANCE,
+                                      choose_radiation)
 
     m4 = mfm.load(CONFIGS / "m4_134.toml")
     name, why = choose_radiation(m4, dt=0.006, n_steps=20_000)
-    assert name == "state_space_exact" and "24² moved dofs" in why and "> 2e+10" in why
+    assert name == "state_space" and "24² moved dofs" in why and "> 2e+10" in why, why
+    assert "its states integrated" in why, why
+    err = float(why.split("response up to ")[1].split()[0])
+    assert err <= STATE_SPACE_TOLERANCE, why
     lags = int(why.split(" lags")[0].split()[-1])
     assert abs(lags - m4.hydro.memory() / 0.006) <= 1
     assert choose_radiation(m4, dt=0.006, n_steps=200)[0] == "convolution"
     n_rk4 = int(AUTO_CONVOLUTION_LIMIT / (3 * lags * 24**2))
-    assert choose_radiation(m4, dt=0.006, n_steps=n_rk4 + 1)[0] == "state_space_exact"
+    assert choose_radiation(m4, dt=0.006, n_steps=n_rk4 + 1)[0] == "state_space"
     assert choose_radiation(m4, dt=0.006, n_steps=n_rk4 + 1, integrator="verlet")[0] == "convolution"
+    name, why = choose_radiation(m4, dt=0.006, n_steps=10**6, integrator="verlet")
+    assert name == "state_space_exact" and "verlet declares no amplification factor" in why
+    # a step 10× coarser takes the poles to |p| dt ≈ 0.9: RK4's error there is far above 1e-3
+    name, why = choose_radiation(m4, dt=0.06, n_steps=10**6)
+    assert name == "state_space_exact" and "its states advanced exactly" in why, why
     assert choose_radiation(MODEL, dt=0.01, n_steps=10**9) == ("none", "no water")
 
+
+@pytest.mark.parametrize("p", [-0.05 + 2.0j, -0.4 + 0.0j, -0.01 + 8.0j])
+def test_integrated_state_error_bounds_the_modes_response(p):
+    """The bound of choose_radiation's integrated states, against the steady response of one
+    mode x_{n+1} = a x_n + e^{iωn dt} computed by stepping it (not by the formula), a = RK4's
+    R(p dt) and a = e^{p dt}, on a dense grid of ω around the mode: the largest relative
+    difference equals the bound to first order in it (within 5 %)."""
+    from mfm.timedomain.integrators import RK4
+    from mfm.timedomain.setup import integrated_state_error
+
+    dt = 0.15 / abs(p)                           # |p| dt = 0.15: the bound ~1e-4 to 1e-3
+    bound = integrated_state_error(RK4.amplification, np.array([p * dt]))
+    w = abs(p.imag) + np.linspace(-3, 3, 301) * max(-p.real, 1e-3)
+    n = int(30 / (-p.real * dt))                 # 30 decay times: the transient is e^-30
+    steps = np.exp(1j * w * dt)
+
+    def steady(a):
+        x = np.zeros_like(w, dtype=complex)
+        for _ in range(n):                       # x_n e^{-iωn dt}: the steady amplitude
+            x = (a * x + 1.0) / steps
+        return x * steps
+
+    exact, rk4 = steady(np.exp(p * dt)), steady(RK4.amplification(p * dt))
+    got = np.max(np.abs(rk4 - exact) / np.abs(exact))
+    assert 1e-6 < bound < 1e-2
+    assert abs(got - bound) <= 0.05 * bound, (got, bound)
+
+
+def test_auto_runs_the_state_space_it_chose(monkeypatch):
+    """radiation="auto" takes what choose_radiation says (here the integrated state space, the
+    convolution limit set to 0 so that a short RM3 run takes the state space) and runs it: the
+    same q to the last bit as radiation="state_space", the choice and why in the result."""
+    from mfm.timedomain import setup
+
+    monkeypatch.setattr(setup, "AUTO_CONVOLUTION_LIMIT", 0.0)
+    m = mfm.load(CONFIGS / "rm3.toml")
+    sea = hydro.Regular(height=1.0, period=8.0)
+    kw = dict(duration=4.0, dt=0.1, ramp=2.0)
+    auto = mfm.simulate(m, sea, **kw)
+    assert auto.attrs["radiation"] == "state_space", auto.attrs["radiation"]
+    assert "its states integrated" in auto.attrs["radiation_choice"]
+    np.testing.assert_array_equal(auto.q.values,
+                                  mfm.simulate(m, sea, radiation="state_space", **kw).q.values)
 
 
 def test_outputs_computed_after_the_loop_equal_those_inside_it(monkeypatch):

@@ -75,6 +75,17 @@ class RK4:
     def init(self, f, t0, q0, qd0, z0):
         return _init(f, t0, q0, qd0, z0)
 
+    @staticmethod
+    def amplification(z):
+        """One step on the test equation ẏ = λy, z = λ dt (complex, any shape): y ← R(z) y with
+        R(z) = 1 + z + z²/2 + z³/6 + z⁴/24 (Hairer & Wanner, Solving ODEs II, §IV.2). What RK4
+        does to a first-order state such as a radiation state-space mode; the exact factor is
+        eᶻ (:func:`mfm.timedomain.setup.choose_radiation` compares the two)."""
+        import numpy as np
+
+        z = np.asarray(z, complex)
+        return 1.0 + z * (1.0 + z * (0.5 + z * (1.0 / 6.0 + z / 24.0)))
+
     def step(self, f, s: State, dt):
         # The four evaluations as one rolled loop of one f (the compiled time loop holds one copy
         # of the dynamics instead of four). Evaluation j takes

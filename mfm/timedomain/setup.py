@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ..loads.assembly import carried_loads
 from ..loads.base import Load
 from ..mechanics.model import Model
@@ -33,17 +35,42 @@ def model_loads(model: Model, sea=None, *, dt, duration, t0=0.0, ramp=0.0,
 AUTO_CONVOLUTION_LIMIT = 2e10
 
 
-def choose_radiation(model: Model, *, dt, n_steps, integrator="rk4", memory=None):
+# the largest relative error of a fitted radiation mode's response that radiation="auto" accepts
+# from integrating its states with the run's integrator instead of advancing them exactly
+# (:func:`integrated_state_error`); the fits themselves match their database to ~1e-2
+STATE_SPACE_TOLERANCE = 1e-3
+
+
+def choose_radiation(model: Model, *, dt, n_steps, integrator="rk4", memory=None,
+                     state_space_options=None):
     """The radiation strategy ``radiation="auto"`` takes, and why: ``(name, reason)``.
+
+    First the convolution or the state space (:func:`convolution_or_state_space`: the
+    convolution's work against :data:`AUTO_CONVOLUTION_LIMIT`, no fit needed); then, for the
+    state space, how its states advance (:func:`state_space_update`, from the fit: integrated by
+    the integrator where that is as good as exact and cheaper, else advanced exactly). The reason
+    is recorded in the result (``radiation_choice``)."""
+    name, why = convolution_or_state_space(model, dt=dt, n_steps=n_steps, integrator=integrator,
+                                           memory=memory)
+    if name != "state_space_exact":
+        return name, why
+    name, how = state_space_update(model, dt=dt, integrator=integrator,
+                                   state_space_options=state_space_options)
+    return name, f"{why}; {how}"
+
+
+def convolution_or_state_space(model: Model, *, dt, n_steps, integrator="rk4", memory=None):
+    """The first half of :func:`choose_radiation`, without the fit: ``("convolution", why)``,
+    ``("state_space_exact", why)`` (some state space: :func:`state_space_update` says which) or
+    ``("none", "no water")``.
 
     The convolution costs n_steps × S × n_lags × n² multiply–adds (S the stage offsets of the
     integrator, for each of which the history sum is formed once per step,
     :class:`mfm.loads.radiation.Convolution`; n the moved hydro dofs; n_lags = T_K/dt with T_K the
     memory from the decay of K, or ``memory``); the state space a fit once (seconds to a minute) and
     then O(n · poles) per evaluation. Above :data:`AUTO_CONVOLUTION_LIMIT` multiply–adds the state
-    space is taken, its states advanced exactly (``"state_space_exact"``, stable with every
-    integrator); below it the convolution, the direct evaluation of the Cummins integral with no
-    fit. The reason is recorded in the result (``radiation_choice``)."""
+    space is taken; below it the convolution, the direct evaluation of the Cummins integral with
+    no fit."""
     if model.hydro is None:
         return "none", "no water"
     integ = _integrators.get(integrator)
@@ -60,6 +87,53 @@ def choose_radiation(model: Model, *, dt, n_steps, integrator="rk4", memory=None
     if macs > AUTO_CONVOLUTION_LIMIT:
         return "state_space_exact", f"auto: {what} > {AUTO_CONVOLUTION_LIMIT:.0e}: state space"
     return "convolution", f"auto: {what} ≤ {AUTO_CONVOLUTION_LIMIT:.0e}: convolution"
+
+
+def integrated_state_error(amplification, z):
+    """The largest relative error, over every input frequency, of the response of modes
+    ẋ = p x + u integrated with one step's amplification factor R (z = p dt, Re z < 0) instead of
+    advanced exactly (eᶻ): the response to an input at frequency ω is Σₙ aⁿ e^{−iωn dt} =
+    1/(1 − a e^{−iω dt}), whose relative change from a = eᶻ to R(z) is at most
+    |R(z) − eᶻ| / (1 − |eᶻ|) (at resonance, ω dt = Im z), to first order. Returns the maximum over
+    ``z``; inf where a mode does not decay (Re z ≥ 0)."""
+    z = np.asarray(z, complex).ravel()
+    if not z.size:
+        return 0.0
+    decay = -np.expm1(z.real)                         # 1 − |eᶻ| > 0 for a decaying mode
+    if not (decay > 0).all():
+        return math.inf
+    return float(np.max(np.abs(amplification(z) - np.exp(z)) / decay))
+
+
+def state_space_update(model: Model, *, dt, integrator="rk4", state_space_options=None):
+    """How the fitted radiation states of ``radiation="auto"`` advance, and why:
+    ``("state_space", why)`` (integrated by the integrator, as its other states) or
+    ``("state_space_exact", why)`` (advanced exactly over each step, for a velocity linear within
+    it: stable at every dt, but each stage offset of the step needs its own product with the
+    states).
+
+    Integrated where the integrator declares its amplification factor R(z) (RK4's) and the
+    largest relative error it makes in a fitted mode's response (:func:`integrated_state_error`,
+    z = p dt for every pole p of the fit) is at most :data:`STATE_SPACE_TOLERANCE`; then the states
+    cost one product per evaluation and nothing more (M4 134 over 100 T_p at T_p/200: 0.66× the
+    exact update's time, benchmarks/RESULTS.md; its fit's poles reach |p| dt = 0.09, an error of
+    ~1e-6). Else exact."""
+    from ..loads.radiation import StateSpace
+
+    integ = _integrators.get(integrator)
+    amplification = getattr(integ, "amplification", None)
+    if amplification is None:
+        return "state_space_exact", (f"its states advanced exactly ({integ.name} declares no "
+                                     "amplification factor to integrate them with)")
+    ss = StateSpace.build(model.hydro, state_space_options)
+    p = np.asarray(ss.p[:, 0]) + 1j * np.asarray(ss.p[:, 1])
+    err = integrated_state_error(amplification, p * float(dt))
+    biggest = float(np.max(np.abs(p))) * float(dt) if p.size else 0.0
+    what = (f"{p.size} fitted poles, largest |p| dt {biggest:.3g}: {integ.name} integrates them "
+            f"with a relative error of the modes' response up to {err:.2g}")
+    if err <= STATE_SPACE_TOLERANCE:
+        return "state_space", f"{what} ≤ {STATE_SPACE_TOLERANCE:g}: its states integrated"
+    return "state_space_exact", f"{what} > {STATE_SPACE_TOLERANCE:g}: its states advanced exactly"
 
 
 def stage_offsets(integrator):

@@ -22,7 +22,8 @@ from .checks import (nonfinite_message, refuse_impossible, warn_accuracy, warn_s
                      warn_verlet_drift)
 from .progress import phase, progress_bar, progress_options
 from .rollout import prepare_progress, rollout, rollout_call, rollout_jit  # noqa: F401
-from .setup import choose_radiation, model_loads, stage_offsets
+from .setup import (choose_radiation, convolution_or_state_space, model_loads,  # noqa: F401
+                    stage_offsets, state_space_update)
 
 
 def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="rk4",
@@ -46,8 +47,10 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
         model's own (its water and its config's loads).
     save_every: keep every k-th step in the output.
     ramp: s, the start-up ramp of the excitation (½(1 − cos πt/ramp)).
-    radiation: ``"auto"`` (default: the cheaper of the next two for this run,
-        :func:`choose_radiation`; the choice and why are in the attribute ``radiation_choice``),
+    radiation: ``"auto"`` (default: the cheaper of the convolution and the state space for this
+        run, the state space's states integrated by the integrator where it does that as well as
+        exactly (RK4 at the usual steps), else advanced exactly: :func:`choose_radiation`; the
+        choice and why are in the attribute ``radiation_choice``),
         ``"convolution"`` (direct, window T_K from the decay of K; ``memory`` overrides it,
         s), ``"state_space"`` (the passive fit of :mod:`hydro.statespace`, options in
         ``state_space_options``, its states integrated by the integrator),
@@ -105,9 +108,12 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                          f"Beeman's corrector; integrator={integ.name!r} has none: use "
                          "integrator='beeman' or added_mass='lhs'")
     choice = "given"
-    if radiation == "auto":
-        radiation, choice = choose_radiation(model, dt=dt, n_steps=n_steps, integrator=integ,
-                                             memory=memory)
+    auto = radiation == "auto"
+    if auto:
+        # the convolution or the state space now; how the state space's states advance once its
+        # fit is made (below, beside the jet's compilation): choose_radiation in two halves
+        radiation, choice = convolution_or_state_space(model, dt=dt, n_steps=n_steps,
+                                                       integrator=integ, memory=memory)
         if model.hydro is None:
             radiation = "convolution"          # no water: nothing to choose
     q0 = initial_vector(model, q0, "q0")
@@ -131,6 +137,10 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
             # with the run's own loads
             ahead = pool.submit(rest.compile_jet, model, rest.still_water_loads(
                 model, extra, added_mass=added_mass, stage_offsets=stage_offsets(integ)), q0)
+        if auto and radiation == "state_space_exact":
+            radiation, how = state_space_update(model, dt=dt, integrator=integ,
+                                                state_space_options=state_space_options)
+            choice = f"{choice}; {how}"
         loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                             radiation=radiation, memory=memory,
                             state_space_options=state_space_options, added_mass=added_mass,
