@@ -82,6 +82,10 @@ DEFAULT_STEP = (1.0, 1.0)
 MOORPY_TOL = 1e-10      # m: MoorPy's catenary convergence tolerance for the tables
 
 _TABLE_CACHE: dict = {}
+# m: the table's centre is the rest span and height rounded to this (a table reaches tens of
+# metres about it, its nodes a metre apart: a shift of half a millimetre changes nothing it
+# covers), so that lines of one geometry share a table
+CENTRE_QUANTUM = 1e-3
 
 
 def moorpy_version() -> str:
@@ -113,9 +117,14 @@ def _axis(centre, half, step):
 def build_table(x0, z0, extent, step, length, EA, weight, seabed_friction):
     """(xs, zs, coef): the grid axes and the nodal data (nx, nz, 4, 2) of the tensor-product
     not-a-knot cubic spline of (H, V): [f, hx ∂f/∂x, hz ∂f/∂z, hx hz ∂²f/∂x∂z] per node.
-    Cached on its arguments (six lines of one geometry make one table)."""
+    The grid is centred on the rest span and height (x0, z0) rounded to :data:`CENTRE_QUANTUM`,
+    and cached on its arguments: lines of one geometry make one table, although their spans,
+    computed from fairlead and anchor positions a config gives to 1e-6 m, differ in the last
+    digits (Wu & Yuan's six lines: three spans 775.4999997–775.5000010 m, so three tables of 2,511
+    MoorPy solves each, 10 s on a 2-core machine, where one serves)."""
     from scipy.interpolate import CubicSpline
 
+    x0, z0 = (round(float(v) / CENTRE_QUANTUM) * CENTRE_QUANTUM for v in (x0, z0))
     key = tuple(round(float(v), 9) for v in (x0, z0, *extent, *step, length, EA, weight,
                                              seabed_friction))
     if key in _TABLE_CACHE:
