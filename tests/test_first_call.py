@@ -263,3 +263,24 @@ def test_a_compiled_program_is_not_compiled_again_when_called(monkeypatch, tmp_p
         # arguments of other shapes: the jit's own path, which compiles for them
         small = ({"a": p["a"][:3, :3], "b": p["b"][:3]}, x[:3])
         np.testing.assert_array_equal(made(*small)["y"], fn(*small)["y"])
+
+
+def test_the_moved_dofs_of_a_load_come_from_a_saved_program(monkeypatch, tmp_path):
+    """mfm.load's search for the hydro dofs the joints move (H(q) at three random q, ~0.7 s of
+    tracing each load) is a kept program: a later process loads it, and finds the same dofs as
+    the ordinary jit call."""
+    import mfm
+    from mfm.loads import water
+
+    _fresh(monkeypatch, tmp_path)
+    m = mfm.load(CONFIGS / "sphere.toml")
+    spec = m.hydro
+    d_ref = spec.d_ref
+    assert len(list(tmp_path.glob("h_samples-*.bin"))) == 1
+    monkeypatch.setattr(_programs, "_MADE", {})             # as a new process finds it
+    before = dict(_programs.COUNTS)
+    got = water.moving_dofs(m, spec.body_index, d_ref)
+    assert _programs.COUNTS["loaded"] == before["loaded"] + 1
+    monkeypatch.setattr(_programs, "folder", lambda: None)   # the ordinary path
+    np.testing.assert_array_equal(got, water.moving_dofs(m, spec.body_index, d_ref))
+    np.testing.assert_array_equal(got, spec.moving)
