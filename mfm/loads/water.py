@@ -512,7 +512,6 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
                          "radiation='convolution' the number of lags follows dt: give every case "
                          "the same dt and memory, or use radiation='state_space')")
     rad, rad_batched = stacked
-    nd = len(spec.dofs)
     m = grid_subdivisions(stage_offsets)
     # the grid of build_water: excitation and elevation on the stage grid, one step past the end
     n_grids = {int(round(n_steps * float(d) / float(d))) * m + m + 1 for d in uniq}
