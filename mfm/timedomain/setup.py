@@ -37,7 +37,8 @@ AUTO_CONVOLUTION_LIMIT = 2e10
 
 # the largest relative error of a fitted radiation mode's response that radiation="auto" accepts
 # from integrating its states with the run's integrator instead of advancing them exactly
-# (:func:`integrated_state_error`); the fits themselves match their database to ~1e-2
+# (:func:`integrated_state_error`); the fits themselves are further from their databases (band
+# errors of 1e-2 and more)
 STATE_SPACE_TOLERANCE = 1e-3
 
 
@@ -117,7 +118,7 @@ def state_space_update(model: Model, *, dt, integrator="rk4", state_space_option
     z = p dt for every pole p of the fit) is at most :data:`STATE_SPACE_TOLERANCE`; then the states
     cost one product per evaluation and nothing more (M4 134 over 100 T_p at T_p/200: 0.66× the
     exact update's time, benchmarks/RESULTS.md; its fit's poles reach |p| dt = 0.09, an error of
-    ~1e-6). Else exact."""
+    1.8e-5). Else exact."""
     from ..loads.radiation import StateSpace
 
     integ = _integrators.get(integrator)
