@@ -275,8 +275,8 @@ class ExactStateSpace(StateSpace):
     e^{p c dt} of the stage offsets c ∈ ``matvec_stages``, and ``RM`` (n_out, 2 n_b n_p) the
     residues' output map [Re R, −Im R] on [Re w; Im w]: Yₙ[c] = RM [Re w; Im w], w = e^{p c dt} zₙ.
     RM does not follow dt, so a batch of cases of their own dt shares it: each case carries its
-    n_x factors, not an n_out × 2n_x matrix (M4 134: 370 kB per case, read at every step of
-    every case), and the cases' products with RM are one matrix product.
+    n_x factors per stage, not an n_out × 2n_x matrix per stage (M4 134: 194 kB per case with
+    Verlet's one such stage, 387 kB with RK4's two, read at every step of every case), and the cases' products with RM are one matrix product.
     ``CG``, ``CH`` (S + 1, n_out, n_b): Re(R hφ₁), Re(R hφ₂) summed over each block, per stage
     offset and the full step (last). Memory: (tₙ, Re zₙ, Im zₙ, uₙ, Yₙ), z (n_b, n_p), u (n_b,),
     Y (S, n_out)."""

@@ -41,6 +41,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .. import _programs
 from ..mechanics import se3
 from ..mechanics.points import BodyPoints
 from .base import FrequencyTerms, Load, LoadOutput
@@ -666,7 +667,5 @@ def moving_dofs(model, body_index, d_ref, n_samples: int = 3, seed: int = 0) -> 
     args = (model.keyed(), geo, qs)
     # from disk where an earlier process traced it (mfm._programs): its tracing and lowering
     # were ~0.7 s of every mfm.load of M4 134 with the caches filled
-    from .. import _programs
-
     peak = np.abs(np.asarray(_programs.program(_h_samples, "h_samples", args)(*args))).max(axis=(0, 2))
     return np.flatnonzero(peak > 1e-12 * max(float(np.max(peak)), 1e-300))
