@@ -233,14 +233,18 @@ def phi_functions(x, n: int):
     x = np.asarray(x, complex)
     small = np.abs(x) < 0.5
     xs = np.where(small, 1.0, x)
-    out = [np.exp(x)]
-    rec = np.exp(xs)
+    # eˣ once, from real functions (numpy's complex exp took 80 ns an element, twice: 0.16 s of
+    # 960 time steps' arrays for M4 134); the recurrence's values where x is small are not used
+    ex = np.exp(x.real) * (np.cos(x.imag) + 1j * np.sin(x.imag))
+    out = [ex]
+    rec = ex
     for k in range(1, n + 1):
         rec = (rec - 1.0 / math.factorial(k - 1)) / xs
         # Σ_{j<20} x^j/(j + k)! by Horner's rule (20 multiply–adds, not 20 complex powers)
         series = np.full(x.shape, 1.0 / math.factorial(19 + k), dtype=complex)
         for j in range(18, -1, -1):
-            series = series * x + 1.0 / math.factorial(j + k)
+            series *= x             # in place: the same numbers, without a temporary per term
+            series += 1.0 / math.factorial(j + k)
         out.append(np.where(small, series, rec))
     return tuple(out)
 
@@ -372,8 +376,6 @@ class ExactStateSpace(StateSpace):
         leading axis of D, and the fields every dt shares (RM and the static ones)."""
         offsets = tuple(float(c) for c in stage_offsets)
         p = np.asarray(ss.p[:, 0]) + 1j * np.asarray(ss.p[:, 1])
-        h = dts[:, None, None] * np.asarray(offsets + (1.0,))[None, :, None]     # (D, S + 1, 1)
-        e, phi1, phi2 = phi_functions(p[None, None, :] * h, 2)
         slot, block_inputs, n_p = _blocks(ss.inputs)
         n_b, n_x = len(block_inputs), len(ss.inputs)
         C = np.asarray(ss.C)
@@ -385,23 +387,42 @@ class ExactStateSpace(StateSpace):
             out[..., slot] = a
             return out.reshape(a.shape[:-1] + (n_b, n_p))
 
-        def split(a):
-            # (D, n_x) -> (D, 2, n_b, n_p)
-            return np.stack([blocks(a.real), blocks(a.imag)], axis=1)
+        # the poles in the block layout from the start (the layout of every array below), so the
+        # D time steps' arrays are made in it rather than placed into it (a scatter per array:
+        # 0.12 of 0.37 s for 960 time steps of M4 134)
+        pb, live = blocks(p), blocks(np.ones(n_x)) > 0                 # (n_b, n_p)
+        fractions = np.asarray(offsets + (1.0,))
+        h = dts[:, None, None, None] * fractions[None, :, None, None]    # (D, S + 1, 1, 1)
+        # φ of each distinct fraction of the step once (the step's end is also a stage's offset
+        # for Verlet and RK4), elementwise, so the same numbers for a third to a half of the
+        # work; at the step's start (fraction 0) they are 1, 1, ½ exactly
+        uniq, back = np.unique(fractions, return_inverse=True)         # ascending: 0 first
+        nz = uniq != 0.0
+        parts = phi_functions(pb * (dts[:, None, None, None] * uniq[nz][None, :, None, None]), 2)
+        at_zero = lambda v: np.broadcast_to(np.where(live, v, 0.0).astype(complex),  # noqa: E731
+                                            (len(dts), int((~nz).sum()), n_b, n_p))
+        e, phi1, phi2 = (np.concatenate([at_zero(v), np.where(live, a, 0.0)], axis=1)[:, back]
+                         for a, v in zip(parts, (1.0, 1.0, 0.5)))
 
-        # in the block layout from the start: the residues (n_out, n_b, n_p), real and imaginary
+        def split(a, axis=1):
+            # complex (D, …, n_b, n_p) -> real and imaginary parts on a new axis
+            return np.stack([a.real, a.imag], axis=axis)
+
+        # the residues (n_out, n_b, n_p), real and imaginary
         Rr, Ri = blocks(Rc.real), blocks(Rc.imag)
+        Rb = np.concatenate([Rr, -Ri], axis=-1).transpose(1, 2, 0)         # (n_b, 2 n_p, n_out)
 
         def per_block(a):
-            # Re(R a) summed over each block's states: (D, S + 1, n_out, n_b)
-            ar, ai = blocks(a.real), blocks(a.imag)                  # (D, S + 1, n_b, n_p)
-            return np.einsum("dsbp,obp->dsob", ar, Rr) - np.einsum("dsbp,obp->dsob", ai, Ri)
+            # Re(R a) summed over each block's states: (D, S + 1, n_out, n_b), as one matrix
+            # product per block ([Re a, Im a] against [Re R; −Im R]; numpy's einsum looped it
+            # without BLAS: 0.16 s for 960 time steps of M4 134)
+            ab = np.concatenate([a.real, a.imag], axis=-1)              # (D, S + 1, n_b, 2 n_p)
+            return np.matmul(ab.transpose(2, 0, 1, 3), Rb[:, None]).transpose(1, 2, 3, 0)
 
         # stages after the step's start need a product with the states; one at the start does not
         # where a stage at the end gives it (see the class docstring)
         matvec = tuple(s for s, c in enumerate(offsets) if c != 0.0 or 1.0 not in offsets)
-        em = e[:, list(matvec)]
-        CE = np.stack([blocks(em.real), blocks(em.imag)], axis=2)         # (D, n_c, 2, n_b, n_p)
+        CE = split(e[:, list(matvec)], axis=2)                           # (D, n_c, 2, n_b, n_p)
         # the output map of [Re w; Im w], shared by every dt: Re(R w) = Re R Re w − Im R Im w
         n_out = C.shape[0]
         RM = np.concatenate([Rr.reshape(n_out, -1), -Ri.reshape(n_out, -1)], axis=1)

@@ -40,6 +40,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
+from hydro.seabatch import components_many
 
 from .. import _programs
 from ..mechanics import se3
@@ -522,7 +523,7 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
     n_grid = n_grids.pop()
     steps = dts / m
     live = [i for i, sea in enumerate(seas) if sea is not None]
-    comps = [seas[i].components(water_depth=spec.water_depth, g=spec.g) for i in live]
+    comps = components_many([seas[i] for i in live], water_depth=spec.water_depth, g=spec.g)
     table = excitation_table(spec)
     outside, br = table.brackets_many(comps)
     n_c = max([len(c) for c in comps] + [1])
