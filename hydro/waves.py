@@ -35,6 +35,7 @@ jitter, phases, directions), so switching spreading on or off leaves the phases 
 """
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -590,12 +591,14 @@ def _peak_enhancement_exponent(x):
     return np.exp(-0.5 * ((x - 1.0) / sigma) ** 2)
 
 
+@functools.lru_cache(maxsize=256)
 def jonswap_normalisation(gamma: float, method: str = "exact") -> float:
     """A_γ such that S_J = A_γ · S_PM · γ^{exp(−(ω−ωp)²/(2σ²ωp²))} has ∫S_J dω = Hs²/16.
 
     "exact": 1 / ∫₀^∞ 5 x⁻⁵ e^{−1.25 x⁻⁴} γ^{r(x)} dx (adaptive quadrature, split at the peak x = 1;
     the PM shape 5x⁻⁵e^{−1.25x⁻⁴} integrates to 1). "dnv": the DNV-RP-C205 approximation
-    1 − 0.287 ln γ (within about 1 % for 1 <= γ <= 7).
+    1 − 0.287 ln γ (within about 1 % for 1 <= γ <= 7). Kept per (γ, method): a study's thousands
+    of seas of one γ paid the two quadratures each (1.7 ms of a sea's construction).
     """
     if method == "dnv":
         return 1.0 - 0.287 * math.log(gamma)
