@@ -72,7 +72,10 @@ def _in_threads(n, call):
 
 
 def _join_parts(outs, B):
-    """The parts' outputs joined on the case axis, the padding cases dropped (numpy)."""
+    """The parts' outputs joined on the case axis, the padding cases dropped (numpy; one part,
+    as on a GPU, is taken as it is, not copied: 2,000 samples of 480 M4 134 cases are 0.2 GB)."""
+    if len(outs) == 1:
+        return jax.tree_util.tree_map(lambda a: np.asarray(a)[:B], outs[0])
     return jax.tree_util.tree_map(lambda *a: np.concatenate([np.asarray(x) for x in a])[:B],
                                   *outs)
 
