@@ -18,6 +18,9 @@ the cases in one vmapped loop on a GPU).
   warm wall time of the whole study, per case and per step, and each chunk's; and the time of the
   compiled time loops alone (``batch._batch_jit``, timed in the threads that run them, per
   thread) and of the wave tables (``batch._tables``): the study against the stepping alone.
+- **The host's preparation alone**: the warm time of ``carried_loads_batch`` for the ``cases``
+  cases (the seas discretised together, the radiation's arrays for every dt, the excitation
+  brackets; what the batch does on the host before the device makes the tables), per case.
 - ``--reference PATH``: save the study's mean PTO power per case (``.npy``), or compare with a
   saved one (a CPU run against a GPU run: the largest relative difference is printed).
 """
@@ -90,6 +93,30 @@ def main(argv=None):
         print(f"as the issue measured it, (T({B} × 200) − T(1 × 200)) / {B - 1} − stepping: "
               f"{1e3 * (med[(B, 200)] - med[(1, 200)]) / (B - 1):.2f} ms per case in all "
               f"(stepping of 200 steps per case {1e3 * (med[(B, 400)] - med[(B, 200)]) / B:.2f} ms)")
+
+        # the host's part alone, timed directly (the extrapolation above differences two noisy
+        # times of which the stepping is most): the cases' loads made together
+        # (loads.assembly.carried_loads_batch: the seas discretised, the radiation's arrays for
+        # every dt, the excitation brackets), before the device makes their tables
+        from mfm.loads.assembly import carried_loads_batch
+        from mfm.timedomain import integrators
+        from mfm.timedomain.setup import stage_offsets
+
+        offsets = stage_offsets(integrators.get(kw["integrator"]))
+
+        def prepare():
+            carried_loads_batch(m, seas, dts=dts, ramps=5 * dts * 200, n_steps=200, t0=0.0,
+                                radiation=kw["radiation"], memory=None,
+                                state_space_options=None, stage_offsets=offsets)
+
+        prepare()
+        host = []
+        for _ in range(max(3, args.repeats)):
+            t = time.perf_counter()
+            prepare()
+            host.append(time.perf_counter() - t)
+        print(f"the host's preparation alone (carried_loads_batch, {B} cases, median of "
+              f"{len(host)}): {1e3 * statistics.median(host) / B:.3f} ms per case")
 
     if args.study:
         # the time each part's compiled loop and its tables take, from the threads that run them
