@@ -158,3 +158,25 @@ def test_outputs_computed_after_the_loop_equal_those_inside_it(monkeypatch):
         if np.issubdtype(after[v].dtype, np.number):
             np.testing.assert_allclose(after[v].values, inside[v].values, rtol=1e-12, atol=1e-12,
                                        err_msg=v)
+
+
+def test_simulate_records_every_output_but_not_the_loads_states():
+    """simulate keeps every output (:data:`OUTPUTS`) but no per-sample states z (its dataset has
+    none; an integrated state-space fit has ~10³ a sample): the rollout with OUTPUTS gives the
+    outputs of ``record=True`` to the last bit, and an empty z where that one has the fit's."""
+    from mfm.timedomain.record import OUTPUTS
+    from mfm.timedomain.setup import model_loads
+
+    m = mfm.load(CONFIGS / "rm3.toml")
+    loads = model_loads(m, hydro.Regular(height=1.0, period=8.0), dt=0.1, duration=3.0,
+                        ramp=1.0, radiation="state_space")
+    q0 = np.zeros(m.n_coordinates)
+    every = mfm.rollout(m, q0, q0, dt=0.1, n_steps=30, loads=loads, record=True)
+    kept = mfm.rollout(m, q0, q0, dt=0.1, n_steps=30, loads=loads, record=OUTPUTS)
+    assert every[4].shape[0] == 31 and every[4].shape[1] > 10
+    assert kept[4].shape == (31, 0)
+    for a, b in zip(every[:4] + every[5:6], kept[:4] + kept[5:6]):
+        np.testing.assert_array_equal(a, b)
+    assert every[6].keys() == kept[6].keys()
+    for k in every[6]:
+        np.testing.assert_array_equal(every[6][k], kept[6][k], err_msg=k)

@@ -86,6 +86,9 @@ class Recording:
 
 STATE = Recording((), True)
 EVERY = Recording(None, True)
+# every output without the loads' states per sample: what simulate keeps (its dataset has no z;
+# an integrated state-space fit has ~10³ states a sample, M4 134's 20,000 steps 161 MB)
+OUTPUTS = Recording(None, False)
 
 
 def output_names(outputs) -> tuple:
@@ -120,17 +123,17 @@ DEFERRED_RECORD_WIDTH = 32
 
 def deferred(carry, recording: Recording) -> bool:
     """Whether a recorded run evaluates its outputs after the time loop
-    (:func:`~mfm.timedomain.rollout.rollout_blocks`): every output is recorded and the loads'
-    memory is at most :data:`DEFERRED_RECORD_MEMORY` floats."""
+    (:func:`~mfm.timedomain.rollout.rollout_blocks`): every output is recorded (:data:`EVERY`,
+    :data:`OUTPUTS`) and the loads' memory is at most :data:`DEFERRED_RECORD_MEMORY` floats."""
     mem_size = sum(int(np.prod(np.shape(a))) for a in jax.tree_util.tree_leaves(carry[1]))
-    return recording == EVERY and mem_size <= DEFERRED_RECORD_MEMORY
+    return recording.every and mem_size <= DEFERRED_RECORD_MEMORY
 
 
-def outputs_after(model, loads, carries):
-    """The outputs (:func:`saved`, :data:`EVERY`) of stacked carries, in groups of a fixed
-    width: every sample is computed by the same vmapped program whatever their number, so a run
-    in chunks (progress bar) gives the same bits."""
-    return map_in_groups(lambda sm: saved(model, loads, *sm, EVERY), carries,
+def outputs_after(model, loads, carries, recording: Recording = EVERY):
+    """What ``recording`` (:data:`EVERY` or :data:`OUTPUTS`) keeps (:func:`saved`) of stacked
+    carries, in groups of a fixed width: every sample is computed by the same vmapped program
+    whatever their number, so a run in chunks (progress bar) gives the same bits."""
+    return map_in_groups(lambda sm: saved(model, loads, *sm, recording), carries,
                           DEFERRED_RECORD_WIDTH)
 
 

@@ -58,7 +58,8 @@ def rollout_start(model, loads, q0, qd0, z0, t0, dt, integrator, recording: Reco
     state = integrator.init(dynamics_function(model, loads, mem0), t0, q0, qd0, z0)
     carry = (state, mem0)
     if deferred(carry, recording):
-        one = outputs_after(model, loads, jax.tree_util.tree_map(lambda a: a[None], carry))
+        one = outputs_after(model, loads, jax.tree_util.tree_map(lambda a: a[None], carry),
+                            recording)
         return carry, jax.tree_util.tree_map(lambda a: a[0], one)
     return carry, saved(model, loads, state, mem0, recording)
 
@@ -86,7 +87,7 @@ def rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every,
 
     carry, out = jax.lax.scan(block, carry, None, length=n_blocks)
     if later and not keep_carries:
-        out = outputs_after(model, loads, out)
+        out = outputs_after(model, loads, out, recording)
     return carry, out
 
 
@@ -98,7 +99,8 @@ def rollout_impl(model, loads, q0, qd0, z0, t0, dt, n_steps, integrator, save_ev
     if deferred(carry, recording):
         # the initial sample's outputs in the same pass as the others': one copy of the outputs'
         # program to compile, not two (M4 134: ~4 s of a first call)
-        return _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every)[1]
+        return _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every,
+                                 recording)[1]
     first = saved(model, loads, *carry, recording)
     _, traj = rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, recording)
     return jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), first, traj)
@@ -115,7 +117,8 @@ def _chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every, recor
     return rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, recording)
 
 
-def _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every):
+def _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every,
+                      recording: Recording = EVERY):
     """``n_blocks`` blocks of a recorded run whose outputs are deferred (:func:`deferred`): the
     last carry, and the outputs of the incoming carry (the head) and of the blocks' saved
     carries in one pass (:func:`outputs_after`: each sample by the same vmapped program, so a
@@ -123,16 +126,18 @@ def _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every)
     carry_out, carries = rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every,
                                         EVERY, keep_carries=True)
     stacked = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), carry, carries)
-    return carry_out, outputs_after(model, loads, stacked)
+    return carry_out, outputs_after(model, loads, stacked, recording)
 
 
-def _headed_chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every):
+def _headed_chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every,
+                       recording: Recording = EVERY):
     """A chunk of a recorded run whose outputs are deferred (:func:`_blocks_with_head`). The
     host keeps the head of the first chunk only (the run's initial sample): the start then needs
     no outputs program of its own, and a first run compiles one copy of the outputs instead of
     two (RM3: the start's 4.7 of 14 s of compilation, cold)."""
     TRACES["rollout_chunk"] += 1
-    return _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every)
+    return _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every,
+                             recording)
 
 
 _start_jit = jax.jit(rollout_start, static_argnames=("integrator", "recording"))
@@ -143,7 +148,7 @@ _chunk_jit = jax.jit(_chunk_impl, static_argnames=("n_blocks", "integrator", "sa
 
 
 _headed_chunk_jit = jax.jit(_headed_chunk_impl, static_argnames=("n_blocks", "integrator",
-                                                                 "save_every"))
+                                                                 "save_every", "recording"))
 
 
 def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=None,
@@ -191,12 +196,14 @@ def _strong(tree):
     return jax.tree_util.tree_map(lambda a: jnp.asarray(a, a.dtype), tree)
 
 
-def prepare_progress(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0):
+def prepare_progress(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0,
+                     recording: Recording = EVERY):
     """Start a recorded run in chunks and compile its chunk, here and now; returns ``run(bar)``,
     which makes the chunks (:func:`~.progress.run_chunked`). Compiling before the bar's run lets
     :func:`~.simulation.simulate` do it while its checks' linearisation compiles on another
     thread (XLA compiles without the GIL): a first run waits for the longer of the two, not
-    their sum."""
+    their sum. ``recording``: :data:`~.record.EVERY` (``rollout``'s ``record=True``) or
+    :data:`~.record.OUTPUTS` (``simulate``'s: no loads' states per sample)."""
     began = time.perf_counter()
     parts = [ld.initial_state(model) for ld in loads]
     z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
@@ -208,16 +215,14 @@ def prepare_progress(model, q0, qd0, *, dt, n_steps, integrator, loads, save_eve
     memories = jax.eval_shape(lambda: init_memories(model, loads, t0, q0, qd0, dt))
     # the outputs of the initial sample come with the first chunk's (its head) where they are
     # deferred; else the start makes them, in the loop's way
-    headed = deferred((None, memories), EVERY)
-    recording = STATE if headed else EVERY
+    headed = deferred((None, memories), recording)
     start_args = (model, loads, q0, qd0, z0, t0, dt)
-    start_kw = dict(integrator=integrator, recording=recording)
-    kw = dict(n_blocks=c, integrator=integrator, save_every=save_every)
+    start_kw = dict(integrator=integrator, recording=STATE if headed else recording)
+    kw = dict(n_blocks=c, integrator=integrator, save_every=save_every, recording=recording)
     if headed:
         fn, name = _headed_chunk_jit, "rollout_chunk_headed"
     else:
         fn, name = _chunk_jit, "rollout_chunk"
-        kw["recording"] = EVERY
     # the chunk compiles on a second thread from the start's shapes while this one compiles and
     # runs the start: XLA compiles without the GIL, so on several cores the two overlap. Both
     # come from disk where an earlier process traced them (mfm._programs)

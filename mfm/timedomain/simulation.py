@@ -21,6 +21,7 @@ from .batch import simulate_batch  # noqa: F401  (exported)
 from .checks import (nonfinite_message, refuse_impossible, warn_accuracy, warn_stability,
                      warn_verlet_drift)
 from .progress import phase, progress_bar, progress_options
+from .record import OUTPUTS
 from .rollout import prepare_progress, rollout, rollout_call, rollout_jit  # noqa: F401
 from .setup import (choose_radiation, convolution_or_state_space, model_loads,  # noqa: F401
                     stage_offsets, state_space_update)
@@ -150,7 +151,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
         # before the checks' warnings
         run = None if progress is not None else rollout_call(
             model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
-            save_every=save_every, t0=t0, z0=None, record=True)
+            save_every=save_every, t0=t0, z0=None, record=OUTPUTS)
         if run is not None:
             # from disk where an earlier process traced it (mfm._programs)
             whole = _programs.program(rollout_jit, "rollout", run[0], run[1])
@@ -159,7 +160,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
             phase(bar, "compiling")
             run_with_bar = prepare_progress(model, q0, qd0, dt=dt, n_steps=n_steps,
                                             integrator=integ, loads=loads, save_every=save_every,
-                                            t0=t0)
+                                            t0=t0, recording=OUTPUTS)
         if check_stability:
             phase(bar, "linearising at q0 for the checks")
             ahead.result()
