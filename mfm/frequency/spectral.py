@@ -25,6 +25,7 @@ import time as _time
 
 import numpy as np
 import xarray as xr
+from hydro.seabatch import components_many
 
 from .. import results
 from ..loads.pto import linear_ptos, mean_absorbed_power
@@ -77,7 +78,7 @@ def _check_in_grid(model, seas, labels):
 
     grid = np.asarray(model.hydro.database()["omega"].values, dtype=float)
     grid = np.sort(grid[np.isfinite(grid)])
-    comps = [s.components(water_depth=model.hydro.water_depth, g=model.hydro.g) for s in seas]
+    comps = components_many(seas, water_depth=model.hydro.water_depth, g=model.hydro.g)
     for c, s, what in zip(comps, seas, labels):
         check_sea_in_grid(c, s, grid, what, rtol=GRID_RTOL)
     return comps

@@ -30,6 +30,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import xarray as xr
+from hydro.seabatch import components_many
 
 from .. import results
 from ..errors import OptimizeError
@@ -105,7 +106,7 @@ def _parameters(model, parameters, table):
 
 def _sea_union(model, seas, lds, radiation, state_space_options):
     """ω (U,), a² (S, U), Zb (U, 6K, 6K), X (U, 6K) on the union of the seas' (β, ω) pairs."""
-    comps = [s.components(water_depth=model.hydro.water_depth, g=model.hydro.g) for s in seas]
+    comps = components_many(seas, water_depth=model.hydro.water_depth, g=model.hydro.g)
     union, inverse, bounds = component_union(comps)
     a2 = np.zeros((len(seas), len(union)))
     for s, c in enumerate(comps):
