@@ -13,6 +13,8 @@ from hydro.waves import (  # noqa: E402,F401
     WaveComponents,
     elevation, ramp, wavenumber,
 )
+# many seas discretised at once (a study's), the same components as each sea's own
+from hydro.seabatch import components_many  # noqa: E402,F401
 from hydro.excitation import (  # noqa: E402,F401
     excitation_coefficients, excitation_dataarray, excitation_time_series,
 )
