@@ -564,11 +564,7 @@ def pierson_moskowitz_spectrum(omega, hs, tp) -> np.ndarray:
     w = np.asarray(omega, dtype=np.float64)
     out = np.zeros_like(w)
     pos = w > 0.0
-    if np.ndim(hs) == 0 and np.ndim(tp) == 0:
-        wp = 2.0 * math.pi / tp
-        r = wp / w[pos]
-        out[pos] = (5.0 / 16.0) * hs * hs / wp * r**5 * np.exp(-1.25 * r**4)
-        return out
+    # elementwise, so a number and an array of it give the same bits
     hs, tp = (np.broadcast_to(np.asarray(a, dtype=np.float64), w.shape)[pos] for a in (hs, tp))
     wp = 2.0 * math.pi / tp
     r = wp / w[pos]
@@ -598,7 +594,7 @@ def jonswap_normalisation(gamma: float, method: str = "exact") -> float:
     "exact": 1 / ∫₀^∞ 5 x⁻⁵ e^{−1.25 x⁻⁴} γ^{r(x)} dx (adaptive quadrature, split at the peak x = 1;
     the PM shape 5x⁻⁵e^{−1.25x⁻⁴} integrates to 1). "dnv": the DNV-RP-C205 approximation
     1 − 0.287 ln γ (within about 1 % for 1 <= γ <= 7). Kept per (γ, method): a study's thousands
-    of seas of one γ paid the two quadratures each (1.7 ms of a sea's construction).
+    of seas of one γ paid the two quadratures each (~1 ms of a sea's construction).
     """
     if method == "dnv":
         return 1.0 - 0.287 * math.log(gamma)
