@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import functools
 import math
-import warnings
 
 import numpy as np
 
@@ -88,38 +87,18 @@ def components_many(seas, water_depth: float = math.inf, g: float = _w.G_STANDAR
     hs = np.array([s.hs for s in peaked])
     tp = np.array([s.tp for s in peaked])
 
-    # breaking, as _PeakSea.components: H_s against 0.142 L tanh(kh) at the peak period
-    k = _w.wavenumber(2.0 * math.pi / tp, h, g)
-    limit = _w.BREAKING_STEEPNESS * (2.0 * math.pi / k) * (np.tanh(k * h) if math.isfinite(h)
-                                                           else 1.0)
-    broken = np.flatnonzero(hs > limit)
-    if broken.size:             # that sea's own call gives the error
-        peaked[broken[0]].components(water_depth=h, g=g)
+    # breaking, as _PeakSea.components: H_s against Miche's height at the peak period
+    broken = np.flatnonzero(hs > _w.breaking_height(tp, h, g))
+    if broken.size:             # that sea's own check gives the error
+        peaked[broken[0]]._refuse_breaking(h, g)
 
     for j in np.flatnonzero(_band_fractions(peaked) < _w.BAND_ENERGY_MIN):
-        with warnings.catch_warnings():     # the sea's own warning, raised as it would be
-            warnings.simplefilter("error", _w.SeaStateWarning)
-            try:
-                peaked[j].components(water_depth=h, g=g)
-            except _w.SeaStateWarning as warning:
-                message = warning
-            else:       # within the tables' 1e-6 of the threshold: its own check kept it
-                continue
-        warnings.warn(message, stacklevel=2)
+        # the sea's own quadrature decides and words it, as in its own call (the tables are
+        # within 1e-6 of it)
+        peaked[j]._warn_band(peaked[j].band_energy_fraction(), stacklevel=3)
 
     # each sea's draws from its own seed, as _SpectralSea.components
-    omega, dw, phase, heading = [], [], [], []
-    for s in peaked:
-        rng_jitter, rng_phase, rng_dir = _w._sea_streams(s.seed)
-        w, d = _w._frequencies(s.band, s.n_components, s.repeat_period, s.frequency_jitter,
-                               rng_jitter)
-        omega.append(w)
-        dw.append(d)
-        phase.append(rng_phase.uniform(0.0, 2.0 * math.pi, size=w.shape[0]))
-        beta = np.full(w.shape[0], s.heading)
-        if s.spreading is not None:
-            beta = beta + s.spreading.sample(rng_dir, w.shape[0])
-        heading.append(beta)
+    omega, dw, phase, heading = zip(*(s._draws() for s in peaked))
     counts = np.array([len(w) for w in omega])
     each = lambda a: np.repeat(a, counts)  # noqa: E731
     w_all = np.concatenate(omega)

@@ -370,13 +370,15 @@ def _heading_label(heading) -> str:
 BREAKING_STEEPNESS = 0.142
 
 
-def breaking_height(period: float, water_depth: float = math.inf, g: float = G_STANDARD) -> float:
+def breaking_height(period, water_depth: float = math.inf, g: float = G_STANDARD):
     """The highest wave (m, crest to trough) of ``period`` (s) in water of ``water_depth`` (m):
     H_b = 0.142 L tanh(k h) (Miche), L = 2π/k from ω² = g k tanh(k h); past it the wave breaks
-    and linear (Airy) theory, the BEM excitation and the elevation stand for nothing real."""
-    k = float(wavenumber(2.0 * math.pi / period, water_depth, g))
+    and linear (Airy) theory, the BEM excitation and the elevation stand for nothing real.
+    ``period`` a number (a float back) or an array (elementwise: many seas' peaks at once)."""
+    k = wavenumber(2.0 * math.pi / np.asarray(period, dtype=np.float64), water_depth, g)
     h = _water_depth(water_depth)
-    return BREAKING_STEEPNESS * (2.0 * math.pi / k) * (math.tanh(k * h) if math.isfinite(h) else 1.0)
+    out = BREAKING_STEEPNESS * (2.0 * math.pi / k) * (np.tanh(k * h) if math.isfinite(h) else 1.0)
+    return float(out) if np.ndim(out) == 0 else out
 
 
 def _check_breaking(what: str, height: float, period: float, water_depth, g):
@@ -535,7 +537,14 @@ class _SpectralSea:
 
         A band that keeps less than BAND_ENERGY_MIN of the spectrum's variance (its sea is then
         more than 5 % lower than the stated Hs) warns with a :class:`SeaStateWarning`."""
-        frac = self.band_energy_fraction()
+        self._warn_band(self.band_energy_fraction(), stacklevel=3)
+        w, dw, phase, heading = self._draws()
+        amp = np.sqrt(2.0 * np.maximum(self.spectrum(w), 0.0) * dw)
+        return _make_components(w, amp, phase, heading, water_depth, g, self.repeat_period)
+
+    def _warn_band(self, frac: float, stacklevel: int):
+        """The :class:`SeaStateWarning` of :meth:`components` where the band keeps a fraction
+        ``frac`` < BAND_ENERGY_MIN of the variance (``stacklevel``: from this method)."""
         if frac < BAND_ENERGY_MIN:
             lo, hi = self.band
             peak = getattr(self, "omega_peak", None)
@@ -546,15 +555,17 @@ class _SpectralSea:
                 f"Hs = {math.sqrt(frac):.3g} × the stated one; accepted without this warning: a band "
                 f"keeping >= {BAND_ENERGY_MIN:g} (Hs within 5 %). Widen omega_range to cover the "
                 "spectrum (the default band does), or, if the cut is meant, restate the sea so that "
-                "the band holds its energy", SeaStateWarning, stacklevel=2)
+                "the band holds its energy", SeaStateWarning, stacklevel=stacklevel)
+
+    def _draws(self):
+        """What the sea's seed decides: ω_j, Δω_j, φ_j ~ U[0, 2π), β_j = heading (+ spread)."""
         rng_jitter, rng_phase, rng_dir = _sea_streams(self.seed)
         w, dw = _frequencies(self.band, self.n_components, self.repeat_period, self.frequency_jitter, rng_jitter)
-        amp = np.sqrt(2.0 * np.maximum(self.spectrum(w), 0.0) * dw)
         phase = rng_phase.uniform(0.0, 2.0 * math.pi, size=w.shape[0])
         heading = np.full(w.shape[0], self.heading)
         if self.spreading is not None:
             heading = heading + self.spreading.sample(rng_dir, w.shape[0])
-        return _make_components(w, amp, phase, heading, water_depth, g, self.repeat_period)
+        return w, dw, phase, heading
 
 
 def pierson_moskowitz_spectrum(omega, hs, tp) -> np.ndarray:
@@ -638,8 +649,11 @@ class _PeakSea(_SpectralSea):
         """As :meth:`_SpectralSea.components`; a sea whose significant height would break as a
         regular wave of its peak period (:func:`breaking_height`; realistic seas stay below about
         half of it, a significant steepness 2π Hs/(g Tp²) of 1/15, DNV-RP-C205 §3.5.5) is refused."""
-        _check_breaking(f"{type(self).__name__}: hs", self.hs, self.tp, water_depth, g)
+        self._refuse_breaking(water_depth, g)
         return super().components(water_depth=water_depth, g=g)
+
+    def _refuse_breaking(self, water_depth, g):
+        _check_breaking(f"{type(self).__name__}: hs", self.hs, self.tp, water_depth, g)
 
     def _default_range(self):
         return (DEFAULT_BAND[0] * self.omega_peak, DEFAULT_BAND[1] * self.omega_peak)
