@@ -328,6 +328,7 @@ class ExactStateSpace(StateSpace):
         else:
             zr, zi = (E[0] * ar - E[1] * ai + G[0] * un + H[0] * du,
                       E[0] * ai + E[1] * ar + G[1] * un + H[1] * du)
+        ar, ai = zr, zi             # the memory's next states: zₙ₊₁, or e^{p dt} zₙ₊₁ below
         rows = [None] * len(self.stage_offsets)
         if self.matvec_stages:
             er, ei = self.CE[:, 0], self.CE[:, 1]                        # (n_c, n_b, n_p)
@@ -340,8 +341,6 @@ class ExactStateSpace(StateSpace):
             if self._carries_free_response:
                 k = self.matvec_stages.index(self._end)
                 ar, ai = wr[k], wi[k]
-        if not self._carries_free_response:
-            ar, ai = zr, zi
         for s, c in enumerate(self.stage_offsets):
             if rows[s] is None:
                 # c = 0: Re(R zₙ₊₁) = the full step's stage output of zₙ and the inputs
