@@ -13,9 +13,11 @@ at dt = T_p/200 (20,000 steps), ramp 5 T_p. Rows, each compiled once and then ti
   state space's states advance (the exact update);
 - ``verlet + state_space_exact``: the fast path.
 
-Beside each, the compiled time loop alone (``mfm.rollout`` with the same loads, nothing recorded):
-what the rest of the call (the loads' preparation, recording every output of every step, the
-checks, the dataset) adds.
+Beside each, the same call with its outputs made after the time loop instead of beside it
+(one chunk, no pipeline: :func:`mfm.timedomain.progress.run_pipelined`), timed in turn with it,
+and the median of the pairs' ratios (this tree's call / that one); and the compiled time loop
+alone (``mfm.rollout`` with the same loads, nothing recorded): what the rest of the call (the
+loads' preparation, recording every output of every step, the checks, the dataset) adds.
 
 Accuracy, the issue's criterion: the hinge angles' rms θ_rms and the mean PTO power over the last
 80 T_p against RK4 at dt/4 with the states integrated (``radiation="state_space"``, every 4th
@@ -26,6 +28,7 @@ after the other, and say which machine.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import time
 import warnings
@@ -36,6 +39,20 @@ os.environ.setdefault("MFM_COMPILATION_CACHE", "off")     # compile times are no
 os.environ.setdefault("MFM_FIT_CACHE", "off")             # but nothing read from an earlier run
 
 TP, N = 1.2, 20_000
+
+
+@contextlib.contextmanager
+def one_chunk():
+    """simulate's outputs made after its time loop, not beside it (one chunk: no pipeline,
+    :func:`mfm.timedomain.progress.pipeline_plan`), for the column that compares the two."""
+    from mfm.timedomain import progress
+
+    kept = progress.PIPELINE_MIN_STEPS
+    progress.PIPELINE_MIN_STEPS = 2**62
+    try:
+        yield
+    finally:
+        progress.PIPELINE_MIN_STEPS = kept
 
 
 def measures(ds, keep_from):
@@ -72,18 +89,25 @@ def main():
     print(f"M4 134, {N} steps at dt = {dt:g} s; accuracy against RK4 at dt/4 (state space "
           f"integrated) over the last 80 T_p: θ_rms {np.round(theta_ref, 5).tolist()} rad, "
           f"power {power_ref:.6g} W")
-    print("| run | warm median (least) | first call | the loop alone | θ_rms error | power error "
-          "| radiation |")
-    print("|---|---|---|---|---|---|---|")
+    print("| run | warm median (least) | first call | outputs after the loop (ratio) | the loop "
+          "alone | θ_rms error | power error | radiation |")
+    print("|---|---|---|---|---|---|---|---|")
     for name, options in rows:
         t0 = time.perf_counter()
         ds = mfm.simulate(m, sea, dt=dt, **kw, **options)
         first = time.perf_counter() - t0
-        times = []
+        with one_chunk():
+            mfm.simulate(m, sea, dt=dt, **kw, **options)          # its own programs compiled
+        times, serial = [], []
         for _ in range(args.repeats):
+            # the two ways in turn, so that the ratio holds when the machine's speed drifts
             t0 = time.perf_counter()
             ds = mfm.simulate(m, sea, dt=dt, **kw, **options)
             times.append(time.perf_counter() - t0)
+            with one_chunk():
+                t0 = time.perf_counter()
+                mfm.simulate(m, sea, dt=dt, **kw, **options)
+                serial.append(time.perf_counter() - t0)
         theta, power = measures(ds, keep)
         integ = options.get("integrator", "rk4")
         loads = model_loads(m, sea, dt=dt, radiation=ds.attrs["radiation"], integrator=integ,
@@ -102,8 +126,9 @@ def main():
             loops.append(time.perf_counter() - t0)
         e_theta = float(np.max(np.abs(theta / theta_ref - 1)))
         e_power = abs(power / power_ref - 1)
+        ratio = np.median(np.asarray(times) / np.asarray(serial))
         print(f"| {name} | {np.median(times):.3f} s ({min(times):.3f}) | {first:.1f} s | "
-              f"{np.median(loops):.3f} s | "
+              f"{np.median(serial):.3f} s ({ratio:.2f}) | {np.median(loops):.3f} s | "
               f"{e_theta:.1e} | {e_power:.1e} | {ds.attrs['radiation']} |")
         if name == "defaults":
             choice = ds.attrs["radiation_choice"]

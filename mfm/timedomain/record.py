@@ -1,7 +1,8 @@
 """What a run records of each saved state (:class:`Recording`): the state itself, and the
 outputs (poses, joint reactions, energies, the loads' diagnostics), every one or those named,
 computed inside the time loop or, for a small load memory, after it in one vmapped pass over the
-saved samples."""
+saved samples (which :func:`~mfm.simulate` makes chunk by chunk beside the loop:
+:func:`~mfm.timedomain.progress.run_pipelined`)."""
 from __future__ import annotations
 
 import dataclasses

@@ -19,7 +19,7 @@ from ..mechanics.kinematics import kinematics
 from ..mechanics.model import Model
 from ..validation import positive_seconds, whole_number
 from . import integrators as _integrators
-from .progress import chunk_plan, run_chunked
+from .progress import chunk_plan, pipeline_plan, run_chunked, run_pipelined
 from .record import EVERY, STATE, Recording, deferred, outputs_after, saved
 
 
@@ -129,15 +129,21 @@ def _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every,
     return carry_out, outputs_after(model, loads, stacked, recording)
 
 
-def _headed_chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every,
-                       recording: Recording = EVERY):
-    """A chunk of a recorded run whose outputs are deferred (:func:`_blocks_with_head`). The
-    host keeps the head of the first chunk only (the run's initial sample): the start then needs
-    no outputs program of its own, and a first run compiles one copy of the outputs instead of
-    two (RM3: the start's 4.7 of 14 s of compilation, cold)."""
+def _steps_impl(model, loads, carry, dt, n_blocks, integrator, save_every):
+    """A chunk of a pipelined run (:func:`~.progress.run_pipelined`): ``n_blocks`` blocks from
+    ``carry``, the carry after them and each block's saved carry, stacked; no outputs."""
     TRACES["rollout_chunk"] += 1
-    return _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every,
-                             recording)
+    return rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, EVERY,
+                          keep_carries=True)
+
+
+def _outputs_impl(model, loads, head, carries, recording: Recording = EVERY):
+    """What ``recording`` keeps of a pipelined chunk's samples: the incoming carry (the head),
+    then the chunk's saved carries, by :func:`outputs_after` (each sample the same vmapped
+    computation as in a run made in one call)."""
+    TRACES["rollout_outputs"] += 1
+    stacked = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), head, carries)
+    return outputs_after(model, loads, stacked, recording)
 
 
 _start_jit = jax.jit(rollout_start, static_argnames=("integrator", "recording"))
@@ -147,8 +153,10 @@ _chunk_jit = jax.jit(_chunk_impl, static_argnames=("n_blocks", "integrator", "sa
                                                    "recording"))
 
 
-_headed_chunk_jit = jax.jit(_headed_chunk_impl, static_argnames=("n_blocks", "integrator",
-                                                                 "save_every", "recording"))
+_steps_jit = jax.jit(_steps_impl, static_argnames=("n_blocks", "integrator", "save_every"))
+
+
+_outputs_jit = jax.jit(_outputs_impl, static_argnames=("recording",))
 
 
 def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=None,
@@ -196,14 +204,22 @@ def _strong(tree):
     return jax.tree_util.tree_map(lambda a: jnp.asarray(a, a.dtype), tree)
 
 
-def prepare_progress(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0,
-                     recording: Recording = EVERY):
-    """Start a recorded run in chunks and compile its chunk, here and now; returns ``run(bar)``,
-    which makes the chunks (:func:`~.progress.run_chunked`). Compiling before the bar's run lets
-    :func:`~.simulation.simulate` do it while its checks' linearisation compiles on another
-    thread (XLA compiles without the GIL): a first run waits for the longer of the two, not
-    their sum. ``recording``: :data:`~.record.EVERY` (``rollout``'s ``record=True``) or
-    :data:`~.record.OUTPUTS` (``simulate``'s: no loads' states per sample)."""
+def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0,
+                recording: Recording = EVERY, chunked: bool = False):
+    """Start a recorded run and compile its programs, here and now; returns ``run(bar)``, which
+    makes the run and gives what ``recording`` keeps of each saved step (numpy or jax arrays,
+    the initial state first). Compiling before ``run`` lets :func:`~.simulation.simulate` do it
+    while its checks' linearisation compiles on another thread (XLA compiles without the GIL): a
+    first run waits for the longer of the two, not their sum.
+
+    ``recording``: :data:`~.record.EVERY` (``rollout``'s ``record=True``) or
+    :data:`~.record.OUTPUTS` (``simulate``'s: no loads' states per sample). Where its outputs
+    are made after the time loop (:func:`~.record.deferred`: a small load memory), the run is
+    pipelined (:func:`~.progress.run_pipelined`): chunks of steps on this thread, each chunk's
+    outputs on another as the next one steps; ``chunked`` (a progress bar) in 20 to 100 chunks
+    (:func:`~.progress.chunk_plan`), else in up to 8 (:func:`~.progress.pipeline_plan`). Else
+    the outputs are made inside the loop: in one program, or with ``chunked`` in chunks of one
+    (:func:`~.progress.run_chunked`). The same numbers every way."""
     began = time.perf_counter()
     parts = [ld.initial_state(model) for ld in loads]
     z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
@@ -211,46 +227,64 @@ def prepare_progress(model, q0, qd0, *, dt, n_steps, integrator, loads, save_eve
     t0, dt = jnp.asarray(t0, jnp.float64), jnp.asarray(dt, jnp.float64)
     model, loads = compile_view(model, loads)
     n_blocks = n_steps // save_every
-    c, _ = chunk_plan(n_blocks)
     memories = jax.eval_shape(lambda: init_memories(model, loads, t0, q0, qd0, dt))
-    # the outputs of the initial sample come with the first chunk's (its head) where they are
-    # deferred; else the start makes them, in the loop's way
-    headed = deferred((None, memories), recording)
+    pipelined = deferred((None, memories), recording)
     start_args = (model, loads, q0, qd0, z0, t0, dt)
-    start_kw = dict(integrator=integrator, recording=STATE if headed else recording)
-    kw = dict(n_blocks=c, integrator=integrator, save_every=save_every, recording=recording)
-    if headed:
-        fn, name = _headed_chunk_jit, "rollout_chunk_headed"
+    if not (pipelined or chunked):
+        # the outputs inside the loop (a convolution's history is too large to keep per step):
+        # the whole run, one program (from disk where an earlier process traced it)
+        opts = dict(n_steps=n_steps, integrator=integrator, save_every=save_every,
+                    record=recording)
+        whole = _programs.program(rollout_jit, "rollout", start_args, opts)
+        whole.compile(*start_args)
+        return lambda bar: whole(*start_args)
+    if pipelined:
+        c, _ = chunk_plan(n_blocks) if chunked else pipeline_plan(n_blocks, save_every)
     else:
-        fn, name = _chunk_jit, "rollout_chunk"
-    # the chunk compiles on a second thread from the start's shapes while this one compiles and
-    # runs the start: XLA compiles without the GIL, so on several cores the two overlap. Both
-    # come from disk where an earlier process traced them (mfm._programs)
+        c, _ = chunk_plan(n_blocks)
+    start_kw = dict(integrator=integrator, recording=STATE if pipelined else recording)
+    # the chunk's programs compile on other threads from the start's shapes while this one
+    # compiles and runs the start: XLA compiles without the GIL, so on several cores they
+    # overlap. All come from disk where an earlier process traced them (mfm._programs)
     start = _programs.program(_start_jit, "rollout_start", start_args, start_kw)
     # the carry strongly typed, however the start was made (a saved program keeps no weak types),
     # so that the chunk is one program, one key (the same dtypes: the same numbers)
     shapes = jax.tree_util.tree_map(lambda a: jax.ShapeDtypeStruct(a.shape, a.dtype),
                                     start.shapes(*start_args)[0])
 
-    def chunk_program():
-        made = _programs.program(fn, name, (model, loads, shapes, dt), kw)
-        made.compile(model, loads, shapes, dt)
+    def compiled(fn, name, args, kw):
+        made = _programs.program(fn, name, args, kw)
+        made.compile(*args)
         return made
 
-    pool = concurrent.futures.ThreadPoolExecutor(1)
+    pool = concurrent.futures.ThreadPoolExecutor(2)
     try:
-        ahead = pool.submit(chunk_program)
+        if pipelined:
+            stacked = jax.tree_util.tree_map(
+                lambda a: jax.ShapeDtypeStruct((c,) + a.shape, a.dtype), shapes)
+            ahead = [pool.submit(compiled, _steps_jit, "rollout_steps", (model, loads, shapes, dt),
+                                 dict(n_blocks=c, integrator=integrator, save_every=save_every)),
+                     pool.submit(compiled, _outputs_jit, "rollout_outputs",
+                                 (model, loads, shapes, stacked), dict(recording=recording))]
+        else:
+            ahead = [pool.submit(compiled, _chunk_jit, "rollout_chunk", (model, loads, shapes, dt),
+                                 dict(n_blocks=c, integrator=integrator, save_every=save_every,
+                                      recording=recording))]
         carry, first = start(*start_args)
         carry = _strong(carry)
-        run_chunk = ahead.result()
+        made = [f.result() for f in ahead]
     finally:
         pool.shutdown(wait=False)
-    if headed:
-        first = None
+    if pipelined:
+        steps, outputs = made
+        return lambda bar: run_pipelined(
+            carry, lambda cr: steps(model, loads, _strong(cr), dt),
+            lambda head, carries: outputs(model, loads, head, carries), c, n_blocks,
+            save_every, bar, began)
 
     def chunk(carry, n):
         assert n == c, (n, c)          # one chunk length: the one compiled
-        return run_chunk(model, loads, _strong(carry), dt)
+        return made[0](model, loads, _strong(carry), dt)
 
     return lambda bar: run_chunked(lambda: (carry, first), chunk, n_blocks, save_every, bar,
                                    time_axis=0, began=began)

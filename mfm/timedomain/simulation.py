@@ -10,7 +10,7 @@ import concurrent.futures
 import numpy as np
 import xarray as xr
 
-from .. import _programs, results
+from .. import results
 from ..errors import AccuracyWarning, SimulationError, StabilityWarning  # noqa: F401  (exported)
 from ..frequency import rest
 from ..loads.assembly import as_loads
@@ -22,7 +22,7 @@ from .checks import (nonfinite_message, refuse_impossible, warn_accuracy, warn_s
                      warn_verlet_drift)
 from .progress import phase, progress_bar, progress_options
 from .record import OUTPUTS
-from .rollout import prepare_progress, rollout, rollout_call, rollout_jit  # noqa: F401
+from .rollout import prepare_run, rollout, rollout_call, rollout_jit  # noqa: F401
 from .setup import (choose_radiation, convolution_or_state_space, model_loads,  # noqa: F401
                     stage_offsets, state_space_update)
 
@@ -146,21 +146,13 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                             radiation=radiation, memory=memory,
                             state_space_options=state_space_options, added_mass=added_mass,
                             integrator=integ) + extra
-        # the recorded run (in one call, or its start and chunk for a bar), compiled here:
-        # beside the jet's compile where the water builds faster than that (no fit), and
+        # the recorded run (its programs: the whole run, or its start and chunks), compiled here:
+        # beside the jet's compilation where the water builds faster than that (no fit), and
         # before the checks' warnings
-        run = None if progress is not None else rollout_call(
-            model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
-            save_every=save_every, t0=t0, z0=None, record=OUTPUTS)
-        if run is not None:
-            # from disk where an earlier process traced it (mfm._programs)
-            whole = _programs.program(rollout_jit, "rollout", run[0], run[1])
-            whole.compile(*run[0])
-        else:
-            phase(bar, "compiling")
-            run_with_bar = prepare_progress(model, q0, qd0, dt=dt, n_steps=n_steps,
-                                            integrator=integ, loads=loads, save_every=save_every,
-                                            t0=t0, recording=OUTPUTS)
+        phase(bar, "compiling")
+        run = prepare_run(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
+                          save_every=save_every, t0=t0, recording=OUTPUTS,
+                          chunked=bar is not None)
         if check_stability:
             phase(bar, "linearising at q0 for the checks")
             ahead.result()
@@ -179,10 +171,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     if sea is not None:
         warn_accuracy(model, sea, dt, integ)
     warn_verlet_drift(integ, free)
-    if bar is None:
-        out = whole(*run[0])
-    else:
-        out = run_with_bar(bar)
+    out = run(bar)
     t, q, qd, qdd, z, iters = (np.asarray(a) for a in out[:6])
     rec = {k: np.asarray(v) for k, v in out[6].items()}
     settings = dict(duration=duration, n_steps=n_steps, save_every=int(save_every), t0=t0,
