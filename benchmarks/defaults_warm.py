@@ -14,7 +14,8 @@ at dt = T_p/200 (20,000 steps), ramp 5 T_p. Rows, each compiled once and then ti
 - ``verlet + state_space_exact``: the fast path.
 
 Beside each, the same call with its outputs made after the time loop instead of beside it
-(one chunk, no pipeline: :func:`mfm.timedomain.progress.run_pipelined`), timed in turn with it,
+(in one program, as a run shorter than ``mfm.timedomain.progress.PIPELINE_MIN_STEPS`` makes them;
+the pipeline: :func:`mfm.timedomain.progress.run_pipelined`), timed in turn with it,
 and the median of the pairs' ratios (this tree's call / that one); and the compiled time loop
 alone (``mfm.rollout`` with the same loads, nothing recorded): what the rest of the call (the
 loads' preparation, recording every output of every step, the checks, the dataset) adds.
@@ -42,9 +43,10 @@ TP, N = 1.2, 20_000
 
 
 @contextlib.contextmanager
-def one_chunk():
-    """simulate's outputs made after its time loop, not beside it (one chunk: no pipeline,
-    :func:`mfm.timedomain.progress.pipeline_plan`), for the column that compares the two."""
+def one_program():
+    """simulate's outputs made after its time loop in the same program, not beside it (no
+    pipeline: :data:`mfm.timedomain.progress.PIPELINE_MIN_STEPS` raised), for the column that
+    compares the two."""
     from mfm.timedomain import progress
 
     kept = progress.PIPELINE_MIN_STEPS
@@ -96,7 +98,7 @@ def main():
         t0 = time.perf_counter()
         ds = mfm.simulate(m, sea, dt=dt, **kw, **options)
         first = time.perf_counter() - t0
-        with one_chunk():
+        with one_program():
             mfm.simulate(m, sea, dt=dt, **kw, **options)          # its own programs compiled
         times, serial = [], []
         for _ in range(args.repeats):
@@ -104,7 +106,7 @@ def main():
             t0 = time.perf_counter()
             ds = mfm.simulate(m, sea, dt=dt, **kw, **options)
             times.append(time.perf_counter() - t0)
-            with one_chunk():
+            with one_program():
                 t0 = time.perf_counter()
                 mfm.simulate(m, sea, dt=dt, **kw, **options)
                 serial.append(time.perf_counter() - t0)

@@ -23,20 +23,20 @@ def chunk_plan(n_blocks: int, fewest: int = 20, most: int = 100) -> tuple[int, i
     return c, -(-n_blocks // c)
 
 
-# a run without a bar is pipelined (:func:`run_pipelined`) in this many chunks at most, and only
-# from this many steps: each chunk costs two program calls and a hand-over between threads
-# (~0.1 ms), and the outputs of the last chunk are not hidden behind any stepping
+# a recorded run of this many steps or more is pipelined (:func:`run_pipelined`): its outputs
+# made on a second thread as the loop goes on. It then has two programs to compile instead of
+# one (RM3's README command, 2,000 steps with empty caches: ~2 s more on 2 cores), which a
+# shorter run's outputs (~20 µs a sample at most, M4 134's) would not pay back
+PIPELINE_MIN_STEPS = 10_000
+# without a bar, in this many chunks at most: each costs two program calls and a hand-over
+# between threads (~0.1 ms), and the last chunk's outputs are not hidden behind any stepping
 PIPELINE_CHUNKS = 8
-PIPELINE_MIN_STEPS = 2_000
 
 
-def pipeline_plan(n_blocks: int, save_every: int) -> tuple[int, int]:
-    """(chunk length in saved blocks, number of chunks) for a run without a bar whose outputs are
-    made apart from its steps (:func:`run_pipelined`): 4 to :data:`PIPELINE_CHUNKS` chunks of one
-    length, the fewest blocks wasted past the end (:func:`chunk_plan`); one chunk for a run of
-    fewer than :data:`PIPELINE_MIN_STEPS` steps."""
-    if n_blocks * save_every < PIPELINE_MIN_STEPS or n_blocks < 4:
-        return n_blocks, 1
+def pipeline_plan(n_blocks: int) -> tuple[int, int]:
+    """(chunk length in saved blocks, number of chunks) for a pipelined run without a bar
+    (:func:`run_pipelined`): 4 to :data:`PIPELINE_CHUNKS` chunks of one length, the fewest
+    blocks wasted past the end (:func:`chunk_plan`)."""
     return chunk_plan(n_blocks, fewest=4, most=PIPELINE_CHUNKS)
 
 

@@ -19,7 +19,8 @@ from ..mechanics.kinematics import kinematics
 from ..mechanics.model import Model
 from ..validation import positive_seconds, whole_number
 from . import integrators as _integrators
-from .progress import chunk_plan, pipeline_plan, run_chunked, run_pipelined
+from . import progress
+from .progress import chunk_plan, run_chunked, run_pipelined
 from .record import EVERY, STATE, Recording, deferred, outputs_after, saved
 
 
@@ -129,6 +130,18 @@ def _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every,
     return carry_out, outputs_after(model, loads, stacked, recording)
 
 
+def _headed_chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every,
+                       recording: Recording = EVERY):
+    """A chunk of a recorded run whose outputs are deferred (:func:`_blocks_with_head`), in one
+    program with its steps (a run too short to pipeline, :data:`~.progress.PIPELINE_MIN_STEPS`).
+    The host keeps the head of the first chunk only (the run's initial sample): the start then
+    needs no outputs program of its own, and a first run compiles one copy of the outputs instead
+    of two (RM3: the start's 4.7 of 14 s of compilation, cold)."""
+    TRACES["rollout_chunk"] += 1
+    return _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every,
+                             recording)
+
+
 def _steps_impl(model, loads, carry, dt, n_blocks, integrator, save_every):
     """A chunk of a pipelined run (:func:`~.progress.run_pipelined`): ``n_blocks`` blocks from
     ``carry``, the carry after them and each block's saved carry, stacked; no outputs."""
@@ -151,6 +164,10 @@ _start_jit = jax.jit(rollout_start, static_argnames=("integrator", "recording"))
 
 _chunk_jit = jax.jit(_chunk_impl, static_argnames=("n_blocks", "integrator", "save_every",
                                                    "recording"))
+
+
+_headed_chunk_jit = jax.jit(_headed_chunk_impl, static_argnames=("n_blocks", "integrator",
+                                                                 "save_every", "recording"))
 
 
 _steps_jit = jax.jit(_steps_impl, static_argnames=("n_blocks", "integrator", "save_every"))
@@ -214,11 +231,14 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
 
     ``recording``: :data:`~.record.EVERY` (``rollout``'s ``record=True``) or
     :data:`~.record.OUTPUTS` (``simulate``'s: no loads' states per sample). Where its outputs
-    are made after the time loop (:func:`~.record.deferred`: a small load memory), the run is
-    pipelined (:func:`~.progress.run_pipelined`): chunks of steps on this thread, each chunk's
-    outputs on another as the next one steps; ``chunked`` (a progress bar) in 20 to 100 chunks
-    (:func:`~.progress.chunk_plan`), else in up to 8 (:func:`~.progress.pipeline_plan`). Else
-    the outputs are made inside the loop: in one program, or with ``chunked`` in chunks of one
+    are made after the time loop (:func:`~.record.deferred`: a small load memory) and the run
+    has at least :data:`~.progress.PIPELINE_MIN_STEPS` steps, it is pipelined
+    (:func:`~.progress.run_pipelined`): chunks of steps on this thread, each chunk's outputs on
+    another as the next one steps; ``chunked`` (a progress bar) in 20 to 100 chunks
+    (:func:`~.progress.chunk_plan`), else in up to 8 (:func:`~.progress.pipeline_plan`).
+    Shorter runs make their outputs after the loop in the same program (one program to compile
+    instead of two), and a large memory (a convolution's history) makes them inside the loop: the
+    whole run in one program, or with ``chunked`` in chunks of one
     (:func:`~.progress.run_chunked`). The same numbers every way."""
     began = time.perf_counter()
     parts = [ld.initial_state(model) for ld in loads]
@@ -228,21 +248,21 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
     model, loads = compile_view(model, loads)
     n_blocks = n_steps // save_every
     memories = jax.eval_shape(lambda: init_memories(model, loads, t0, q0, qd0, dt))
-    pipelined = deferred((None, memories), recording)
+    headed = deferred((None, memories), recording)
+    pipelined = headed and n_steps >= progress.PIPELINE_MIN_STEPS
     start_args = (model, loads, q0, qd0, z0, t0, dt)
     if not (pipelined or chunked):
-        # the outputs inside the loop (a convolution's history is too large to keep per step):
-        # the whole run, one program (from disk where an earlier process traced it)
+        # the whole run, one program (from disk where an earlier process traced it); its outputs
+        # after the loop (rollout_impl), or inside it for a large memory
         opts = dict(n_steps=n_steps, integrator=integrator, save_every=save_every,
                     record=recording)
         whole = _programs.program(rollout_jit, "rollout", start_args, opts)
         whole.compile(*start_args)
         return lambda bar: whole(*start_args)
-    if pipelined:
-        c, _ = chunk_plan(n_blocks) if chunked else pipeline_plan(n_blocks, save_every)
-    else:
-        c, _ = chunk_plan(n_blocks)
-    start_kw = dict(integrator=integrator, recording=STATE if pipelined else recording)
+    c, _ = progress.pipeline_plan(n_blocks) if pipelined and not chunked else chunk_plan(n_blocks)
+    # the outputs of the initial sample come with the first chunk's (its head) where they are
+    # made after the steps; else the start makes them, in the loop's way
+    start_kw = dict(integrator=integrator, recording=STATE if headed else recording)
     # the chunk's programs compile on other threads from the start's shapes while this one
     # compiles and runs the start: XLA compiles without the GIL, so on several cores they
     # overlap. All come from disk where an earlier process traced them (mfm._programs)
@@ -257,19 +277,21 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
         made.compile(*args)
         return made
 
+    steps_kw = dict(n_blocks=c, integrator=integrator, save_every=save_every)
     pool = concurrent.futures.ThreadPoolExecutor(2)
     try:
         if pipelined:
             stacked = jax.tree_util.tree_map(
                 lambda a: jax.ShapeDtypeStruct((c,) + a.shape, a.dtype), shapes)
             ahead = [pool.submit(compiled, _steps_jit, "rollout_steps", (model, loads, shapes, dt),
-                                 dict(n_blocks=c, integrator=integrator, save_every=save_every)),
+                                 steps_kw),
                      pool.submit(compiled, _outputs_jit, "rollout_outputs",
                                  (model, loads, shapes, stacked), dict(recording=recording))]
         else:
-            ahead = [pool.submit(compiled, _chunk_jit, "rollout_chunk", (model, loads, shapes, dt),
-                                 dict(n_blocks=c, integrator=integrator, save_every=save_every,
-                                      recording=recording))]
+            fn, name = ((_headed_chunk_jit, "rollout_chunk_headed") if headed
+                        else (_chunk_jit, "rollout_chunk"))
+            ahead = [pool.submit(compiled, fn, name, (model, loads, shapes, dt),
+                                 dict(steps_kw, recording=recording))]
         carry, first = start(*start_args)
         carry = _strong(carry)
         made = [f.result() for f in ahead]
@@ -281,6 +303,8 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
             carry, lambda cr: steps(model, loads, _strong(cr), dt),
             lambda head, carries: outputs(model, loads, head, carries), c, n_blocks,
             save_every, bar, began)
+    if headed:
+        first = None
 
     def chunk(carry, n):
         assert n == c, (n, c)          # one chunk length: the one compiled
