@@ -284,3 +284,41 @@ def test_the_moved_dofs_of_a_load_come_from_a_saved_program(monkeypatch, tmp_pat
     monkeypatch.setattr(_programs, "folder", lambda: None)   # the ordinary path
     np.testing.assert_array_equal(got, water.moving_dofs(m, spec.body_index, d_ref))
     np.testing.assert_array_equal(got, spec.moving)
+
+
+def test_a_pipelined_run_calls_the_executables_it_compiled(monkeypatch):
+    """A pipelined run (mfm.timedomain.progress.run_pipelined) compiles its steps and outputs
+    programs ahead, from shapes; every chunk's call must then match what was compiled (structure,
+    shapes, dtypes, weak types), else it compiles again while the run goes (M4 134's outputs
+    program: 7.5 s more of a first run, when a step's weakly typed iteration count reached it)."""
+    import mfm
+    from mfm.timedomain import progress
+    from mfm.timedomain import rollout
+
+    made = {}
+    program = _programs.program
+
+    def keep(jitted, name, args, static=None):
+        made[name] = program(jitted, name, args, static)
+        return made[name]
+
+    calls = []
+    call = _programs.Program.__call__
+
+    def counted(self, *args):
+        if any(self is p for n, p in made.items() if n in ("rollout_steps", "rollout_outputs")):
+            calls.append(self._compiled is not None
+                         and _programs._signature(args) == self._compiled[0])
+        return call(self, *args)
+
+    monkeypatch.setattr(rollout._programs, "program", keep)
+    monkeypatch.setattr(_programs.Program, "__call__", counted)
+    monkeypatch.setattr(progress, "PIPELINE_MIN_STEPS", 2000)
+    m = mfm.load(CONFIGS / "double_pendulum.toml")
+    for integrator in ("verlet", "rk4"):
+        made.clear()
+        calls.clear()
+        ds = mfm.simulate(m, duration=21.1, dt=0.01, q0={"upper.angle": 0.5},
+                          integrator=integrator)
+        assert ds.sizes["time"] == 2111
+        assert len(calls) == 10 and all(calls), (integrator, calls)   # 5 chunks, two programs

@@ -301,7 +301,10 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
         steps, outputs = made
         return lambda bar: run_pipelined(
             carry, lambda cr: steps(model, loads, _strong(cr), dt),
-            lambda head, carries: outputs(model, loads, head, carries), c, n_blocks,
+            # strongly typed as the program was compiled (a step's iteration count comes out
+            # weak): else the call compiles it again (M4 134: 7.5 s of a first run)
+            lambda head, carries: outputs(model, loads, _strong(head), _strong(carries)), c,
+            n_blocks,
             save_every, bar, began)
     if headed:
         first = None
