@@ -201,7 +201,8 @@ def run_pipelined(carry, steps, outputs, c, n_blocks, save_every, bar=None, bega
                 break
         pieces = [f.result() for f in made]
     finally:
-        pool.shutdown(wait=True)
+        # an interrupted run (Ctrl-C) waits for the chunk being made, not for those queued
+        pool.shutdown(wait=True, cancel_futures=True)
         if bar is not None:
             bar.close()
     return jax.tree_util.tree_map(lambda *a: np.concatenate(a, axis=0), *pieces)
