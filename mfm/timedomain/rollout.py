@@ -303,9 +303,8 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
             carry, lambda cr: steps(model, loads, _strong(cr), dt),
             # strongly typed as the program was compiled (a step's iteration count comes out
             # weak): else the call compiles it again (M4 134: 7.5 s of a first run)
-            lambda head, carries: outputs(model, loads, _strong(head), _strong(carries)), c,
-            n_blocks,
-            save_every, bar, began)
+            lambda head, carries: outputs(model, loads, _strong(head), _strong(carries)),
+            c, n_blocks, save_every, bar, began)
     if headed:
         first = None
 
