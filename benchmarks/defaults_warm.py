@@ -14,7 +14,7 @@ at dt = T_p/200 (20,000 steps), ramp 5 T_p. Rows, each compiled once and then ti
 - ``verlet + state_space_exact``: the fast path.
 
 Beside each, the same call with its outputs made after the time loop instead of beside it
-(in one program, as a run shorter than ``mfm.timedomain.progress.PIPELINE_MIN_STEPS`` makes them;
+(in one program, as a run shorter than ``mfm.timedomain.progress.PIPELINE_MIN_SAMPLES`` makes them;
 the pipeline: :func:`mfm.timedomain.progress.run_pipelined`), timed in turn with it,
 and the median of the pairs' ratios (this tree's call / that one); and the compiled time loop
 alone (``mfm.rollout`` with the same loads, nothing recorded): what the rest of the call (the
@@ -45,16 +45,16 @@ TP, N = 1.2, 20_000
 @contextlib.contextmanager
 def one_program():
     """simulate's outputs made after its time loop in the same program, not beside it (no
-    pipeline: :data:`mfm.timedomain.progress.PIPELINE_MIN_STEPS` raised), for the column that
+    pipeline: :data:`mfm.timedomain.progress.PIPELINE_MIN_SAMPLES` raised), for the column that
     compares the two."""
     from mfm.timedomain import progress
 
-    kept = progress.PIPELINE_MIN_STEPS
-    progress.PIPELINE_MIN_STEPS = 2**62
+    kept = progress.PIPELINE_MIN_SAMPLES
+    progress.PIPELINE_MIN_SAMPLES = 2**62
     try:
         yield
     finally:
-        progress.PIPELINE_MIN_STEPS = kept
+        progress.PIPELINE_MIN_SAMPLES = kept
 
 
 def measures(ds, keep_from):

@@ -313,7 +313,7 @@ def test_a_pipelined_run_calls_the_executables_it_compiled(monkeypatch):
 
     monkeypatch.setattr(rollout._programs, "program", keep)
     monkeypatch.setattr(_programs.Program, "__call__", counted)
-    monkeypatch.setattr(progress, "PIPELINE_MIN_STEPS", 2000)
+    monkeypatch.setattr(progress, "PIPELINE_MIN_SAMPLES", 2000)
     m = mfm.load(CONFIGS / "double_pendulum.toml")
     for integrator in ("verlet", "rk4"):
         made.clear()

@@ -586,34 +586,35 @@ def test_progress_bar_keeps_a_diverging_run_and_a_batch_exact(capsys):
 def test_a_pipelined_run_gives_the_bits_of_one_program(monkeypatch):
     """A long run whose outputs are made apart from its steps is made in chunks, each chunk's
     outputs on a second thread as the next chunk steps (mfm.timedomain.progress.run_pipelined):
-    here from 2,000 steps (PIPELINE_MIN_STEPS lowered), 2,110 steps in 5 chunks of 422 without a
-    bar (pipeline_plan) and 96 of 22 under one, every chunk the same two compiled programs
-    (traced once each). The dataset has the bits of the run made in one program (a shorter run's
-    way) and of the bar's. A diverging run stops in the chunk where it goes non-finite, with the
-    error and partial dataset of the run made in one program."""
+    here from 2,000 saved samples (PIPELINE_MIN_SAMPLES lowered), 2,130 steps in 6 chunks of 355
+    without a bar (pipeline_plan) and 71 of 30 under one, every chunk the same two compiled
+    programs (traced once each: a chunk length no other test uses, so compiled here). The
+    dataset has the bits of the run made in one program (a shorter run's way) and of the bar's.
+    A diverging run stops in the chunk where it goes non-finite, with the error and partial
+    dataset of the run made in one program."""
     import mfm
     from mfm.timedomain import progress
     from mfm.timedomain.rollout import TRACES
 
-    assert progress.pipeline_plan(2110) == (422, 5)
+    assert progress.pipeline_plan(2130) == (355, 6)
     assert progress.pipeline_plan(20000) == (2500, 8)
     m = mfm.load(CONFIGS / "double_pendulum.toml")
-    kw = dict(duration=21.1, dt=0.01, q0={"upper.angle": 0.5, "lower.angle": -0.3},
+    kw = dict(duration=21.3, dt=0.01, q0={"upper.angle": 0.5, "lower.angle": -0.3},
               integrator="verlet")
-    whole = mfm.simulate(m, **kw)                   # 2,110 < 10,000 steps: one program
-    monkeypatch.setattr(progress, "PIPELINE_MIN_STEPS", 2000)
+    whole = mfm.simulate(m, **kw)                   # 2,131 < 10,000 samples: one program
+    monkeypatch.setattr(progress, "PIPELINE_MIN_SAMPLES", 2000)
     before = dict(TRACES)
     chunks = mfm.simulate(m, **kw)
     assert (TRACES["rollout_chunk"] - before.get("rollout_chunk", 0),
             TRACES["rollout_outputs"] - before.get("rollout_outputs", 0)) == (1, 1)
-    assert chunks.sizes["time"] == 2111
+    assert chunks.sizes["time"] == 2131
     _same_numbers(chunks, whole)
     _same_numbers(chunks, mfm.simulate(m, progress={"file": open(os.devnull, "w")}, **kw))
     # RK4 at dt = 0.5 s: non-finite within the first of 8 chunks of 500 steps
     kw = dict(duration=2000.0, dt=0.5, q0={"upper.angle": 1.0}, check_stability=False)
     errors = []
     for low in (False, True):
-        monkeypatch.setattr(progress, "PIPELINE_MIN_STEPS", 2000 if low else 10**9)
+        monkeypatch.setattr(progress, "PIPELINE_MIN_SAMPLES", 2000 if low else 10**9)
         with pytest.raises(mfm.SimulationError) as e:
             mfm.simulate(m, **kw)
         errors.append(e.value)

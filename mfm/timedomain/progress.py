@@ -23,12 +23,13 @@ def chunk_plan(n_blocks: int, fewest: int = 20, most: int = 100) -> tuple[int, i
     return c, -(-n_blocks // c)
 
 
-# a recorded run of this many steps or more is pipelined (:func:`run_pipelined`): its outputs
-# made on a second thread as the loop goes on. It then has three programs to compile instead of
-# one (start, steps, outputs); a shorter run's outputs (~20 µs a sample at most, M4 134's) are
-# under 0.2 s, and RM3's README command (2,000 steps, empty caches, 2 cores) took 24.7 and 23.9 s
-# pipelined against 22.2 and 24.0 s in one program
-PIPELINE_MIN_STEPS = 10_000
+# a recorded run that saves this many samples or more is pipelined (:func:`run_pipelined`): its
+# outputs, whose cost goes with the samples saved, made on a second thread as the loop goes on.
+# It then has three programs to compile instead of one (start, steps, outputs); fewer samples'
+# outputs (~20 µs a sample at most, M4 134's) take under 0.2 s, and RM3's README command (2,000
+# samples, empty caches, 2 cores) took 24.7 and 23.9 s pipelined against 22.2 and 24.0 s in one
+# program
+PIPELINE_MIN_SAMPLES = 10_000
 # without a bar, in this many chunks at most: each costs two program calls and a hand-over
 # between threads (~0.1 ms), and the last chunk's outputs are not hidden behind any stepping
 PIPELINE_CHUNKS = 8

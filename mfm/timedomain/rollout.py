@@ -133,7 +133,7 @@ def _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every,
 def _headed_chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every,
                        recording: Recording = EVERY):
     """A chunk of a recorded run whose outputs are deferred (:func:`_blocks_with_head`), in one
-    program with its steps (a run too short to pipeline, :data:`~.progress.PIPELINE_MIN_STEPS`).
+    program with its steps (a run too short to pipeline, :data:`~.progress.PIPELINE_MIN_SAMPLES`).
     The host keeps the head of the first chunk only (the run's initial sample): the start then
     needs no outputs program of its own, and a first run compiles one copy of the outputs instead
     of two (RM3: the start's 4.7 of 14 s of compilation, cold)."""
@@ -232,11 +232,11 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
     ``recording``: :data:`~.record.EVERY` (``rollout``'s ``record=True``) or
     :data:`~.record.OUTPUTS` (``simulate``'s: no loads' states per sample). Where its outputs
     are made after the time loop (:func:`~.record.deferred`: a small load memory) and the run
-    has at least :data:`~.progress.PIPELINE_MIN_STEPS` steps, it is pipelined
+    saves at least :data:`~.progress.PIPELINE_MIN_SAMPLES` samples, it is pipelined
     (:func:`~.progress.run_pipelined`): chunks of steps on this thread, each chunk's outputs on
     another as the next one steps; ``chunked`` (a progress bar) in 20 to 100 chunks
     (:func:`~.progress.chunk_plan`), else in up to 8 (:func:`~.progress.pipeline_plan`).
-    Shorter runs make their outputs after the loop in the same program (one program to compile
+    Other runs make their outputs after the loop in the same program (one program to compile
     instead of two), and a large memory (a convolution's history) makes them inside the loop: the
     whole run in one program, or with ``chunked`` in chunks of one
     (:func:`~.progress.run_chunked`). The same numbers every way."""
@@ -249,7 +249,7 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
     n_blocks = n_steps // save_every
     memories = jax.eval_shape(lambda: init_memories(model, loads, t0, q0, qd0, dt))
     headed = deferred((None, memories), recording)
-    pipelined = headed and n_steps >= progress.PIPELINE_MIN_STEPS
+    pipelined = headed and n_blocks >= progress.PIPELINE_MIN_SAMPLES
     start_args = (model, loads, q0, qd0, z0, t0, dt)
     if not (pipelined or chunked):
         # the whole run, one program (from disk where an earlier process traced it); its outputs
