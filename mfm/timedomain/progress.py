@@ -12,13 +12,18 @@ import jax
 import numpy as np
 
 
-def chunk_plan(n_blocks: int, fewest: int = 20, most: int = 100) -> tuple[int, int]:
+def chunk_plan(n_blocks: int, fewest: int = 20, most: int = 100,
+               multiple: int = 1) -> tuple[int, int]:
     """(chunk length in saved blocks, number of chunks) for a progress bar: between ``fewest``
     and ``most`` updates, the length that wastes the fewest blocks past the end (the last chunk
-    has the same length, so one compilation serves every chunk; its extra blocks are dropped)."""
-    if n_blocks <= fewest:
+    has the same length, so one compilation serves every chunk; its extra blocks are dropped).
+    ``multiple``: the length a multiple of it (a pipelined run's chunks, whose outputs are made
+    in groups of that many samples: :func:`run_pipelined`)."""
+    if n_blocks <= fewest and multiple == 1:
         return 1, n_blocks
-    lengths = range(-(-n_blocks // most), -(-n_blocks // fewest) + 1)
+    up = lambda x: -(-x // multiple) * multiple                 # noqa: E731
+    lo = up(-(-n_blocks // most))
+    lengths = range(lo, max(lo, up(-(-n_blocks // fewest))) + 1, multiple)
     c = min(lengths, key=lambda c: (-(-n_blocks // c) * c - n_blocks, c))
     return c, -(-n_blocks // c)
 
@@ -35,11 +40,11 @@ PIPELINE_MIN_SAMPLES = 10_000
 PIPELINE_CHUNKS = 8
 
 
-def pipeline_plan(n_blocks: int) -> tuple[int, int]:
+def pipeline_plan(n_blocks: int, multiple: int = 1) -> tuple[int, int]:
     """(chunk length in saved blocks, number of chunks) for a pipelined run without a bar
-    (:func:`run_pipelined`): 4 to :data:`PIPELINE_CHUNKS` chunks of one length, the fewest
-    blocks wasted past the end (:func:`chunk_plan`)."""
-    return chunk_plan(n_blocks, fewest=4, most=PIPELINE_CHUNKS)
+    (:func:`run_pipelined`): 4 to :data:`PIPELINE_CHUNKS` chunks of one length, a multiple of
+    ``multiple``, the fewest blocks wasted past the end (:func:`chunk_plan`)."""
+    return chunk_plan(n_blocks, fewest=4, most=PIPELINE_CHUNKS, multiple=multiple)
 
 
 def progress_options(progress):
@@ -166,8 +171,11 @@ def run_pipelined(carry, steps, outputs, c, n_blocks, save_every, bar=None, bega
     thread while the next chunk steps. A time loop is one thread's work; the outputs pass (poses,
     reactions, the loads' parts: M4 134, ~20 µs a sample, more than a Verlet step) is vectorised
     over the samples and overlaps it, so a run costs its stepping and the last chunk's outputs
-    instead of their sum. Every chunk is the same two compiled programs, each sample's outputs
-    the same vmapped computation: the same numbers as the run in one call.
+    instead of their sum. Every chunk is the same two compiled programs, and ``c`` a multiple
+    of the outputs' group width (:data:`~.record.DEFERRED_RECORD_WIDTH`), so that every sample
+    takes the same place in its group as in the run made in one call (a sample's outputs may
+    differ in the last bit with its place: the double pendulum's kinetic energy did, by 1 ulp):
+    the same numbers.
 
     ``bar`` (or None) is updated as the chunks step; stops early once a chunk has a non-finite q
     or q̇ (the caller finds where, from the outputs made up to that chunk). Returns the saved

@@ -21,7 +21,8 @@ from ..validation import positive_seconds, whole_number
 from . import integrators as _integrators
 from . import progress
 from .progress import chunk_plan, run_chunked, run_pipelined
-from .record import EVERY, STATE, Recording, deferred, outputs_after, saved
+from .record import (DEFERRED_RECORD_WIDTH, EVERY, STATE, Recording, deferred,
+                     outputs_after, saved)
 
 
 # How many times each compiled function was traced (a retrace means a recompilation); tests use it.
@@ -259,7 +260,13 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
         whole = _programs.program(rollout_jit, "rollout", start_args, opts)
         whole.compile(*start_args)
         return lambda bar: whole(*start_args)
-    c, _ = progress.pipeline_plan(n_blocks) if pipelined and not chunked else chunk_plan(n_blocks)
+    if pipelined:
+        # a multiple of the outputs' group width: each sample in the place of its group it has
+        # in the run made in one program (the same bits; progress.run_pipelined)
+        c, _ = (chunk_plan(n_blocks, multiple=DEFERRED_RECORD_WIDTH) if chunked
+                else progress.pipeline_plan(n_blocks, multiple=DEFERRED_RECORD_WIDTH))
+    else:
+        c, _ = chunk_plan(n_blocks)
     # the outputs of the initial sample come with the first chunk's (its head) where they are
     # made after the steps; else the start makes them, in the loop's way
     start_kw = dict(integrator=integrator, recording=STATE if headed else recording)
