@@ -1,6 +1,7 @@
-"""A progress bar over a run or a batch: the run is made in 20 to 100 chunks of one compiled
-function, the bar (tqdm, on stderr) updated between them; the same steps in the same order, so the
-same numbers as the run in one call."""
+"""A run in chunks: under a progress bar (a run or a batch in 20 to 100 chunks of one compiled
+function, the bar, tqdm on stderr, updated between them), and a long run's pipeline (its outputs
+made on a second thread while its steps go on, :func:`run_pipelined`); the same steps in the same
+order, so the same numbers as the run in one call."""
 from __future__ import annotations
 
 import concurrent.futures
