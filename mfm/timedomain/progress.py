@@ -115,6 +115,18 @@ def _restart(bar, n: int):
     bar._ema_dn, bar._ema_dt, bar._ema_miniters = (EMA(bar.smoothing) for _ in range(3))
 
 
+def _advance(bar, done: int, take: int, save_every: int, began: float):
+    """``bar`` past a chunk of ``take`` blocks, ``done`` in all. After the first chunk (compiled
+    by then) its rate, elapsed time and ETA count from now, else the compilation (seconds to a
+    minute) shows as slow steps and a far-off ETA; it says how long that took since ``began``."""
+    if done == take:
+        compiled = time.perf_counter() - began
+        _restart(bar, take * save_every)
+        _say(bar, f"compiled in {compiled:.0f} s")
+    else:
+        bar.update(take * save_every)
+
+
 def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis, began=None):
     """Run ``start()`` then ``chunk(carry, c)`` (``c`` blocks, from :func:`chunk_plan`) until
     ``n_blocks`` are done,
@@ -148,14 +160,7 @@ def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis, began=None):
             traj = jax.tree_util.tree_map(lambda a: np.asarray(a)[cut], traj)
             pieces.append(traj)
             done += take
-            if done == take:
-                # the first chunk compiled: rate, elapsed and ETA count from here, else the
-                # compilation (seconds to a minute) shows as slow steps and a far-off ETA
-                compiled = time.perf_counter() - began
-                _restart(bar, take * save_every)
-                _say(bar, f"compiled in {compiled:.0f} s")
-            else:
-                bar.update(take * save_every)
+            _advance(bar, done, take, save_every, began)
             if not (np.isfinite(traj[1]).all() and np.isfinite(traj[2]).all()):
                 break
     finally:
@@ -201,12 +206,7 @@ def run_pipelined(carry, steps, outputs, c, n_blocks, save_every, bar=None, bega
                       and np.isfinite(np.asarray(state.qd)[:take]).all())
             done += take
             if bar is not None:
-                if done == take:
-                    compiled = time.perf_counter() - began
-                    _restart(bar, take * save_every)
-                    _say(bar, f"compiled in {compiled:.0f} s")
-                else:
-                    bar.update(take * save_every)
+                _advance(bar, done, take, save_every, began)
             if not finite:
                 break
         pieces = [f.result() for f in made]
