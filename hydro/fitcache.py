@@ -34,7 +34,7 @@ CACHE_BYTES = 512 * 2**20
 # fits kept in the process (the least recently used dropped first)
 MEMORY_ITEMS = 16
 # the code a fit depends on: a change in any of these files is another key
-_SOURCES = ("statespace.py", "radiation.py", "fitcache.py")
+_SOURCES = ("statespace.py", "vectorfit.py", "passivity.py", "radiation.py", "fitcache.py")
 
 _memory: collections.OrderedDict = collections.OrderedDict()
 _warned = False

@@ -12,12 +12,11 @@ from pathlib import Path
 import equinox as eqx
 import numpy as np
 import pytest
-import xarray as xr
 
 import hydro
 from hydro.prepare import HydroSpec
 import mfm
-from hydro import statespace as S
+from hydro import vectorfit as VF
 from hydro.waves import elevation
 from mfm.studies import wec
 from mfm.studies.fidelity import reduce, variant_model
@@ -56,10 +55,10 @@ def test_common_pole_vector_fitting_recovers_known_poles():
         truth.append(res)
     F = np.stack(F, axis=1)
     w = np.ones(len(s))
-    reps, coef = S._vf(s, F, w, 5, 0.5, 8.0, n_iter=20)
-    P = np.sort_complex(S._pole_residue(reps, coef[:, 0])[0])
+    reps, coef = VF._vf(s, F, w, 5, 0.5, 8.0, n_iter=20)
+    P = np.sort_complex(VF._pole_residue(reps, coef[:, 0])[0])
     np.testing.assert_allclose(P, np.sort_complex(poles), atol=1e-8)
-    fit = S._basis(s, reps) @ coef
+    fit = VF._basis(s, reps) @ coef
     assert np.abs(fit - F).max() < 1e-8 * np.abs(F).max()
 
 
@@ -69,10 +68,10 @@ def test_one_function_common_fit_equals_single_entry_fit():
     f = 1.0 / (s + 0.5 - 2j) + 1.0 / (s + 0.5 + 2j) - 2 * (0.5 / (0.25 + 4)) / (1 + s)
     w = np.ones(len(s))
     # order 3 = the pair and the real pole: the poles are unique, so both paths must find them
-    a, ca = S._vf(s, f, w, 3, 0.5, 5.0)
-    b, cb = S._vf(s, f[:, None], w, 3, 0.5, 5.0)
+    a, ca = VF._vf(s, f, w, 3, 0.5, 5.0)
+    b, cb = VF._vf(s, f[:, None], w, 3, 0.5, 5.0)
     np.testing.assert_allclose(np.sort_complex(np.array(a)), np.sort_complex(np.array(b)), rtol=1e-6)
-    np.testing.assert_allclose(S._basis(s, a) @ ca, (S._basis(s, b) @ cb)[:, 0], rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(VF._basis(s, a) @ ca, (VF._basis(s, b) @ cb)[:, 0], rtol=1e-6, atol=1e-9)
 
 
 def test_moving_dofs_of_a_planar_model(m111):

@@ -12,7 +12,9 @@ import numpy as np
 import pytest
 
 import mfm
+from hydro import passivity as PV
 from hydro import statespace as S
+from hydro import vectorfit as VF
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
@@ -83,7 +85,7 @@ def test_spectral_clipping_makes_a_non_passive_model_passive():
     E = rng.normal(size=(3, 3))
     E = 0.5 * (E + E.T)
     C_bad = C + 0.05 * np.array([[E[i, j], 0.3 * E[i, j], -E[i, j]] for i, j in keys]).T
-    Pg = S._basis(1j * S._passivity_grid(6.0), reps).real
+    Pg = VF._basis(1j * PV._passivity_grid(6.0), reps).real
 
     def lam_min(Cc):
         vals = Pg @ Cc
@@ -93,7 +95,7 @@ def test_spectral_clipping_makes_a_non_passive_model_passive():
         return np.linalg.eigvalsh(H)[:, 0].min()
 
     assert lam_min(C) >= -1e-12 and lam_min(C_bad) < -0.05        # the premise (measured −0.116)
-    C_fix, it = S._enforce_passivity_common(reps, C_bad, keys, 3, s, w, 6.0)
+    C_fix, it = PV._enforce_passivity_common(reps, C_bad, keys, 3, s, w, 6.0)
     # converged (measured 6 iterations; the cap is 40), not stopped at the cap or on stagnation
     assert lam_min(C_fix) >= 0.0 and it < 40
     # the change is smaller than the perturbation (2.2 % of ||C||), not of the model's size:
@@ -123,25 +125,25 @@ def test_sigma_step_sees_the_functions_only_through_their_gram_matrix(monkeypatc
     om = np.linspace(0.1, 4.0, 40)
     s = np.concatenate([[0.0], 1j * om])
     true = [complex(-0.3, 1.0), complex(-0.5, 2.5), complex(-0.8, 0.0)]
-    Phi_true = S._basis(s, true)
+    Phi_true = VF._basis(s, true)
     F = Phi_true @ rng.normal(size=(Phi_true.shape[1], 300)) \
         + 1e-3 * (rng.normal(size=(len(s), 300)) + 1j * rng.normal(size=(len(s), 300)))
     w = np.concatenate([[10.0], np.where(om < 3.0, 1.0, 0.1)])
-    Phi = S._basis(s, S._initial_poles(6, 0.1, 4.0))
+    Phi = VF._basis(s, VF._initial_poles(6, 0.1, 4.0))
     Fw = (F * w[:, None]).T
-    tri = S._gram_rows(Fw)
+    tri = VF._gram_rows(Fw)
     assert tri.shape == (2 * len(s), len(s))
 
     def rel(a, b):
         return max(abs(a[0] - b[0]), np.abs(a[1] - b[1]).max()) / np.abs(b[1]).max()
 
-    chol_all, chol_tri = S._sigma_relaxed(Phi, Fw, w, 300), S._sigma_relaxed(Phi, tri, w, 300)
-    wrong = S._sigma_relaxed(Phi, np.linalg.qr(Fw.real, mode="r").astype(complex), w, 300)
+    chol_all, chol_tri = VF._sigma_relaxed(Phi, Fw, w, 300), VF._sigma_relaxed(Phi, tri, w, 300)
+    wrong = VF._sigma_relaxed(Phi, np.linalg.qr(Fw.real, mode="r").astype(complex), w, 300)
 
     def no_cholesky(a):
         raise np.linalg.LinAlgError
     monkeypatch.setattr(np.linalg, "cholesky", no_cholesky)
-    qr_all, qr_tri = S._sigma_relaxed(Phi, Fw, w, 300), S._sigma_relaxed(Phi, tri, w, 300)
+    qr_all, qr_tri = VF._sigma_relaxed(Phi, Fw, w, 300), VF._sigma_relaxed(Phi, tri, w, 300)
     assert rel(qr_tri, qr_all) < 1e-11
     assert rel(chol_all, qr_all) < 1e-7 and rel(chol_tri, qr_all) < 1e-7
     assert rel(wrong, qr_all) > 1e-3
@@ -166,7 +168,7 @@ def test_eigenpairs_under_the_floor_are_those_of_the_full_decomposition():
         H[k] = (Q * lam) @ Q.T
         H[k] = 0.5 * (H[k] + H[k].T)
     delta = 1e-3 * np.abs(np.linalg.eigvalsh(H)).max(axis=1)
-    at, lam, V = S._below(H, delta)
+    at, lam, V = PV._below(H, delta)
     full_l, full_v = np.linalg.eigh(H)
     expect = [k for k in range(n_g) if full_l[k, 0] <= delta[k]]
     assert list(at) == expect and 0 < len(expect) < n_g
