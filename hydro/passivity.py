@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .phases import say
 from .vectorfit import _basis
 
 def _passivity_grid(w_max):
@@ -170,6 +171,7 @@ def _enforce_passivity_common(poles, C, keys, nk, s_fit, w_fit, w_max, max_iter=
     at = np.arange(len(grid))                                            # the points to lift
     best = (lam[:, 0].min(), Cc, 0)
     for it in range(max_iter):
+        say(f"state-space fit: passivity, iteration {it + 1} of at most {max_iter}")
         if it:
             at, lam, V = _below(hermitian(Cc), delta)
         # the least eigenvalue over the grid: at a point left out it exceeds δ_k > 0, so when it

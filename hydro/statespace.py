@@ -41,6 +41,7 @@ import numpy as np
 import xarray as xr
 
 from .passivity import _enforce_passivity, _enforce_passivity_common, _passivity_grid
+from .phases import say
 from .radiation import filon_weights, impulse_response, impulse_response_transform, memory_length
 from .vectorfit import _basis, _era_fit, _pole_residue, _vf
 
@@ -120,7 +121,8 @@ def _fit_common(entries, T, Z, band, n_om, dpk, s, w, orders, target, w_lo, w_hi
     ew = np.array([1.0 if (i == j or not symmetrize) else np.sqrt(2.0) for (i, j) in keys])
     wb = 1j * _band_omega(s, band, n_om)
     best = None
-    for n in orders:
+    for k, n in enumerate(orders):
+        say(f"state-space fit: order {n} ({k + 1} of at most {len(orders)})")
         poles, coef = _vf(s, Fn, w, n, w_lo, w_hi, n_iter=n_iter)
         fit = _basis(wb, poles) @ coef
         err = float(np.linalg.norm((fit - Zb) * ew) / np.linalg.norm(Zb * ew))
@@ -410,7 +412,9 @@ def fit_state_space(db: xr.Dataset, *, order="auto", method: str = "vf",
             entries, T, Z, band, len(om), dpk, s, w, orders, target, w_lo, w_hi, symmetrize, labels,
             enforce_passivity, om[-1])
     else:
-        for (i, j) in entries:
+        for e, (i, j) in enumerate(entries):
+            if e % max(1, len(entries) // 10) == 0:
+                say(f"state-space fit: entry {e + 1} of {len(entries)}")
             if symmetrize and (j, i) in done:               # same model, its own states
                 fits.append(fits[done[(j, i)]])
                 used[(labels[i], labels[j])] = used[(labels[j], labels[i])]
@@ -444,6 +448,7 @@ def fit_state_space(db: xr.Dataset, *, order="auto", method: str = "vf",
     if enforce_passivity and symmetrize and done and pole_sharing == "entry":
         n_enforce = _enforce_passivity(fits, done, nd, dpk, dof_ok, s, w, om[-1])
         fits = [fits[done[(i, j)] if (i, j) in done else done[(j, i)]] for (i, j) in entries]
+    say("state-space fit: its realisation and report (band errors, passivity to 100 ω_max)")
     Am, Bm, Cm = _realise(entries, fits, nd, shared=pole_sharing == "common")
     P_all, R_all = zip(*[_pole_residue(p, c) for p, c in fits]) if fits else ((), ())
     ss = StateSpaceRadiation(Am, Bm, Cm, Ainf_fit, tuple(labels), tuple(entries), tuple(P_all),

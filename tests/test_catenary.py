@@ -681,3 +681,49 @@ def test_tables_are_kept_on_disk_and_read_back_bit_for_bit(monkeypatch, tmp_path
     # lines of one geometry whose spans differ in the last digits of their positions share it
     catenary.build_table(775.5000009, 75.0000004, *args[2:])
     assert len(calls) == 4 * n
+
+
+def test_load_says_how_far_its_mooring_table_is(tmp_path, monkeypatch, capsys):
+    # mfm.load(progress=...) shows what the load does; a mooring table it must make says its
+    # MoorPy solves as they go (Wu & Yuan's 2,511: ~7 s where the cache is empty). A table of
+    # 5 spans × 4 heights (table_extent [2, 1] m, table_step [1, 1] m: _axis keeps ≥ 4 nodes)
+    from mfm.loads import catenary
+
+    monkeypatch.setenv("MFM_FIT_CACHE", "off")              # no table from an earlier run
+    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})
+    ln = wy_lines()[0]
+    p = tmp_path / "moored.toml"
+    p.write_text(f'''[model]
+name = "one moored hull"
+[[bodies]]
+name = "hull"
+mass = 1.61e7
+com = [0.0, 0.0, -9.68]
+principal_inertia = [1e10, 1e10, 1e10]
+[bodies.joint]
+type = "free"
+dofs = ["surge", "sway", "heave"]
+[[catenary_lines]]
+name = "{ln["name"]}"
+body = "hull"
+fairlead = {ln["fairlead"]}
+anchor = {ln["anchor"]}
+length = {ln["length"]}
+weight = {ln["weight"]}
+EA = {ln["EA"]}
+table_extent = [2.0, 1.0]
+table_step = [1.0, 1.0]
+''')
+    quiet = mfm.load(p)
+    assert capsys.readouterr().err == ""                    # off by default
+    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})
+    shown = mfm.load(p, progress={"delay": 0, "mininterval": 0})
+    err = capsys.readouterr().err
+    assert "loading one moored hull" in err
+    # a report every row of spans (5 rows of 4 heights), before the row
+    for done in (0, 4, 8, 12, 16):
+        assert f"mooring table (MoorPy): {done} of 20 solves" in err, done
+    assert "done" in err
+    assert np.array_equal(np.asarray(quiet.loads[0].coef), np.asarray(shown.loads[0].coef))
+    with pytest.raises(ValueError, match=r"progress: 'yes'; give False"):
+        mfm.load(p, progress="yes")

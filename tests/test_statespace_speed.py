@@ -203,3 +203,27 @@ def test_max_real_eig_block_by_block_equals_the_whole_matrix():
         whole = float(np.max(np.linalg.eigvals(A).real))
         assert S._max_real_eig(A) == pytest.approx(whole, abs=1e-12 * max(1.0, abs(whole)))
     assert S._max_real_eig(np.zeros((0, 0))) == -np.inf
+
+
+def test_the_fit_says_how_far_it_is(m111):
+    # under hydro.phases.reporting the fit names each order it tries and each passivity
+    # iteration, in order (what `mfm simulate`'s bar shows while a minute's fit runs)
+    from hydro import phases
+
+    m, ss = m111
+    said = []
+    with phases.reporting(said.append):
+        S.fit_state_space(m.hydro.database(), pole_sharing="common", omega_fit=m.hydro.wave_band(),
+                          dofs=tuple(m.hydro.dofs[k] for k in m.hydro.moving))
+    orders = [w for w in said if "order" in w]
+    assert orders[0] == "state-space fit: order 8 (1 of at most 9)"
+    # the default fit of M4 111 is order 32 (the 7th): the orders stop there
+    assert orders[-1] == "state-space fit: order 32 (7 of at most 9)" and len(orders) == 7
+    iterations = [w for w in said if "passivity, iteration" in w]
+    assert iterations[0] == "state-space fit: passivity, iteration 1 of at most 40"
+    assert len(iterations) == ss.report["passivity_enforcement_iterations"] + 1
+    assert said.index(orders[-1]) < said.index(iterations[0])
+    assert said[-1].startswith("state-space fit: its realisation and report")
+    said.clear()
+    S.fit_state_space(m.hydro.database(), pole_sharing="common", order=8)
+    assert said == []                                       # nobody listening: nothing said

@@ -158,7 +158,9 @@ def cmd_simulate(args):
         raise ValueError(f"--ramp {args.ramp:g} s is longer than --duration {args.duration:g} s: "
                          "the waves would never reach full height; shorten the ramp")
 
-    model = load(args.config, body_coupling=False if args.no_body_coupling else None)
+    # the run's bar options for the load too: seconds of MoorPy tables where the cache is empty
+    model = load(args.config, body_coupling=False if args.no_body_coupling else None,
+                 progress=args.progress)
     sea = _sea(args)
     from hydro.database import write_netcdf
 

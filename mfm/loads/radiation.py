@@ -27,6 +27,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
+from hydro import phases
 
 STRATEGIES = ("convolution", "state_space", "state_space_exact", "none")
 
@@ -213,6 +214,7 @@ class StateSpace(NoRadiation):
         key = ("modal_form", repr(sorted(options.items())))
         cache = getattr(spec, "_cache", {})
         if cache.get(key, (None,))[0] is not ss:
+            phases.say("the state space's modal form")
             cache[key] = (ss, modal_form(ss))
         P, C, ins, outs = cache[key][1]
         report = tuple((k, v) for k, v in (getattr(ss, "report", None) or {}).items()

@@ -40,6 +40,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
+from hydro import phases
 from hydro.seabatch import components_many
 
 from .. import _programs
@@ -582,6 +583,7 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
     relative = not path.is_absolute()
     if relative:
         path = Path(config_dir) / path
+    phases.say(f"reading the hydro database {path.name}")
     try:
         db = open_any_database(path, names=options.get("names"), rho=options.get("rho"),
                                g=options.get("g"))
@@ -641,9 +643,11 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
     if not isinstance(coupling, bool):
         raise ValueError(f"body_coupling: {coupling!r}; accepted: True, False or None (the config's "
                          "hydro.body_coupling)")
+    phases.say("the hydro dofs the joints move (H(q), compiled once per model structure)")
+    moving = moving_dofs(model, idx, np.asarray(db["reference_point"].values) - com0)
     return HydroSpec(db, idx, [name for name, _, _ in wet], com0, np.stack([d for _, _, d in wet]),
                      body_coupling=coupling, added_mass_inf=options.get("added_mass_inf", "consistent"),
-                     source=str(path), moving=moving_dofs(model, idx, np.asarray(db["reference_point"].values) - com0))
+                     source=str(path), moving=moving)
 
 
 @jax.jit

@@ -9,6 +9,7 @@ import concurrent.futures
 
 import numpy as np
 import xarray as xr
+from hydro import phases
 
 from .. import results
 from ..errors import AccuracyWarning, SimulationError, StabilityWarning  # noqa: F401  (exported)
@@ -138,14 +139,17 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
             # with the run's own loads
             ahead = pool.submit(rest.compile_jet, model, rest.still_water_loads(
                 model, extra, added_mass=added_mass, stage_offsets=stage_offsets(integ)), q0)
-        if auto and radiation == "state_space_exact":
-            radiation, how = state_space_update(model, dt=dt, integrator=integ,
-                                                state_space_options=state_space_options)
-            choice = f"{choice}; {how}"
-        loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
-                            radiation=radiation, memory=memory,
-                            state_space_options=state_space_options, added_mass=added_mass,
-                            integrator=integ) + extra
+        # the fit says how far it is (its orders, its passivity iterations) on the bar
+        with phases.reporting(None if bar is None else
+                              (lambda what: phase(bar, f"preparing the loads: {what}"))):
+            if auto and radiation == "state_space_exact":
+                radiation, how = state_space_update(model, dt=dt, integrator=integ,
+                                                    state_space_options=state_space_options)
+                choice = f"{choice}; {how}"
+            loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
+                                radiation=radiation, memory=memory,
+                                state_space_options=state_space_options, added_mass=added_mass,
+                                integrator=integ) + extra
         # the recorded run (its programs: the whole run, or its start and chunks), compiled here:
         # beside the jet's compilation where the water builds faster than that (no fit), and
         # before the checks' warnings
