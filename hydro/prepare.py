@@ -205,13 +205,18 @@ class HydroSpec:
 
     def memory(self, rtol: float = 1e-3) -> float:
         """Memory length T_K (s): where |K| stays below rtol·max|K| (from the decay of K, not Tp)."""
-        if "memory" not in self._cache:
+        key = ("memory", float(rtol))
+        if key not in self._cache:
+            from .fitcache import cached_value
             from .radiation import impulse_response_memory
 
             t = np.arange(0.0, 400.0, 0.05)
-            # memory_length(impulse_response(t), t, rtol), K not formed for every time and entry
-            self._cache["memory"] = impulse_response_memory(self.database(), t, rtol=rtol)
-        return self._cache["memory"]
+            # memory_length(impulse_response(t), t, rtol), K not formed for every time and entry;
+            # kept by the database's content (hydro.fitcache): ~0.4 s of every first run
+            self._cache[key] = float(cached_value(
+                self.database(), "memory", {"rtol": float(rtol)},
+                lambda: impulse_response_memory(self.database(), t, rtol=rtol)))
+        return self._cache[key]
 
     def added_mass_inf(self) -> np.ndarray:
         """A∞ used in the time domain. 'consistent': the database's plus the constant (the median
@@ -221,25 +226,34 @@ class HydroSpec:
         if self.added_mass_inf_option == "database":
             return self.A_inf_db
         if "A_inf" not in self._cache:
-            from .radiation import impulse_response_transform
+            from .fitcache import cached_value
 
-            db = self.database()
-            om = np.asarray(db["omega"].values)
-            t = np.arange(0.0, max(2 * self.memory(), 60.0), min(0.02, np.pi / om.max() / 4))
-            # A(ω) rebuilt from K by Ogilvie (hydro.radiation.added_mass_from_irf: A∞ − ∫K sin ωt
-            # dt / ω), with ∫K e^{−iωt} dt formed as one linear map of the damping nodes, K itself
-            # not formed (n_t × n_dof² values: 23,440 × 8,100 for Wu & Yuan); the same numbers up
-            # to round-off (tests/test_hydro_radiation.py)
-            T = impulse_response_transform(db, t, om)           # Im T = −∫ K sin ωt dt
-            A_rebuilt = self.A_inf_db[None] + T.imag / om[:, None, None]
-            lo, hi = self.radiation_band()
-            sel = (om >= lo) & (om <= hi)
-            # the median: robust to the stretches of a BEM grid where A(ω) is noisy or irregular
-            delta = np.median(np.asarray(db["added_mass"].values)[sel] - A_rebuilt[sel], axis=0)
-            delta = delta * self.mask
-            self._cache["A_inf"] = self.A_inf_db + 0.5 * (delta + delta.T)
-            self._cache["A_inf_band"] = (lo, hi)
+            # kept by the database's content and the coupling mask (hydro.fitcache): up to 1.6 s
+            # of every first run (Wu & Yuan)
+            self._cache["A_inf"] = cached_value(self.database(), "added_mass_inf_consistent",
+                                                {"mask": np.asarray(self.mask, float)},
+                                                self._consistent_added_mass_inf)
         return self._cache["A_inf"]
+
+    def _consistent_added_mass_inf(self) -> np.ndarray:
+        """:meth:`added_mass_inf`'s 'consistent' A∞, made."""
+        from .radiation import impulse_response_transform
+
+        db = self.database()
+        om = np.asarray(db["omega"].values)
+        t = np.arange(0.0, max(2 * self.memory(), 60.0), min(0.02, np.pi / om.max() / 4))
+        # A(ω) rebuilt from K by Ogilvie (hydro.radiation.added_mass_from_irf: A∞ − ∫K sin ωt
+        # dt / ω), with ∫K e^{−iωt} dt formed as one linear map of the damping nodes, K itself
+        # not formed (n_t × n_dof² values: 23,440 × 8,100 for Wu & Yuan); the same numbers up
+        # to round-off (tests/test_hydro_radiation.py)
+        T = impulse_response_transform(db, t, om)           # Im T = −∫ K sin ωt dt
+        A_rebuilt = self.A_inf_db[None] + T.imag / om[:, None, None]
+        lo, hi = self.radiation_band()
+        sel = (om >= lo) & (om <= hi)
+        # the median: robust to the stretches of a BEM grid where A(ω) is noisy or irregular
+        delta = np.median(np.asarray(db["added_mass"].values)[sel] - A_rebuilt[sel], axis=0)
+        delta = delta * self.mask
+        return self.A_inf_db + 0.5 * (delta + delta.T)
 
     def radiation_band(self, fraction: float = 0.05):
         """(ω_lo, ω_hi): where some diagonal damping B_ii(ω) is at least ``fraction`` of its own

@@ -32,6 +32,7 @@ def folder(tmp_path, monkeypatch):
     """An empty cache folder and an empty in-process cache."""
     monkeypatch.setenv("MFM_FIT_CACHE", str(tmp_path / "fits"))
     monkeypatch.setattr(FC, "_memory", collections.OrderedDict())
+    monkeypatch.setattr(FC, "_values", {})
     return tmp_path / "fits"
 
 
@@ -136,3 +137,33 @@ def test_plain_form_round_trips_every_field(sphere_db):
     assert [f.name for f in dataclasses.fields(back)] == [f.name for f in dataclasses.fields(fit)]
     _same_fit(back, fit)
     assert dict(back.report) == dict(fit.report)
+
+
+def test_memory_and_consistent_added_mass_read_back_equal_what_is_made(folder, monkeypatch):
+    # HydroSpec.memory() and its consistent A∞ (hydro.fitcache.cached_value): made once, then
+    # read from the folder by a later process (a fresh spec, the process's values forgotten)
+    # equal to the last bit without being made again; another rtol is another value
+    from hydro import prepare, radiation
+
+    def made():
+        spec = mfm.load(CONFIGS / "sphere.toml").hydro
+        return spec, spec.memory(), spec.added_mass_inf()
+
+    spec, T_K, A_inf = made()
+    ref_T = radiation.impulse_response_memory(spec.database(), np.arange(0.0, 400.0, 0.05),
+                                              rtol=1e-3)
+    assert T_K == ref_T
+    np.testing.assert_array_equal(A_inf, spec._consistent_added_mass_inf())
+    assert not A_inf.flags.writeable
+    assert len(list(folder.glob("*.pkl"))) == 2
+    FC.clear()
+
+    def never(*a, **k):
+        raise AssertionError("made again, not read back")
+    monkeypatch.setattr(radiation, "impulse_response_memory", never)
+    monkeypatch.setattr(prepare.HydroSpec, "_consistent_added_mass_inf", never)
+    _, T_K2, A_inf2 = made()
+    assert T_K2 == T_K
+    np.testing.assert_array_equal(A_inf2, A_inf)
+    with pytest.raises(AssertionError, match="made again"):
+        mfm.load(CONFIGS / "sphere.toml").hydro.memory(rtol=1e-2)
