@@ -15,7 +15,9 @@ kept under the sha256 of all three (with numpy's version: its linear algebra mak
   jax's is.
 
 A fit read back equals the one written to the last bit; its report gains ``cache``: the file it
-came from (``""`` when it was fitted in this process).
+came from (``""`` when it was fitted in this process). Smaller values that every process would
+make again from a database (its radiation memory T_K, its consistent A∞) are kept the same way
+(:func:`cached_value`).
 """
 from __future__ import annotations
 

@@ -59,11 +59,13 @@ def load(path: str | Path, hydro: bool = True, body_coupling: bool | None = None
                        None, f"loading {options['name']}") if progress is not None else None
     try:
         with phases.reporting(None if bar is None else (lambda what: phase(bar, what))):
-            return _assemble(path, hydro, body_coupling, raw, options, bodies)
+            model = _assemble(path, hydro, body_coupling, raw, options, bodies)
+        if bar is not None:
+            phase(bar, "done")      # the bar keeps its line: "done" says the load ended there
     finally:
         if bar is not None:
-            phase(bar, "done")
-            bar.close()
+            bar.close()             # after an error: its message follows the phase it stopped in
+    return model
 
 
 def _assemble(path, hydro, body_coupling, raw, options, bodies) -> Model:
