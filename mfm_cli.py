@@ -178,6 +178,10 @@ def main(argv=None):
     args = build_parser().parse_args(argv)
     if getattr(args, "progress", None) is not None:
         args.progress = progress_option(args.progress)     # simulate's progress= argument
+    else:
+        # a command without --progress still says what a long load does (its MoorPy tables:
+        # seconds where the cache is empty), as --progress auto would
+        args.progress = progress_option("auto")
     from mfm.io import cli   # the commands, and with them mfm and jax: only now that there is work
 
     try:

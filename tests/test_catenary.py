@@ -727,3 +727,13 @@ table_step = [1.0, 1.0]
     assert np.array_equal(np.asarray(quiet.loads[0].coef), np.asarray(shown.loads[0].coef))
     with pytest.raises(ValueError, match=r"progress: 'yes'; give False"):
         mfm.load(p, progress="yes")
+    # a command without --progress (mfm info) shows it too, as --progress auto would: in a log
+    # once the load has taken PROGRESS_DELAY_LOG (made 0 here, the table being quick)
+    import mfm_cli
+
+    monkeypatch.setattr(mfm_cli, "PROGRESS_DELAY_LOG", 0.0)
+    monkeypatch.setattr(mfm_cli, "PROGRESS_INTERVAL_LOG", 0.0)
+    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})
+    assert mfm_cli.main(["info", str(p)]) == 0
+    err = capsys.readouterr().err
+    assert "loading one moored hull" in err and "mooring table (MoorPy): 16 of 20 solves" in err

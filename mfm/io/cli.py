@@ -75,7 +75,7 @@ def cmd_info(args):
 
     options, _ = load_config(args.config)
     wet = "hydro" in options and not args.no_hydro
-    model = load(args.config, hydro=wet)
+    model = load(args.config, hydro=wet, progress=getattr(args, "progress", False))
     print(f"{model.name}: {model.n_bodies} bodies, {model.n_coordinates} coordinates, "
           f"gravity {float(model.gravity)} m/s²")
     print("\ntree:")
@@ -268,7 +268,7 @@ def cmd_optimize(args):
     from ..studies.optimize import optimize
 
     out = _writable(args.out)
-    model = load(args.config)
+    model = load(args.config, progress=getattr(args, "progress", False))
     sea = _sea(args, "optimize")
     parameters = _bounds(args.param, model)
     constraints = _constraints(args.constraint)
@@ -359,7 +359,8 @@ def cmd_rao(args):
 
     from hydro.database import split_complex
 
-    model = load(args.config, body_coupling=False if args.no_body_coupling else None)
+    model = load(args.config, body_coupling=False if args.no_body_coupling else None,
+                 progress=getattr(args, "progress", False))
     omega = np.linspace(args.omega_min, args.omega_max, args.n)
     ds = frequency_response(model, omega, heading=float(np.deg2rad(args.heading)),
                                 radiation=args.radiation)
