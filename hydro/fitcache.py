@@ -136,10 +136,12 @@ def _from_plain(fields: dict):
     return fit
 
 
-def _read(path: Path):
+def _read(path: Path, convert=_from_plain):
+    """``convert`` of what the file at ``path`` holds, or None (no file, or one that cannot be
+    read)."""
     try:
         with open(path, "rb") as f:
-            return _from_plain(pickle.load(f))
+            return convert(pickle.load(f))
     except FileNotFoundError:
         return None
     except Exception:                 # a damaged or foreign file: fitted again, written anew
@@ -169,10 +171,12 @@ def write_whole(path: Path, write) -> None:
         raise
 
 
-def _write(folder: Path, path: Path, fit) -> None:
+def _write(folder: Path, path: Path, plain) -> None:
+    """Pickle ``plain`` into ``path`` whole, then trim ``folder``; a folder that cannot be written
+    is warned about once."""
     global _warned
     try:
-        write_whole(path, lambda f: pickle.dump(_to_plain(fit), f,
+        write_whole(path, lambda f: pickle.dump(plain, f,
                                                 protocol=pickle.HIGHEST_PROTOCOL))
         trim(folder)
     except Exception as e:            # the cache is a shortcut: never the reason a run fails
@@ -220,7 +224,7 @@ def cached_fit(db, **options):
 
     fit = fit_state_space(db, **options)
     if path is not None:
-        _write(folder, path, fit)
+        _write(folder, path, _to_plain(fit))
     return _remember(key, _with_source(fit, ""))
 
 
@@ -236,21 +240,12 @@ def cached_value(db, name: str, options: dict, compute):
         return _values[key]
     folder = cache_dir()
     path = None if folder is None else folder / f"{key}.pkl"
-    if path is not None:
-        try:
-            with open(path, "rb") as f:
-                value = pickle.load(f)
-            os.utime(path)
-            return _keep(key, _readonly(value))
-        except Exception:             # none yet, or a damaged file: made again, written anew
-            pass
+    value = None if path is None else _read(path, _readonly)
+    if value is not None:
+        return _keep(key, value)
     value = _readonly(compute())
     if path is not None:
-        try:
-            write_whole(path, lambda f: pickle.dump(value, f, protocol=pickle.HIGHEST_PROTOCOL))
-            trim(folder)
-        except Exception:             # the cache is a shortcut: never the reason a run fails
-            pass
+        _write(folder, path, value)
     return _keep(key, value)
 
 

@@ -41,7 +41,7 @@ import numpy as np
 import xarray as xr
 
 from .passivity import _enforce_passivity, _enforce_passivity_common, _passivity_grid
-from .phases import say
+from .phases import every, say
 from .radiation import filon_weights, impulse_response, impulse_response_transform, memory_length
 from .vectorfit import _basis, _era_fit, _pole_residue, _vf
 
@@ -413,7 +413,7 @@ def fit_state_space(db: xr.Dataset, *, order="auto", method: str = "vf",
             enforce_passivity, om[-1])
     else:
         for e, (i, j) in enumerate(entries):
-            if e % max(1, len(entries) // 10) == 0:
+            if e % every(len(entries)) == 0:
                 say(f"state-space fit: entry {e + 1} of {len(entries)}")
             if symmetrize and (j, i) in done:               # same model, its own states
                 fits.append(fits[done[(j, i)]])

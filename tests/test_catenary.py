@@ -57,6 +57,19 @@ def hull_model(mass=1.61e7, k_heave=0.0, rest=0.0):
                   "rest": [0.0, 0.0, rest]}}]})[1])
 
 
+# the hull of hull_model as a config's [[bodies]] table
+HULL_TOML = '''
+[[bodies]]
+name = "hull"
+mass = 1.61e7
+com = [0.0, 0.0, -9.68]
+principal_inertia = [1e10, 1e10, 1e10]
+[bodies.joint]
+type = "free"
+dofs = ["surge", "sway", "heave"]
+'''
+
+
 @pytest.fixture(scope="module")
 def lines():
     model = hull_model()
@@ -217,16 +230,7 @@ def test_equilibrium_against_moorpy():
 
 def test_config_table_line_types_and_errors(tmp_path, lines):
     model, ld = lines
-    text = '''
-[[bodies]]
-name = "hull"
-mass = 1.61e7
-com = [0.0, 0.0, -9.68]
-principal_inertia = [1e10, 1e10, 1e10]
-[bodies.joint]
-type = "free"
-dofs = ["surge", "sway", "heave"]
-'''
+    text = HULL_TOML
     entries = []
     for i, ln in enumerate(wy_lines()):
         lt = ('line_type = {name = "chain", length = 800.0, mass_per_length = 303.0, EA = 1.243e9}'
@@ -693,17 +697,7 @@ def test_load_says_how_far_its_mooring_table_is(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(catenary, "_TABLE_CACHE", {})
     ln = wy_lines()[0]
     p = tmp_path / "moored.toml"
-    p.write_text(f'''[model]
-name = "one moored hull"
-[[bodies]]
-name = "hull"
-mass = 1.61e7
-com = [0.0, 0.0, -9.68]
-principal_inertia = [1e10, 1e10, 1e10]
-[bodies.joint]
-type = "free"
-dofs = ["surge", "sway", "heave"]
-[[catenary_lines]]
+    p.write_text('[model]\nname = "one moored hull"\n' + HULL_TOML + f'''[[catenary_lines]]
 name = "{ln["name"]}"
 body = "hull"
 fairlead = {ln["fairlead"]}
