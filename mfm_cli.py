@@ -183,6 +183,9 @@ def main(argv=None):
         # seconds where the cache is empty), as --progress auto would
         args.progress = progress_option("auto")
     from mfm.io import cli   # the commands, and with them mfm and jax: only now that there is work
+    from mfm import _gc
+
+    _gc.freeze_at_exit()     # the command's objects skip the exit's collections (mfm/_gc.py)
 
     try:
         getattr(cli, args.func)(args)

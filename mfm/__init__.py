@@ -40,8 +40,12 @@ from .errors import ConfigError, SweepError  # noqa: E402
 from .studies.sweep import sweep  # noqa: E402
 from .studies.optimize import optimize  # noqa: E402
 from . import _compat  # noqa: E402
+from . import _gc  # noqa: E402
 
 _compat.install()
+# the libraries' objects, which live as long as the process, out of the collector's walks (and
+# its exit's): see mfm/_gc.py
+_gc.freeze()
 
 
 def __getattr__(name):

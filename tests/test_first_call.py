@@ -16,6 +16,7 @@ import os
 import subprocess
 import sys
 import textwrap
+import types
 
 import jax
 import jax.numpy as jnp
@@ -323,3 +324,41 @@ def test_a_pipelined_run_calls_the_executables_it_compiled(monkeypatch):
         assert ds.sizes["time"] == 2111
         n_chunks = progress.pipeline_plan(2110, multiple=32)[1]
         assert len(calls) == 2 * n_chunks and all(calls), (integrator, calls)   # two programs
+
+
+def _freeze_count(env_extra):
+    code = "import gc, mfm; print(gc.get_freeze_count())"
+    env = dict(os.environ, **env_extra)
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True,
+                         text=True, check=True).stdout
+    return int(out.split()[-1])
+
+
+def test_importing_mfm_freezes_the_libraries_objects_unless_told_not_to():
+    # mfm/_gc.py: what exists at the end of the import (jax's, xarray's, mfm's own objects) is out
+    # of the collector's walks and the exit's; MFM_GC_FREEZE=off keeps Python's default
+    assert _freeze_count({"MFM_GC_FREEZE": ""}) > 50_000
+    assert _freeze_count({"MFM_GC_FREEZE": "off"}) == 0
+
+
+def test_the_command_line_freezes_at_exit_once(monkeypatch):
+    import gc
+
+    import mfm_cli
+    from mfm import _gc
+
+    registered = []
+    monkeypatch.setattr(_gc, "_at_exit", False)
+    # the module's own view of atexit (the other libraries' handlers register as usual)
+    monkeypatch.setattr(_gc, "atexit", types.SimpleNamespace(register=registered.append))
+    for _ in range(2):
+        assert mfm_cli.main(["info", str(CONFIGS / "double_pendulum.toml")]) == 0
+    assert registered == [_gc.freeze]                   # once, however many commands ran
+    # the handler itself moves what exists into the permanent generation (and undoes nothing)
+    monkeypatch.setenv("MFM_GC_FREEZE", "off")
+    assert _gc.freeze() is False
+    monkeypatch.delenv("MFM_GC_FREEZE")
+    before = gc.get_freeze_count()
+    made = [object() for _ in range(10)] + [[i] for i in range(1000)]
+    assert _gc.freeze() is True and gc.get_freeze_count() >= before + 1000
+    del made

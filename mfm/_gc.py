@@ -1,0 +1,52 @@
+"""Python's cyclic garbage collector and the objects that live as long as the process.
+
+Importing jax, xarray, hydro and mfm leaves ~150,000 objects the collector tracks (modules,
+functions, classes; a full collection then finds no garbage among them). Every later full
+collection walks them all again, and so does the interpreter's exit: a process that imported mfm
+spent 0.5 s in its exit, and one that had also run M4 134 1.0–1.3 s, before it returned to the
+shell (``python benchmarks/first_call.py``; the collections at exit, not the work of the run).
+
+So mfm moves what exists at the end of its import into the collector's permanent generation
+(:func:`gc.freeze`, the standard library's tool for long-lived objects): later collections and
+the exit skip them. Nothing is lost: those objects are the libraries' own and live to the end of
+the process anyway, and everything made afterwards (models, results, the user's objects) is
+collected as before. ``MFM_GC_FREEZE=off`` keeps Python's default.
+
+The command line (``mfm ...``) also freezes at its exit whatever its command made: it has closed
+its files by then, and the objects would only be collected to be thrown away with the process.
+A library cannot do that for a user's script, whose own objects may rely on being collected at
+exit (a file flushed by a finaliser), so :func:`freeze_at_exit` is the command line's alone.
+"""
+from __future__ import annotations
+
+import atexit
+import gc
+import os
+
+OFF = ("off", "0", "false", "no", "none")
+
+
+def enabled() -> bool:
+    """Whether ``MFM_GC_FREEZE`` leaves the freezing on (the default)."""
+    return os.environ.get("MFM_GC_FREEZE", "").strip().lower() not in OFF
+
+
+def freeze() -> bool:
+    """Move every object the collector tracks now into its permanent generation (unless
+    ``MFM_GC_FREEZE=off``); returns whether it did."""
+    if not enabled():
+        return False
+    gc.freeze()
+    return True
+
+
+_at_exit = False
+
+
+def freeze_at_exit() -> None:
+    """Freeze whatever exists when the interpreter exits, before its final collections (the
+    command line's: see the module docstring). Registered once however often it is called."""
+    global _at_exit
+    if not _at_exit:
+        atexit.register(freeze)
+        _at_exit = True
