@@ -240,3 +240,49 @@ def test_compiled_programs_are_kept_on_disk_and_loaded_by_a_later_process(tmp_pa
     # the default folder, under XDG_CACHE_HOME
     assert _child({"XDG_CACHE_HOME": str(tmp_path / "xdg")})["dir"] \
         == str(tmp_path / "xdg" / "mfm" / "jax")
+
+
+def test_wide_products_are_made_column_by_column_and_keep_the_loop_whole():
+    """se3.matmul_small with the loop compiled whole on a CPU: a product of ≥ 16,384
+    multiplications (Wu & Yuan's A∞ H, 75 × 75 × 18; Hᵀ(A∞ H); BᵀMB over 16 bodies) is made as
+    matrix–vector products in a loop, a narrower one (M4 134's 24 × 24 × 7) stays one
+    multiply–reduce. Both are X Y to the round-off of a sum of k terms (|X||Y| k u), in value,
+    derivatives and under vmap; and a time loop holding the wide one is still compiled whole."""
+    from mfm.mechanics import se3
+
+    assert _xla.LOOPS_COMPILED_WHOLE and jax.default_backend() == "cpu"
+    rng = np.random.default_rng(7)
+    cases = [((75, 75), (75, 18), False, True), ((24, 24), (24, 7), False, False),
+             ((16, 6, 18), (16, 6, 18), True, True), ((8, 6, 7), (8, 6, 7), True, False)]
+    for xs, ys, tr, wide in cases:
+        X, Y = rng.standard_normal(xs), rng.standard_normal(ys)
+        Xm, Ym = (X.reshape(-1, xs[-1]), Y.reshape(-1, ys[-1])) if tr else (X, Y)
+        want = Xm.T @ Ym if tr else X @ Y
+        k = Xm.shape[0] if tr else X.shape[1]
+        bound = k * np.finfo(float).eps * ((np.abs(Xm).T @ np.abs(Ym)) if tr
+                                           else np.abs(X) @ np.abs(Y))
+        f = jax.jit(lambda X, Y, tr=tr: se3.matmul_small(X, Y, transpose_x=tr))
+        got = np.asarray(f(jnp.asarray(X), jnp.asarray(Y)))
+        assert np.all(np.abs(got - want) <= bound), (xs, np.abs(got - want).max())
+        jaxpr = str(jax.make_jaxpr(f)(X, Y))
+        assert ("scan" in jaxpr or "while" in jaxpr) == wide, (xs, ys)     # the columns' loop
+        # linear in Y: its Jacobian is X (Xᵀ) itself, exactly; a vmapped call is the calls
+        J = np.asarray(jax.jacfwd(lambda Y: se3.matmul_small(jnp.asarray(X), Y, transpose_x=tr))(
+            jnp.asarray(Y)))
+        Jw = np.einsum("ij,kl->ikjl", Xm.T if tr else X, np.eye(Ym.shape[1]))
+        np.testing.assert_array_equal(J.reshape(Jw.shape[0], Jw.shape[1], -1),
+                                      Jw.reshape(Jw.shape[0], Jw.shape[1], -1))
+        batch = jnp.stack([jnp.asarray(Y), 2.0 * jnp.asarray(Y)])
+        v = np.asarray(jax.vmap(lambda Y: se3.matmul_small(jnp.asarray(X), Y, transpose_x=tr))(batch))
+        assert np.all(np.abs(v[1] - 2.0 * got) <= 2.0 * bound)
+
+    A = jnp.asarray(rng.standard_normal((75, 75)))
+
+    @jax.jit
+    def loop(H):
+        def step(i, H):
+            return H + 1e-6 * se3.matmul_small(A, H)
+        return jax.lax.fori_loop(0, 100, step, H)
+
+    H0 = jnp.asarray(rng.standard_normal((75, 18)))
+    assert "xla_cpu_small_call" in loop.lower(H0).compile().as_text()

@@ -11,6 +11,7 @@ All functions are pure jax and work on float64 arrays; batch them with ``jax.vma
 """
 from __future__ import annotations
 
+import jax
 import jax.numpy as jnp
 
 from .. import _xla
@@ -38,22 +39,55 @@ def rotate_t(R, v):
 # products X Y (m, k) × (k, p) up to this many multiplications are written as a multiply–reduce,
 # wider ones as a dot: XLA makes a wide multiply–reduce one slow library fusion (Wu & Yuan's BᵀMB,
 # 96 × 18 × 18: 55 µs/step traced, against a dot's few). With the time loop compiled whole
-# (mfm._xla, library fusions off) always a multiply–reduce: the inline dot is the slow one there
-# (the same product 28 µs/step)
+# (mfm._xla, library fusions off) a multiply–reduce up to _COLUMNS_LIMIT: the inline dot is the
+# slow one there (the same product 28 µs/step)
 _REDUCE_LIMIT = 8192
+# With the time loop compiled whole on a CPU, products of at least this many multiplications are
+# made column by column (:func:`_by_columns`): XLA emits a multiply–reduce there as one scalar
+# chain per output element (Wu & Yuan's A∞ H, 75 × 75 × 18: 71–83 µs an evaluation, and with
+# Hᵀ(A∞ H) more than half of the model's evaluation), a matrix–vector product as a vectorised
+# tiled loop (16 µs). Below it the multiply–reduce, which fuses with its operands' making, wins
+# (M4 134's 24 × 24 × 10).
+_COLUMNS_LIMIT = 16384
+
+
+def _by_columns(X, Y):
+    """X Y for X (m, k), Y (k, p) as p matrix–vector products X Y[:, l], in a loop (one copy of
+    the product in the compiled program: unrolled, the p copies cost Wu & Yuan's first run 8 s
+    more compilation for the same speed). Sums in another order than the multiply–reduce: the
+    same to round-off."""
+    YT = Y.T                                   # (p, k): the columns as contiguous rows
+
+    def column(l, GT):
+        y = jax.lax.dynamic_index_in_dim(YT, l, axis=0, keepdims=False)
+        return jax.lax.dynamic_update_index_in_dim(GT, X @ y, l, axis=0)
+
+    GT = jax.lax.fori_loop(0, YT.shape[0], column,
+                           jnp.zeros((YT.shape[0], X.shape[0]), jnp.result_type(X, Y)))
+    return GT.T
 
 
 def matmul_small(X, Y, *, transpose_x=False):
     """X Y for 2-D X (m, k), Y (k, p); with ``transpose_x``, Xᵀ Y for X (..., m), Y (..., p),
     summed over all leading axes. A multiply–reduce while m k p ≤ 8,192 (see :func:`rotate` for
-    why), a dot above; with the time loop compiled whole (:mod:`mfm._xla`) always a multiply–reduce
-    (XLA's inline dot of Wu & Yuan's BᵀMB cost 28 µs/step there). Xᵀ Y is reduced over X's leading
-    axes directly: a transposed or reshaped operand costs XLA extra copy kernels."""
+    why), a dot above. With the time loop compiled whole (:mod:`mfm._xla`) a multiply–reduce up
+    to m k p < 16,384 (XLA's inline dot of Wu & Yuan's BᵀMB cost 28 µs/step there), and on a CPU
+    column by column above (:func:`_by_columns`). Xᵀ Y is reduced over X's leading axes
+    directly: a transposed or reshaped operand costs XLA extra copy kernels."""
     if transpose_x:
         m, k = X.shape[-1], X.size // X.shape[-1]
     else:
         m, k = X.shape
-    if _xla.LOOPS_COMPILED_WHOLE or m * k * Y.shape[-1] <= _REDUCE_LIMIT:
+    p = Y.shape[-1]
+    if _xla.LOOPS_COMPILED_WHOLE:
+        if m * k * p >= _COLUMNS_LIMIT and jax.default_backend() == "cpu":
+            if transpose_x:
+                return _by_columns(X.reshape(k, m).T, Y.reshape(k, p))
+            return _by_columns(X, Y)
+        if transpose_x:
+            return jnp.sum(X[..., :, None] * Y[..., None, :], axis=tuple(range(X.ndim - 1)))
+        return jnp.sum(X[:, :, None] * Y[None, :, :], axis=1)
+    if m * k * p <= _REDUCE_LIMIT:
         if transpose_x:
             return jnp.sum(X[..., :, None] * Y[..., None, :], axis=tuple(range(X.ndim - 1)))
         return jnp.sum(X[:, :, None] * Y[None, :, :], axis=1)
