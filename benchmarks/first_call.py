@@ -60,7 +60,21 @@ def _phases(stderr: str) -> list[str]:
         m = re.search(r"\|\s*\d+/\d+ \[[^,\]]*, [^,\]]*/s, ([^\]]+)\]", part)
         if m and m.group(1).strip() not in seen:
             seen.append(m.group(1).strip())
-    return seen
+    return _counted(seen)
+
+
+def _counted(phases: list[str]) -> list[str]:
+    """Runs of one phase that counts ("passivity, iteration 3 of at most 40", "order 16 (3 of at
+    most 9)") as one entry from its first count to its last."""
+    out, last = [], None
+    for p in phases:
+        key = re.sub(r"\d+", "#", p)
+        if key == last and "#" in key:
+            out[-1] = (out[-1].split(" … ")[0]) + " … " + p
+        else:
+            out.append(p)
+        last = key
+    return out
 
 
 def main(argv=None):

@@ -243,7 +243,7 @@ def test_compiled_programs_are_kept_on_disk_and_loaded_by_a_later_process(tmp_pa
 
 
 def test_wide_products_are_made_column_by_column_and_keep_the_loop_whole():
-    """se3.matmul_small with the loop compiled whole on a CPU: a product of ≥ 16,384
+    """se3.matmul_small with the loop compiled whole on a CPU: a product of more than 8,192
     multiplications (Wu & Yuan's A∞ H, 75 × 75 × 18; Hᵀ(A∞ H); BᵀMB over 16 bodies) is made as
     matrix–vector products in a loop, a narrower one (M4 134's 24 × 24 × 7) stays one
     multiply–reduce. Both are X Y to the round-off of a sum of k terms (|X||Y| k u), in value,
@@ -253,6 +253,7 @@ def test_wide_products_are_made_column_by_column_and_keep_the_loop_whole():
     assert _xla.LOOPS_COMPILED_WHOLE and jax.default_backend() == "cpu"
     rng = np.random.default_rng(7)
     cases = [((75, 75), (75, 18), False, True), ((24, 24), (24, 7), False, False),
+             ((32, 32), (32, 8), False, False), ((32, 32), (32, 9), False, True),   # 8,192 | 9,216
              ((16, 6, 18), (16, 6, 18), True, True), ((8, 6, 7), (8, 6, 7), True, False)]
     for xs, ys, tr, wide in cases:
         X, Y = rng.standard_normal(xs), rng.standard_normal(ys)

@@ -42,13 +42,14 @@ def rotate_t(R, v):
 # (mfm._xla, library fusions off) a multiply–reduce up to _COLUMNS_LIMIT: the inline dot is the
 # slow one there (the same product 28 µs/step)
 _REDUCE_LIMIT = 8192
-# With the time loop compiled whole on a CPU, products of at least this many multiplications are
+# With the time loop compiled whole on a CPU, products of more than this many multiplications are
 # made column by column (:func:`_by_columns`): XLA emits a multiply–reduce there as one scalar
-# chain per output element (Wu & Yuan's A∞ H, 75 × 75 × 18: 71–83 µs an evaluation, and with
-# Hᵀ(A∞ H) more than half of the model's evaluation), a matrix–vector product as a vectorised
-# tiled loop (16 µs). Below it the multiply–reduce, which fuses with its operands' making, wins
-# (M4 134's 24 × 24 × 10).
-_COLUMNS_LIMIT = 16384
+# chain per output element (Wu & Yuan's A∞ H, 75 × 75 × 18: 82 µs an iteration of a loop, and
+# with Hᵀ(A∞ H) half of the model's evaluation), a matrix–vector product as a vectorised tiled
+# loop (16 µs; 36 × 36 × 12: 12.4 against 2.3 µs; python benchmarks/wide_products.py). Below it
+# the multiply–reduce, which fuses with its operands' making, is as fast or faster (M4 134's
+# 24 × 24 × 7: its loop 15–19 µs an evaluation against 20–21 µs by columns).
+_COLUMNS_LIMIT = 8192
 
 
 def _by_columns(X, Y):
@@ -71,7 +72,7 @@ def matmul_small(X, Y, *, transpose_x=False):
     """X Y for 2-D X (m, k), Y (k, p); with ``transpose_x``, Xᵀ Y for X (..., m), Y (..., p),
     summed over all leading axes. A multiply–reduce while m k p ≤ 8,192 (see :func:`rotate` for
     why), a dot above. With the time loop compiled whole (:mod:`mfm._xla`) a multiply–reduce up
-    to m k p < 16,384 (XLA's inline dot of Wu & Yuan's BᵀMB cost 28 µs/step there), and on a CPU
+    to the same size (XLA's inline dot of Wu & Yuan's BᵀMB cost 28 µs/step there), and on a CPU
     column by column above (:func:`_by_columns`). Xᵀ Y is reduced over X's leading axes
     directly: a transposed or reshaped operand costs XLA extra copy kernels."""
     if transpose_x:
@@ -80,7 +81,7 @@ def matmul_small(X, Y, *, transpose_x=False):
         m, k = X.shape
     p = Y.shape[-1]
     if _xla.LOOPS_COMPILED_WHOLE:
-        if m * k * p >= _COLUMNS_LIMIT and jax.default_backend() == "cpu":
+        if m * k * p > _COLUMNS_LIMIT and jax.default_backend() == "cpu":
             if transpose_x:
                 return _by_columns(X.reshape(k, m).T, Y.reshape(k, p))
             return _by_columns(X, Y)
