@@ -4,7 +4,8 @@ Importing jax, xarray, hydro and mfm leaves ~150,000 objects the collector track
 functions, classes; a full collection then finds no garbage among them). Every later full
 collection walks them all again, and so does the interpreter's exit: a process that imported mfm
 spent 0.5 s in its exit, and one that had also run M4 134 1.0–1.3 s, before it returned to the
-shell (``python benchmarks/first_call.py``; the collections at exit, not the work of the run).
+shell (its last line's time against the shell's clock; 0.1 s with ``os._exit``: the collections
+at exit, not the work of the run). benchmarks/RESULTS.md has the whole processes' figures.
 
 So mfm moves what exists at the end of its import into the collector's permanent generation
 (:func:`gc.freeze`, the standard library's tool for long-lived objects): later collections and
