@@ -24,12 +24,12 @@ import atexit
 import gc
 import os
 
-OFF = ("off", "0", "false", "no", "none")
+from ._xla import switched_off
 
 
 def enabled() -> bool:
     """Whether ``MFM_GC_FREEZE`` leaves the freezing on (the default)."""
-    return os.environ.get("MFM_GC_FREEZE", "").strip().lower() not in OFF
+    return not switched_off(os.environ.get("MFM_GC_FREEZE"))
 
 
 def freeze() -> bool:

@@ -60,7 +60,7 @@ def folder() -> Path | None:
     """The programs' folder, or None when either cache is off."""
     if _xla.COMPILATION_CACHE is None or jax.config.jax_disable_jit:
         return None
-    if os.environ.get(ENV, "").strip().lower() in ("off", "0", "false", "no", "none"):
+    if _xla.switched_off(os.environ.get(ENV)):
         return None
     return Path(_xla.COMPILATION_CACHE) / "mfm-programs"
 

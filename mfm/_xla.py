@@ -104,6 +104,17 @@ def _set_flags() -> tuple[bool, str]:
 LOOPS_COMPILED_WHOLE, LOOP_THRESHOLD = _set_flags()
 
 
+# what turns one of mfm's environment switches off (MFM_COMPILATION_CACHE, MFM_PROGRAM_CACHE,
+# MFM_GC_FREEZE; hydro's MFM_FIT_CACHE reads the same words in hydro/fitcache.py, which never
+# imports mfm)
+OFF_VALUES = ("off", "0", "false", "no", "none")
+
+
+def switched_off(setting: str | None) -> bool:
+    """Whether an environment variable's value (None: unset) says off."""
+    return (setting or "").strip().lower() in OFF_VALUES
+
+
 CACHE_ENV = "MFM_COMPILATION_CACHE"
 # the most the cache folder mfm chooses may hold (jax drops the least recently used beyond it)
 CACHE_BYTES = 2 * 2**30
@@ -126,7 +137,7 @@ def _set_cache() -> str | None:
     if own:
         return own
     setting = os.environ.get(CACHE_ENV, "").strip()
-    if setting.lower() in ("off", "0", "false", "no", "none"):
+    if switched_off(setting):
         return None
     path = setting or default_cache_dir()
     jax.config.update("jax_compilation_cache_dir", path)

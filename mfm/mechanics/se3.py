@@ -80,15 +80,12 @@ def matmul_small(X, Y, *, transpose_x=False):
     else:
         m, k = X.shape
     p = Y.shape[-1]
-    if _xla.LOOPS_COMPILED_WHOLE:
-        if m * k * p > _COLUMNS_LIMIT and jax.default_backend() == "cpu":
-            if transpose_x:
-                return _by_columns(X.reshape(k, m).T, Y.reshape(k, p))
-            return _by_columns(X, Y)
+    if (_xla.LOOPS_COMPILED_WHOLE and m * k * p > _COLUMNS_LIMIT
+            and jax.default_backend() == "cpu"):
         if transpose_x:
-            return jnp.sum(X[..., :, None] * Y[..., None, :], axis=tuple(range(X.ndim - 1)))
-        return jnp.sum(X[:, :, None] * Y[None, :, :], axis=1)
-    if m * k * p <= _REDUCE_LIMIT:
+            return _by_columns(X.reshape(k, m).T, Y.reshape(k, p))
+        return _by_columns(X, Y)
+    if _xla.LOOPS_COMPILED_WHOLE or m * k * p <= _REDUCE_LIMIT:
         if transpose_x:
             return jnp.sum(X[..., :, None] * Y[..., None, :], axis=tuple(range(X.ndim - 1)))
         return jnp.sum(X[:, :, None] * Y[None, :, :], axis=1)
