@@ -160,6 +160,8 @@ def _outputs_impl(model, loads, head, carries, recording: Recording = EVERY):
     return outputs_after(model, loads, stacked, recording)
 
 
+# for the memories' shapes only: a jit keeps its trace, so a warm run does not trace them again
+_init_memories_jit = jax.jit(init_memories)
 _start_jit = jax.jit(rollout_start, static_argnames=("integrator", "recording"))
 
 
@@ -248,7 +250,7 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
     t0, dt = jnp.asarray(t0, jnp.float64), jnp.asarray(dt, jnp.float64)
     model, loads = compile_view(model, loads)
     n_blocks = n_steps // save_every
-    memories = jax.eval_shape(lambda: init_memories(model, loads, t0, q0, qd0, dt))
+    memories = _programs.eval_shape(_init_memories_jit, model, loads, t0, q0, qd0, dt)
     headed = deferred((None, memories), recording)
     pipelined = headed and n_blocks >= progress.PIPELINE_MIN_SAMPLES
     start_args = (model, loads, q0, qd0, z0, t0, dt)
