@@ -255,6 +255,13 @@ def main():
                                loads=loads, save_every=n_tr)[1].block_until_ready()
         run_short()
         per = {k: v for k, v in traced_kernels(run_short, n_tr).items() if k in named}
+        if not per:
+            # a loop compiled whole is one native call to the profiler: its parts are not timed
+            print("\ntraced: no kernel of the step seen by the profiler (the time loop is compiled "
+                  "whole, one native call); to rank them kernel by kernel, run again with "
+                  "XLA_FLAGS=--xla_backend_extra_options=xla_cpu_small_while_loop_byte_threshold"
+                  "=1024 (XLA's default: the loop dispatched kernel by kernel, slower)")
+            return
         base = sorted(per.values())[len(per) // 2]
         print(f"\ntraced ({n_tr} steps; every kernel carries the trace's overhead, the median "
               f"kernel {base:.2f} µs/step): the kernels that take the most beyond the median\n"
