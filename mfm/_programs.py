@@ -220,10 +220,14 @@ def eval_shape(jitted, *args, **static):
     return jax.eval_shape(functools.partial(jitted, **static), *args)    # jax before the method
 
 
-def program(jitted, name: str, args: tuple, static: dict | None = None) -> "Program":
+def program(jitted, name: str, args: tuple, static: dict | None = None, *,
+            once: bool = False) -> "Program":
     """The :class:`Program` of ``jitted(*args, **static)``: the one this process made already
-    for that key, else one from disk, else one traced now (and saved)."""
+    for that key, else one from disk, else one traced now (and saved). ``once``: a program run
+    once per call, compiled with :func:`mfm._xla.once_options` (faster to compile, slower to
+    run)."""
     static = dict(static or {})
+    options = _xla.once_options() if once else None
     where = folder()
     try:
         if where is None:
@@ -231,11 +235,14 @@ def program(jitted, name: str, args: tuple, static: dict | None = None) -> "Prog
         k = key(name, args, static)
     except _Unkeyable:
         COUNTS["ordinary"] += 1
-        return Program(jitted, args, static, None)
+        return Program(jitted, args, static, None, options)
+    if options:
+        k += "-once"               # in this process, apart from the same program compiled fully
     with _LOCK:
         made = _MADE.get(k)
     if made is None:
-        made = Program(jitted, args, static, where / f"{name}-{k}.bin")
+        made = Program(jitted, args, static, where / f"{name}-{k.removesuffix('-once')}.bin",
+                       options)
         with _LOCK:
             made = _MADE.setdefault(k, made)
     return made
@@ -247,8 +254,10 @@ class Program:
     (None: the ordinary path). Call it with arrays of that structure; :meth:`compile` compiles it
     ahead (from any thread). Made by :func:`program`."""
 
-    def __init__(self, jitted, args: tuple, static: dict, path: Path | None):
+    def __init__(self, jitted, args: tuple, static: dict, path: Path | None,
+                 options: dict | None = None):
         self._jitted, self._static = jitted, static
+        self._options = options      # XLA's compiler options (None: its defaults)
         self._ordinary = lambda *a: jitted(*a, **static)
         self._lower = lambda *a: jitted.lower(*a, **static)
         self._tree = jax.tree_util.tree_structure(args)
@@ -287,6 +296,9 @@ class Program:
 
     def __call__(self, *args):
         compiled = self._compiled
+        if self._options and (compiled is None or _signature(args) != compiled[0]):
+            self.compile(*args)          # with its options: jax's own call would use the defaults
+            compiled = self._compiled
         if compiled is not None and _signature(args) == compiled[0]:
             out = compiled[1](*(args if self._call is None else self._flat(args)))
         elif self._call is None:
@@ -308,10 +320,9 @@ class Program:
         """Compile for arguments like ``args`` (arrays or ShapeDtypeStructs), here and now; a
         later call with arguments of the same structure, shapes, dtypes and weak types runs
         that executable."""
-        if self._call is None:
-            compiled = self._lower(*args).compile()
-        else:
-            compiled = self._call.lower(*self._flat(args)).compile()
+        lowered = (self._lower(*args) if self._call is None
+                   else self._call.lower(*self._flat(args)))
+        compiled = lowered.compile(self._options) if self._options else lowered.compile()
         self._compiled = (_signature(args), compiled)
 
 

@@ -115,6 +115,28 @@ def switched_off(setting: str | None) -> bool:
     return (setting or "").strip().lower() in OFF_VALUES
 
 
+# A program run once per call (a linearisation's Jacobians, the joints' reaction derivatives,
+# the moved dofs' samples) is compiled with XLA's backend at its lowest optimisation level: its
+# compilation is what the user waits for, its run a few milliseconds. M4 134's jet: 5.0–6.3 ->
+# 3.6–4.0 s to compile, 0.5 -> 1.4 ms to run; the same numbers to 1e-15. A time loop keeps
+# XLA's default (it runs 8x slower at level 0: benchmarks/RESULTS.md).
+ONCE_OPTIONS = {"xla_backend_optimization_level": 0}
+ONCE_ENV = "MFM_FAST_COMPILE"
+
+
+def once_options() -> dict | None:
+    """The compiler options of a program run once per call (:data:`ONCE_OPTIONS`) on a CPU, or
+    None: on another backend (not measured), where ``XLA_FLAGS`` sets the optimisation level
+    itself (yours wins), or with ``MFM_FAST_COMPILE=off``."""
+    import jax
+
+    if (switched_off(os.environ.get(ONCE_ENV))
+            or "xla_backend_optimization_level" in os.environ.get("XLA_FLAGS", "")
+            or jax.default_backend() != "cpu"):
+        return None
+    return dict(ONCE_OPTIONS)
+
+
 CACHE_ENV = "MFM_COMPILATION_CACHE"
 # the most the cache folder mfm chooses may hold (jax drops the least recently used beyond it)
 CACHE_BYTES = 2 * 2**30

@@ -299,8 +299,8 @@ def test_a_pipelined_run_calls_the_executables_it_compiled(monkeypatch):
     made = {}
     program = _programs.program
 
-    def keep(jitted, name, args, static=None):
-        made[name] = program(jitted, name, args, static)
+    def keep(jitted, name, args, static=None, **kw):
+        made[name] = program(jitted, name, args, static, **kw)
         return made[name]
 
     calls = []
@@ -405,3 +405,57 @@ def test_a_warm_run_traces_nothing(monkeypatch, tmp_path, kept):
         monitoring.unregister_event_duration_listener(listen)
     assert traced == [], traced
     np.testing.assert_array_equal(second.q.values, first.q.values)
+
+
+def test_programs_run_once_compile_fast_and_give_the_same_numbers(monkeypatch, tmp_path):
+    """A program run once per call (the jet of the checks, the equilibrium and the frequency
+    domain) is compiled with XLA's backend at level 0 (mfm._xla.once_options), on the saved and
+    the ordinary path alike, and gives the numbers of the program compiled at XLA's default
+    level within round-off; XLA_FLAGS naming the level, or MFM_FAST_COMPILE=off, keeps XLA's own
+    choice. The suite itself compiles everything at level 0 (conftest), so the flags are set
+    here as a user's process has them."""
+    import mfm
+    from mfm import _xla
+    from mfm.frequency import rest
+
+    flags = " ".join(f for f in os.environ.get("XLA_FLAGS", "").split()
+                     if "optimization_level" not in f)
+    monkeypatch.setenv("XLA_FLAGS", flags)
+    monkeypatch.delenv(_xla.ONCE_ENV, raising=False)
+    assert _xla.once_options() == (_xla.ONCE_OPTIONS if jax.default_backend() == "cpu" else None)
+    if jax.default_backend() != "cpu":
+        pytest.skip("level 0 is asked for on a CPU only")
+    monkeypatch.setenv(_xla.ONCE_ENV, "off")
+    assert _xla.once_options() is None
+    monkeypatch.setenv(_xla.ONCE_ENV, "on")
+    monkeypatch.setenv("XLA_FLAGS", flags + " --xla_backend_optimization_level=2")
+    assert _xla.once_options() is None
+    monkeypatch.setenv("XLA_FLAGS", flags)
+
+    asked = []
+    plain_compile = jax.stages.Lowered.compile
+
+    def spy(self, compiler_options=None, **kw):
+        asked.append(compiler_options)
+        return plain_compile(self, compiler_options, **kw)
+
+    monkeypatch.setattr(jax.stages.Lowered, "compile", spy)
+    m = mfm.load(CONFIGS / "double_pendulum.toml")
+    keyed, static, mems = rest._static_functions(m, rest.still_water_loads(m, ()))
+    q = jnp.asarray([0.3, -0.2])
+    args = (keyed, static, mems, q)
+    reference = plain_compile(rest._static_jet.lower(*args),
+                              {"xla_backend_optimization_level": 2})(*args)
+    for kept in (True, False):
+        _fresh(monkeypatch, tmp_path / str(kept))
+        if not kept:
+            monkeypatch.setattr(_programs, "folder", lambda: None)
+        del asked[:]
+        got = rest._jet_program(*args)(*args)
+        assert asked == [_xla.ONCE_OPTIONS], asked        # compiled once, at level 0
+        for a, b in zip(jax.tree_util.tree_leaves(got), jax.tree_util.tree_leaves(reference)):
+            a, b = np.asarray(a), np.asarray(b)
+            # the same operations in the same order, fused differently: a few ulps of the
+            # largest entry at most
+            np.testing.assert_allclose(a, b, rtol=0, atol=64 * np.finfo(float).eps
+                                       * max(np.abs(b).max(), 1e-300))

@@ -24,7 +24,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .. import results
+from .. import _programs, results
 from ..loads.assembly import applied_loads, compile_view, state_offsets
 from ..loads.base import Context
 from ..mechanics.dynamics import Evaluation, gravity_loads, reaction_loads
@@ -93,8 +93,10 @@ def _reaction_derivatives(model, loads, q0):
 
 def _joint_reactions(model, sys, omega, heading, options, x):
     """(static (n, 6), complex amplitudes (n_ω, n, 6)): see :func:`joint_reactions`."""
-    static, (Jq, Jv, Ja) = jax.tree_util.tree_map(
-        np.asarray, _reaction_derivatives(*compile_view(model, sys.loads), jnp.asarray(sys.q0, jnp.float64)))
+    args = (*compile_view(model, sys.loads), jnp.asarray(sys.q0, jnp.float64))
+    # run once per call: compiled for a fast compilation, and kept on disk (mfm._programs)
+    derivatives = _programs.program(_reaction_derivatives, "reaction_derivatives", args, once=True)
+    static, (Jq, Jv, Ja) = jax.tree_util.tree_map(np.asarray, derivatives(*args))
     w = omega[:, None, None, None]
     D = Jq[None] - 1j * w * Jv[None] - w**2 * Ja[None]           # (n_ω, n, 6, n_q)
     out = np.einsum("wnai,wi->wna", D, x)

@@ -121,7 +121,7 @@ def _static_functions(model: Model, loads):
 def _jet_program(model, static, mems, q):
     """:func:`_static_jet` for these arguments' structure, from disk where an earlier process
     traced it (:mod:`mfm._programs`): called from the host, not inside a trace."""
-    return _programs.program(_static_jet, "static_jet", (model, static, mems, q))
+    return _programs.program(_static_jet, "static_jet", (model, static, mems, q), once=True)
 
 
 def jet(model: Model, q, loads) -> _Jet:
