@@ -331,16 +331,7 @@ class CatenaryLines(Load):
     def frequency_outputs(self, model, kin0, x, omega):
         """Tension amplitude per metre of wave amplitude: ∂T/∂r_F at q₀ times the fairlead's
         displacement amplitude (the line's own linearisation, the one the stiffness uses)."""
-        P = len(self.names)
-
-        def tension(p):
-            H, V, _ = self.tensions(p)
-            return jnp.sqrt(H * H + V * V)
-
-        p0 = self.fairleads.positions(kin0)
-        dT = np.asarray(jax.jacfwd(tension)(p0))                               # (P, P, 3)
-        dT = np.einsum("kka->ka", dT)
-        Hp = np.asarray(self.fairleads.h_matrix(kin0)[0]).reshape(P, 6, -1)[:, :3]
+        dT, Hp = (np.asarray(a) for a in _tension_gradient(self, kin0))
         rao = np.einsum("ka,kai,wi->wk", dT, Hp, x)
         return {"fairlead_tension_rao": (("mooring_line",), rao,
                                          {"long_name": "fairlead tension amplitude per metre of "
@@ -529,6 +520,23 @@ class CatenaryLines(Load):
                    anchors=jnp.asarray(np.stack([t["anchor"] for t in parsed])),
                    coef=jnp.asarray(padded), n=jnp.asarray(n), lo=jnp.asarray(np.array(lo)), step=jnp.asarray(np.array(step)),
                    names=tuple(t["name"] for t in parsed), lines=tuple(lines))
+
+
+@eqx.filter_jit
+def _tension_gradient(lines: CatenaryLines, kin0):
+    """∂T/∂r_F (P, 3) of each line's fairlead tension T = √(H² + V²) at the fairleads of
+    ``kin0``, and the fairleads' velocity maps ∂ṙ_F/∂q̇ (P, 3, n_q) there (compiled: op by op,
+    the first frequency response of Wu & Yuan spent 6 s compiling its primitives one by one)."""
+    P = len(lines.names)
+
+    def tension(p):
+        H, V, _ = lines.tensions(p)
+        return jnp.sqrt(H * H + V * V)
+
+    p0 = lines.fairleads.positions(kin0)
+    k = jnp.arange(P)
+    dT = jax.jacfwd(tension)(p0)[k, k]                                      # line k's own
+    return dT, lines.fairleads.h_matrix(kin0)[0].reshape(P, 6, -1)[:, :3]
 
 
 @eqx.filter_jit

@@ -281,7 +281,7 @@ class Water(Load):
                              f"database's [{om_db[0]:.7g}, {om_db[-1]:.7g}] rad/s; choose frequencies "
                              "inside it or regenerate the database")
         A, B = rad.coefficients(spec, np.clip(omega, om_db[0], om_db[-1]))
-        H0 = np.asarray(self.geometry.h_matrix(kin0)[0])
+        H0 = np.asarray(_h_matrix(self.geometry, kin0))
         A_rel = np.asarray(A) - np.asarray(self.A_inf)[None]
         if not excitation:
             return A_rel, np.asarray(B), None, H0
@@ -318,9 +318,7 @@ class Water(Load):
         F = -np.einsum("wab,wb->wa", -w**2 * A_rel - 1j * w * B, xi)
         if X is not None:
             F = F + X
-        # the (linear) map to body wrenches as a matrix: one jacobian, not one call per ω
-        T = np.asarray(jax.jacfwd(lambda f: self.geometry.to_body_wrench(f, kin0, model.n_bodies))(
-            jnp.zeros(F.shape[1])))
+        T = np.asarray(_wrench_map(self.geometry, kin0, model.n_bodies))
         return np.einsum("nbk,wk->wnb", T, F)
 
     def frequency_range(self):
@@ -328,7 +326,7 @@ class Water(Load):
         return float(om[0]), float(om[-1])
 
     def frequency_outputs(self, model, kin0, x, omega):
-        H0 = np.asarray(self.geometry.h_matrix(kin0)[0])
+        H0 = np.asarray(_h_matrix(self.geometry, kin0))
         return {"xi_rao": (("hydro_dof",), np.einsum("ai,wi->wa", H0, x),
                            {"long_name": "hydro coordinates (reference points) RAO",
                             "units": "m/m or rad/m"}),
@@ -657,6 +655,23 @@ def _h_samples(model, geo, qs):
     from ..mechanics.kinematics import kinematics
 
     return jax.vmap(lambda q: geo.h_matrix(kinematics(model, q, jnp.zeros_like(q)))[0])(qs)
+
+
+# The frequency domain's maps at q₀, compiled: op by op, each primitive compiled on its own
+# (Wu & Yuan's first frequency response: ~3 s of these two)
+@eqx.filter_jit
+def _h_matrix(geometry: BodyPoints, kin0):
+    """H₀ (6K, n_q): ξ̇ = H₀ q̇ at the configuration of ``kin0``."""
+    return geometry.h_matrix(kin0)[0]
+
+
+@eqx.filter_jit
+def _wrench_map(geometry: BodyPoints, kin0, n_bodies: int):
+    """The linear map of loads at the reference points (6K) to body wrenches (n_bodies, 6) at
+    the configuration of ``kin0`` (:meth:`BodyPoints.to_body_wrench`), as a matrix: one
+    jacobian, not one call per ω."""
+    return jax.jacfwd(lambda f: geometry.to_body_wrench(f, kin0, n_bodies))(
+        jnp.zeros(6 * len(geometry.body_index)))
 
 
 def moving_dofs(model, body_index, d_ref, n_samples: int = 3, seed: int = 0) -> np.ndarray:
