@@ -418,3 +418,33 @@ def test_cubic_errors_name_the_matrix():
         cubic_natural_frequencies(I3, np.diag([1.0, -2.0, 3.0]))
     with pytest.raises(ValueError, match="complex roots"):
         cubic_natural_frequencies(np.array([[1.0, 2.0, 0], [-2.0, 1.0, 0], [0, 0, 1.0]]), I3)
+
+
+def test_the_frequency_domain_is_a_few_programs_not_op_by_op():
+    """frequency_response's work at q₀ (the jet, H₀, the body-wrench and reaction maps) is made
+    by a few compiled programs. Op by op, each primitive of its jacobians was compiled on its own
+    (the sphere: 90 compilations; Wu & Yuan m1: 207, 9 s of a first call), and no cache keeps
+    such tiny programs for the next process. Counted by jax's compile events after its caches
+    are cleared (as a fresh process finds them), not timed."""
+    import jax
+    from jax._src import monitoring
+
+    m = mfm.load(CONFIGS / "sphere.toml")
+    om = np.asarray(m.hydro.database()["omega"].values)
+    om = np.linspace(om[0] * 1.05, om[-1] * 0.95, 4)
+    compiled = []
+
+    def listen(name, dur, **kw):
+        if name.endswith("backend_compile_duration"):
+            compiled.append(kw.get("fun_name", "?"))
+
+    jax.clear_caches()
+    monitoring.register_event_duration_secs_listener(listen)
+    try:
+        r = mfm.frequency_response(m, om)
+    finally:
+        monitoring.unregister_event_duration_listener(listen)
+    assert np.isfinite(r.rao.values).all() and np.isfinite(r.joint_force_rao.values).all()
+    # today 14: the jet, the memories, H₀, the wrench and reaction maps and their derivatives,
+    # and a few scalars of the equilibrium's scale; op by op it was 90
+    assert len(compiled) <= 25, sorted(compiled)

@@ -46,6 +46,7 @@ import xarray as xr
 from .. import results
 from ..loads.pto import load_dampers
 from ..mechanics.model import Model
+from ..mechanics.points import h_matrix_at
 from ..validation import check_model, check_sea, finite_number
 from .rest import linear_system, water_of
 
@@ -271,7 +272,7 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
     water = water_of(sys.loads)
     spec = model.hydro
     rad = StateSpace.build(spec, state_space_options)
-    H0 = np.asarray(water.geometry.h_matrix(sys.kin0)[0])
+    H0 = np.asarray(h_matrix_at(water.geometry, sys.kin0))
     # the fit's A∞ (its corrected one) in place of the database's that the linearisation holds
     M = sys.M + H0.T @ (np.asarray(rad.A_inf) - np.asarray(water.A_inf)) @ H0
     t = dt * np.arange(n_steps + 1)

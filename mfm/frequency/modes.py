@@ -13,7 +13,7 @@ from .. import results
 from ..loads import body_matrix
 from ..loads.base import MODES
 from ..mechanics.model import Model
-from ..mechanics.points import BodyPoints
+from ..mechanics.points import BodyPoints, h_matrix_at
 from .response import _frequency_range, _mass_and_damping_at
 from .rest import linear_system
 from ..validation import check_model
@@ -222,7 +222,7 @@ def critical_damping(model: Model, body: str, mode: str, ratio: float, *, point=
     i = model.body_index(body)
     pt = np.asarray(model.com[i]) if point is None else np.asarray(point, dtype=float)
     sys = linear_system(model, loads=loads)
-    Hp = np.asarray(BodyPoints.on_bodies(model.com, [i], [pt]).h_matrix(sys.kin0)[0])
+    Hp = np.asarray(h_matrix_at(BodyPoints.on_bodies(model.com, [i], [pt]), sys.kin0))
     phi = np.linalg.pinv(Hp)[:, j]
     moved = float((Hp @ phi)[j]) if phi.size else 0.0
     if abs(moved) < 1e-9:

@@ -36,6 +36,7 @@ from ..loads.assembly import (RK4_STAGE_OFFSETS, applied_loads, as_loads, carrie
 from ..mechanics.dynamics import gravity_loads, joint_loads, mass_matrix
 from ..mechanics.kinematics import kinematics
 from ..mechanics.model import Model
+from ..mechanics.points import h_matrix_at
 from ..validation import check_model, initial_vector
 
 
@@ -229,7 +230,7 @@ def linearise(model: Model, q0=None, *, loads=None):
     sys = linear_system(model, q0, loads=loads)
     M0 = np.asarray(mass_matrix(model, jnp.asarray(sys.q0)))
     water = water_of(sys.loads)
-    H0 = None if water is None else np.asarray(water.geometry.h_matrix(sys.kin0)[0])
+    H0 = None if water is None else np.asarray(h_matrix_at(water.geometry, sys.kin0))
     return sys.q0, M0, sys.K, sys.C, H0
 
 

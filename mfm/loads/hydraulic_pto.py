@@ -109,7 +109,7 @@ class HydraulicPTO(Load):
     def frequency_outputs(self, model, kin0, x, omega):
         """Stroke amplitude ŵ = g x̂, force amplitude f̂ = (κ − ω²μ − iωβ) ŵ (:meth:`force_rao`)
         and mean power ½ β ω² |ŵ|² per unit wave amplitude squared."""
-        _, _, g, _, _ = self._kinematics(kin0)
+        _, _, g, _, _ = _kinematics_at(self, kin0)
         stroke = x @ np.asarray(g).T
         return {"hydraulic_pto_rao": (("hydraulic_pto",), stroke,
                                       {"long_name": "piston stroke per metre of wave amplitude",
@@ -127,7 +127,7 @@ class HydraulicPTO(Load):
     def linear_dampers(self, kin0):
         """The pistons to first order about q₀: ẇ = g(q₀) q̇, power β ẇ² (the β term of
         :meth:`evaluate`; μ and κ absorb nothing)."""
-        w, _, g, _, _ = self._kinematics(kin0)
+        w, _, g, _, _ = _kinematics_at(self, kin0)
         return LinearDampers(tuple(self.names), np.asarray(self.beta, dtype=float),
                              np.asarray(g, dtype=float), np.asarray(w, dtype=float))
 
@@ -170,3 +170,10 @@ class HydraulicPTO(Load):
                    length0=jnp.asarray([np.linalg.norm(p["point"] - p["anchor"]) for p in P]),
                    b_fixed=tuple(p["anchor_body"] is None for p in P),
                    names=tuple(p["name"] for p in P))
+
+
+@eqx.filter_jit
+def _kinematics_at(ptos: HydraulicPTO, kin):
+    """``ptos._kinematics(kin)`` compiled, for the host's calls at q₀ (the frequency domain's
+    outputs and dampers): op by op, each primitive compiled on its own."""
+    return ptos._kinematics(kin)

@@ -13,7 +13,7 @@ import equinox as eqx
 import numpy as np
 
 from ..validation import body_ref, tables, vector
-from ..mechanics.points import BodyPoints
+from ..mechanics.points import BodyPoints, h_matrix_at
 from ..errors import ConfigError
 from .base import Load, LoadOutput
 
@@ -48,7 +48,7 @@ class BodyPointOutputs(Load):
                                                            "units": "m/s2"})}
 
     def frequency_outputs(self, model, kin0, x, omega):
-        H = np.asarray(self.points.h_matrix(kin0)[0]).reshape(len(self.names), 6, -1)[:, :3]
+        H = np.asarray(h_matrix_at(self.points, kin0)).reshape(len(self.names), 6, -1)[:, :3]
         disp = np.einsum("pai,wi->wpa", H, x)
         return {"point_rao": (("point", "axis"), disp,
                               {"long_name": "displacement of each named body point per metre of "

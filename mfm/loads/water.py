@@ -45,7 +45,7 @@ from hydro.seabatch import components_many
 
 from .. import _programs
 from ..mechanics import se3
-from ..mechanics.points import BodyPoints
+from ..mechanics.points import BodyPoints, h_matrix_at
 from .base import FrequencyTerms, Load, LoadOutput
 from .radiation import NoRadiation, grid_subdivisions, strategy, strategy_many
 
@@ -281,7 +281,7 @@ class Water(Load):
                              f"database's [{om_db[0]:.7g}, {om_db[-1]:.7g}] rad/s; choose frequencies "
                              "inside it or regenerate the database")
         A, B = rad.coefficients(spec, np.clip(omega, om_db[0], om_db[-1]))
-        H0 = np.asarray(_h_matrix(self.geometry, kin0))
+        H0 = np.asarray(h_matrix_at(self.geometry, kin0))
         A_rel = np.asarray(A) - np.asarray(self.A_inf)[None]
         if not excitation:
             return A_rel, np.asarray(B), None, H0
@@ -326,7 +326,7 @@ class Water(Load):
         return float(om[0]), float(om[-1])
 
     def frequency_outputs(self, model, kin0, x, omega):
-        H0 = np.asarray(_h_matrix(self.geometry, kin0))
+        H0 = np.asarray(h_matrix_at(self.geometry, kin0))
         return {"xi_rao": (("hydro_dof",), np.einsum("ai,wi->wa", H0, x),
                            {"long_name": "hydro coordinates (reference points) RAO",
                             "units": "m/m or rad/m"}),
@@ -657,14 +657,8 @@ def _h_samples(model, geo, qs):
     return jax.vmap(lambda q: geo.h_matrix(kinematics(model, q, jnp.zeros_like(q)))[0])(qs)
 
 
-# The frequency domain's maps at q₀, compiled: op by op, each primitive compiled on its own
-# (Wu & Yuan's first frequency response: ~3 s of these two)
-@eqx.filter_jit
-def _h_matrix(geometry: BodyPoints, kin0):
-    """H₀ (6K, n_q): ξ̇ = H₀ q̇ at the configuration of ``kin0``."""
-    return geometry.h_matrix(kin0)[0]
-
-
+# The frequency domain's map at q₀, compiled: op by op, each primitive compiled on its own
+# (Wu & Yuan's first frequency response: ~3 s of it and H₀)
 @eqx.filter_jit
 def _wrench_map(geometry: BodyPoints, kin0, n_bodies: int):
     """The linear map of loads at the reference points (6K) to body wrenches (n_bodies, 6) at

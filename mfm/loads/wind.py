@@ -45,7 +45,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..validation import body_ref, number, tables, vector
-from ..mechanics.points import BodyPoints
+from ..mechanics.points import BodyPoints, h_matrix_at
 from ..errors import ConfigError
 from .base import Load, LoadOutput
 
@@ -178,7 +178,7 @@ class WindThrust(Load):
 
     def frequency_outputs(self, model, kin0, x, omega):
         """Thrust fluctuation −ρ A C_T U û_hub per metre of wave amplitude, û_hub = −iω d·H x̂."""
-        Hm = np.asarray(self.points.h_matrix(kin0)[0]).reshape(len(self.names), 6, -1)[:, :3]
+        Hm = np.asarray(h_matrix_at(self.points, kin0)).reshape(len(self.names), 6, -1)[:, :3]
         d = np.asarray(self.direction)
         u = -1j * omega[:, None] * np.einsum("pa,pai,wi->wp", d, Hm, x)
         slope = -np.asarray(self.rho_air * self.area * self.thrust_coefficient * self.wind_speed)

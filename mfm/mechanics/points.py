@@ -81,3 +81,11 @@ class BodyPoints(eqx.Module):
         """Inertial positions of the points (K, 3)."""
         idx, R, rho = self._frames(kin)
         return kin.E[idx, :3, 3] + rho
+
+
+@eqx.filter_jit
+def h_matrix_at(points: BodyPoints, kin):
+    """``points.h_matrix(kin)[0]`` compiled: H (6K, n_q) at one configuration, for the host (the
+    frequency domain's maps at q₀). Op by op, each primitive of it is compiled on its own, and
+    no cache keeps those (Stansby & Li's first frequency response: ~1.5 s)."""
+    return points.h_matrix(kin)[0]
