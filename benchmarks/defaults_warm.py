@@ -1,7 +1,7 @@
 """Issue 34's row "`simulate` defaults warm, M4 134": the time of a repeated ``mfm.simulate`` call
 with its defaults, beside the accuracy it keeps (not a test).
 
-    python benchmarks/defaults_warm.py [--repeats 5]
+    python benchmarks/defaults_warm.py [--repeats 5] [--rows defaults exact fast]
 
 M4 134 in the sea of benchmarks/speed.py (JONSWAP H_s 0.04 m, T_p 1.2 s, γ 3.3, seed 1), 100 T_p
 at dt = T_p/200 (20,000 steps), ramp 5 T_p. Rows, each compiled once and then timed
@@ -67,6 +67,10 @@ def measures(ds, keep_from):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--rows", nargs="+", choices=("defaults", "exact", "fast"),
+                    default=("defaults", "exact", "fast"),
+                    help="which rows: defaults, rk4 + state_space_exact, verlet + "
+                    "state_space_exact (default: all three)")
     args = ap.parse_args()
     import jax
     import jax.numpy as jnp
@@ -88,6 +92,8 @@ def main():
             ("rk4 + state_space_exact", dict(radiation="state_space_exact")),
             ("verlet + state_space_exact", dict(integrator="verlet",
                                                 radiation="state_space_exact"))]
+    rows = [r for r, key in zip(rows, ("defaults", "exact", "fast")) if key in args.rows]
+    choice = None
     print(f"M4 134, {N} steps at dt = {dt:g} s; accuracy against RK4 at dt/4 (state space "
           f"integrated) over the last 80 T_p: θ_rms {np.round(theta_ref, 5).tolist()} rad, "
           f"power {power_ref:.6g} W")
@@ -134,7 +140,8 @@ def main():
               f"{e_theta:.1e} | {e_power:.1e} | {ds.attrs['radiation']} |")
         if name == "defaults":
             choice = ds.attrs["radiation_choice"]
-    print(f"\ndefaults: integrator rk4, radiation_choice: {choice}")
+    if choice is not None:
+        print(f"\ndefaults: integrator rk4, radiation_choice: {choice}")
     print("goal: defaults warm ≤ 0.4 s with θ_rms and power within 0.5 % (issue 34)")
 
 
