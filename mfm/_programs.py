@@ -207,6 +207,7 @@ def key(name: str, args: tuple, static: dict) -> str:
 
 
 _MADE: dict = {}
+_ORDINARY_ONCE: dict = {}     # the ordinary path's programs compiled with options (program())
 _LOCK = threading.Lock()
 
 
@@ -235,14 +236,24 @@ def program(jitted, name: str, args: tuple, static: dict | None = None, *,
         k = key(name, args, static)
     except _Unkeyable:
         COUNTS["ordinary"] += 1
-        return Program(jitted, args, static, None, options)
-    if options:
-        k += "-once"               # in this process, apart from the same program compiled fully
+        if not options:
+            return Program(jitted, args, static, None)      # jax's own jit cache keeps it
+        # compiled with its options by the Program itself, which jax's cache does not keep:
+        # kept here, per structure, so that a later call (the equilibrium's next model, a
+        # second linearisation) does not compile it again
+        k = (name, _signature(args), tuple(sorted(static.items())))
+        with _LOCK:
+            made = _ORDINARY_ONCE.get(k)
+        if made is None:
+            made = Program(jitted, args, static, None, options)
+            with _LOCK:
+                made = _ORDINARY_ONCE.setdefault(k, made)
+        return made
+    k = (k, bool(options))         # the same program compiled at XLA's level 0 is another one
     with _LOCK:
         made = _MADE.get(k)
     if made is None:
-        made = Program(jitted, args, static, where / f"{name}-{k.removesuffix('-once')}.bin",
-                       options)
+        made = Program(jitted, args, static, where / f"{name}-{k[0]}.bin", options)
         with _LOCK:
             made = _MADE.setdefault(k, made)
     return made
