@@ -1,6 +1,7 @@
 """Issue 34's first-answer rows: what a new user waits for, each in a fresh process (not a test).
 
-    python benchmarks/first_call.py [--only rm3 rm3_cached m4 m4_cached wu_yuan]
+    python benchmarks/first_call.py [--only rm3 rm3_cached m4 m4_cached wu_yuan wu_yuan_fd
+                                     wu_yuan_fd_cached]
 
 - ``rm3``: the README's first command (``mfm simulate configs/rm3.toml ...``, the run without the
   install), compilation and fit caches empty (fresh folders). Goal ≤ 3 s.
@@ -9,6 +10,9 @@
   T_p 1.2 s, 100 T_p at dt = T_p/200 (the sea of benchmarks/speed.py), empty caches. Goal ≤ 8 s.
 - ``m4_cached``: the same in a second fresh process that finds the caches the first one filled.
   Goal ≤ 1.5 s.
+- ``wu_yuan_fd``: ``mfm.frequency_response`` of Wu & Yuan model 1 (configs/wu_yuan_m1.toml) at
+  periods 6 and 8 s (the issue's two periods), empty caches; ``wu_yuan_fd_cached``: the same in a
+  second fresh process that finds the caches the first filled. Not run unless named in ``--only``.
 - ``wu_yuan``: ``mfm simulate configs/wu_yuan_m1_td.toml --wave regular --height 2 --period 8
   --duration 600 --dt 0.05 --progress on --no-plot``, empty caches, with every phase line the command prints (its progress bar on stderr). Goal
   ≤ 20 s, every phase shown.
@@ -40,6 +44,17 @@ with warnings.catch_warnings():
     warnings.simplefilter("ignore")
     ds = mfm.simulate(m, sea, duration=120.0, dt=0.006)
 print("PHASES", round(time.perf_counter() - t0, 2), float(ds.pto_power.mean()))
+"""
+
+FD = """
+import time, warnings
+t0 = time.perf_counter()
+import numpy as np, mfm
+m = mfm.load("configs/wu_yuan_m1.toml")
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    r = mfm.frequency_response(m, 2 * np.pi / np.array([6.0, 8.0]))
+print("PHASES", round(time.perf_counter() - t0, 2), float(np.abs(r.rao).max()))
 """
 
 
@@ -113,6 +128,14 @@ def main(argv=None):
                 wall, _ = _run([sys.executable, "m4.py"], env("m4"), tmp)
                 print(f"M4 134, the same in a process after one that filled the caches: "
                       f"{wall:.1f} s (goal ≤ 1.5 s)")
+        if "wu_yuan_fd" in a.only or "wu_yuan_fd_cached" in a.only:
+            (tmp / "fd.py").write_text(FD)
+            wall, _ = _run([sys.executable, "fd.py"], env("fd"), tmp)
+            print(f"Wu & Yuan m1 frequency_response at two periods, empty caches: {wall:.1f} s")
+            if "wu_yuan_fd_cached" in a.only:
+                wall, _ = _run([sys.executable, "fd.py"], env("fd"), tmp)
+                print(f"Wu & Yuan m1 frequency_response, the same in a process after one that "
+                      f"filled the caches: {wall:.1f} s")
         if "wu_yuan" in a.only:
             out = tmp / "wy.nc"
             wall, r = _run([sys.executable, str(ROOT / "mfm_cli.py"), "simulate",
