@@ -105,8 +105,8 @@ LOOPS_COMPILED_WHOLE, LOOP_THRESHOLD = _set_flags()
 
 
 # what turns one of mfm's environment switches off (MFM_COMPILATION_CACHE, MFM_PROGRAM_CACHE,
-# MFM_GC_FREEZE; hydro's MFM_FIT_CACHE reads the same words in hydro/fitcache.py, which never
-# imports mfm)
+# MFM_GC_FREEZE, MFM_FAST_COMPILE; hydro's MFM_FIT_CACHE reads the same words in
+# hydro/fitcache.py, which never imports mfm)
 OFF_VALUES = ("off", "0", "false", "no", "none")
 
 
