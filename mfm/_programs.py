@@ -307,10 +307,11 @@ class Program:
 
     def __call__(self, *args):
         compiled = self._compiled
-        if self._options and (compiled is None or _signature(args) != compiled[0]):
+        matches = compiled is not None and _signature(args) == compiled[0]
+        if self._options and not matches:
             self.compile(*args)          # with its options: jax's own call would use the defaults
-            compiled = self._compiled
-        if compiled is not None and _signature(args) == compiled[0]:
+            compiled, matches = self._compiled, True
+        if matches:
             out = compiled[1](*(args if self._call is None else self._flat(args)))
         elif self._call is None:
             return self._ordinary(*args)
