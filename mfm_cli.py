@@ -161,6 +161,11 @@ def build_parser():
     p.add_argument("--force", action="store_true", help="solve again even if up to date")
     p.add_argument("--threads", type=_count(1), help="threads per BEM solve (default: all cores)")
     p.set_defaults(func="cmd_hydro")
+    p = sub.add_parser("fits", help="make the radiation fits and values a config's runs use and "
+                       "store them in its NetCDF database, so a first run on any machine reads "
+                       "them instead of fitting (hydro.fitstore)")
+    p.add_argument("config", nargs="+", help="one or more .toml configs with a [hydro] database")
+    p.set_defaults(func="cmd_fits")
     p = sub.add_parser("plot", help="a config's layout (plan and side view), or a result file: "
                        "time series and spectra (simulate), RAOs (rao), mean power per case "
                        "(batch); PNG")

@@ -18,10 +18,14 @@ A fit read back equals the one written to the last bit; its report gains ``cache
 came from (``""`` when it was fitted in this process). Smaller values that every process would
 make again from a database (its radiation memory T_K, its consistent A∞) are kept the same way
 (:func:`cached_value`).
+
+Before the folder, a fit or value is looked for in the database file itself, where ``mfm fits``
+stores them (:mod:`hydro.fitstore`): there a first run on a new machine finds them.
 """
 from __future__ import annotations
 
 import collections
+import contextlib
 import hashlib
 import os
 import pickle
@@ -45,7 +49,9 @@ _warned = False
 
 
 def cache_dir() -> Path | None:
-    """The folder of the disk cache, or None when ``MFM_FIT_CACHE`` is ``off``."""
+    """The folder of the disk cache, or None when ``MFM_FIT_CACHE`` is ``off`` (then fits and
+    values stored in a database file, :mod:`hydro.fitstore`, are not read either: every one is
+    made in the process, as the benchmarks that time them need)."""
     setting = os.environ.get("MFM_FIT_CACHE", "").strip()
     if setting.lower() in ("off", "0", "false", "no", "none"):
         return None
@@ -79,9 +85,11 @@ def _update(h, x) -> None:
         h.update(repr(x).encode())
 
 
-def fit_key(db, options: dict) -> str:
+def fit_key(db, options: dict, *, sources=None, numpy_version: bool = True) -> str:
     """sha256 of what a fit depends on: every array, dimension and attribute of ``db`` (the
-    database as the fit sees it), the options, the fitting code's source and numpy's version."""
+    database as the fit sees it), the options, the fitting code's source (``sources``: files of
+    hydro/, :data:`_SOURCES` by default) and numpy's version (unless ``numpy_version`` is False:
+    the key of a fit stored in a database file, :mod:`hydro.fitstore`)."""
     h = hashlib.sha256()
     for name in sorted(map(str, db.variables)):
         v = db.variables[name]
@@ -89,9 +97,10 @@ def fit_key(db, options: dict) -> str:
     _update(h, {k: v for k, v in db.attrs.items() if k != "date_read"})
     _update(h, dict(options))
     here = Path(__file__).parent
-    for name in _SOURCES:
+    for name in _SOURCES if sources is None else sources:
         h.update((here / name).read_bytes())
-    h.update(np.__version__.encode())
+    if numpy_version:
+        h.update(np.__version__.encode())
     return h.hexdigest()
 
 
@@ -208,45 +217,99 @@ def trim(folder: Path, limit: int = CACHE_BYTES, pattern: str = "*.pkl") -> None
             pass
 
 
-def cached_fit(db, **options):
+def cached_fit(db, stored=None, **options):
     """:func:`hydro.statespace.fit_state_space` (``db``, ``options``), from the process's fits,
-    else the disk cache, else fitted (and kept in both)."""
+    else the database file ``stored`` (a fit ``mfm fits`` put there, :mod:`hydro.fitstore`), else
+    the disk cache, else fitted (and kept in the process and on disk). ``MFM_FIT_CACHE=off``
+    reads neither the folder nor the database file."""
     key = fit_key(db, options)
+    # MFM_FIT_CACHE=off: every fit made in the process, none read (the benchmarks time fits);
+    # `mfm fits` (recording) stores what it makes even so
+    read = stored is not None and cache_dir() is not None
+    skey = _stored_key(db, options) if read or (stored is not None and _recorder is not None) \
+        else None
     if key in _memory:
         _memory.move_to_end(key)
-        return _memory[key]
+        return _record(stored, skey, "fit", _memory[key])
+    if read:
+        from . import fitstore
+
+        fit = fitstore.read(stored, skey, "fit")
+        if fit is not None:
+            return _record(stored, skey, "fit",
+                           _remember(key, _with_source(fit, f"{stored} (stored)")))
     folder = cache_dir()
     path = None if folder is None else folder / f"{key}.pkl"
     fit = None if path is None else _read(path)
     if fit is not None:
-        return _remember(key, _with_source(fit, str(path)))
+        return _record(stored, skey, "fit", _remember(key, _with_source(fit, str(path))))
     from .statespace import fit_state_space
 
     fit = fit_state_space(db, **options)
     if path is not None:
         _write(folder, path, _to_plain(fit))
-    return _remember(key, _with_source(fit, ""))
+    return _record(stored, skey, "fit", _remember(key, _with_source(fit, "")))
 
 
-def cached_value(db, name: str, options: dict, compute):
+def _stored_key(db, options):
+    from . import fitstore
+
+    return fitstore.fit_key(db, options)
+
+
+# what :func:`recording` collects: {(database path, stored key): (kind, fit or value)}
+_recorder: dict | None = None
+
+
+@contextlib.contextmanager
+def recording():
+    """Collect every fit and value asked for with a database file (``stored=``) while the block
+    runs: ``with recording() as made: ...`` gives ``made[(path, key)] = (kind, item)``, what
+    ``mfm fits`` stores in that file (:func:`hydro.fitstore.store`)."""
+    global _recorder
+    before, _recorder = _recorder, {}
+    try:
+        yield _recorder
+    finally:
+        _recorder = before
+
+
+def _record(stored, skey, kind, item):
+    if _recorder is not None and skey is not None:
+        _recorder[(str(stored), skey)] = (kind, item)
+    return item
+
+
+def cached_value(db, name: str, options: dict, compute, stored=None):
     """``compute()``, a value made from ``db`` alone (a float or an array) that every process
     would make again: kept like the fits, in the process and on disk, under :func:`fit_key` of
     ``db`` and ``{"value": name, **options}``. What uses it: the radiation memory T_K and the
     consistent A∞ of :class:`hydro.prepare.HydroSpec` (0.4–0.5 s and 0.2–1.6 s each for M4 134 and
     Wu & Yuan, in every first run before). A value read back equals the one written to the last
-    bit; an array comes back read-only."""
+    bit; an array comes back read-only. ``stored``: the database file, read first for a value
+    ``mfm fits`` stored there (:mod:`hydro.fitstore`)."""
     key = fit_key(db, {"value": name, **options})
+    read = stored is not None and cache_dir() is not None     # as in cached_fit
+    skey = None
+    if read or (stored is not None and _recorder is not None):
+        from . import fitstore
+
+        skey = fitstore.value_key(db, name, options)
     if key in _values:
-        return _values[key]
+        return _record(stored, skey, "value", _values[key])
+    if read:
+        value = fitstore.read(stored, skey, "value")
+        if value is not None:
+            return _record(stored, skey, "value", _keep(key, value))
     folder = cache_dir()
     path = None if folder is None else folder / f"{key}.pkl"
     value = None if path is None else _read(path, _readonly)
     if value is not None:
-        return _keep(key, value)
+        return _record(stored, skey, "value", _keep(key, value))
     value = _readonly(compute())
     if path is not None:
         _write(folder, path, value)
-    return _keep(key, value)
+    return _record(stored, skey, "value", _keep(key, value))
 
 
 def _keep(key, value):

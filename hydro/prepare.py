@@ -181,6 +181,12 @@ class HydroSpec:
                 "added_mass_inf": self.added_mass_inf_option, "rho": self.rho, "g": self.g,
                 "water_depth": self.water_depth}
 
+    @property
+    def stored_in(self) -> str | None:
+        """The database file that may store this water's fits and values (``mfm fits``,
+        :mod:`hydro.fitstore`): the config's NetCDF database, else None."""
+        return self.source if str(self.source).endswith(".nc") else None
+
     # -- radiation
     def database(self) -> xr.Dataset:
         """The database as both domains use it: A(ω), B(ω), A∞ symmetrized (reciprocity: an
@@ -215,7 +221,8 @@ class HydroSpec:
             # kept by the database's content (hydro.fitcache): ~0.4 s of every first run
             self._cache[key] = float(cached_value(
                 self.database(), "memory", {"rtol": float(rtol)},
-                lambda: impulse_response_memory(self.database(), t, rtol=rtol)))
+                lambda: impulse_response_memory(self.database(), t, rtol=rtol),
+                stored=self.stored_in))
         return self._cache[key]
 
     def added_mass_inf(self) -> np.ndarray:
@@ -232,7 +239,8 @@ class HydroSpec:
             # of every first run (Wu & Yuan)
             self._cache["A_inf"] = cached_value(self.database(), "added_mass_inf_consistent",
                                                 {"mask": np.asarray(self.mask, float)},
-                                                self._consistent_added_mass_inf)
+                                                self._consistent_added_mass_inf,
+                                                stored=self.stored_in)
         return self._cache["A_inf"]
 
     def _consistent_added_mass_inf(self) -> np.ndarray:
@@ -301,8 +309,9 @@ class HydroSpec:
         if key not in self._cache:
             from .fitcache import cached_fit
 
-            # kept by content, in the process and on disk (hydro.fitcache): seconds per fit
-            self._cache[key] = cached_fit(self.database(), **options)
+            # kept by content, in the process and on disk (hydro.fitcache), or stored in the
+            # database file by `mfm fits` (hydro.fitstore): seconds per fit
+            self._cache[key] = cached_fit(self.database(), stored=self.stored_in, **options)
         return self._cache[key]
 
     def kernel(self, dt: float, memory: float | None = None, subdivisions: int = 16,

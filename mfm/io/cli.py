@@ -1,4 +1,4 @@
-"""Command line: ``mfm info | simulate | optimize | rao | hydro | plot``: the commands.
+"""Command line: ``mfm info | simulate | optimize | rao | hydro | fits | plot``: the commands.
 
 The parser and the entry point are in the top-level module :mod:`mfm_cli` (importing this module
 imports the ``mfm`` package, and with it jax): it calls the commands here, and nothing here
@@ -111,6 +111,13 @@ def cmd_info(args):
         from hydro.database import known_data_issues
 
         print(f"\nhydro database {model.hydro.source}")
+        if model.hydro.stored_in is not None:
+            from hydro import fitstore
+
+            kinds = list(fitstore.stored(model.hydro.stored_in).values())
+            print(f"  stores {kinds.count('fit')} radiation fit(s) and {kinds.count('value')} "
+                  "value(s) made from it (`mfm fits`)" if kinds else
+                  "  stores no radiation fit (`mfm fits` stores the config's)")
         issues = known_data_issues(model.hydro.source)
         print("  known data issues (not warned at load; every computation uses the symmetric "
               "part of A, B, A∞):" if issues else "  no known data issues")
@@ -381,6 +388,40 @@ def cmd_rao(args):
 def cmd_hydro(args):
 
     generate(args.config, out=args.out, force=args.force, n_threads=args.threads)
+
+
+def cmd_fits(args):
+    """Store in each config's database file what its runs make from the database and nothing
+    else: the default state-space fit (every ``radiation`` route through a fit uses it), the
+    radiation memory T_K and the consistent A∞ (:mod:`hydro.fitstore`). Items made before, in this
+    process or the disk cache, are taken from there; the rest are made now."""
+    import os
+
+    from hydro import fitcache, fitstore
+
+    for config in args.config:
+        options, _ = load_config(config)
+        if "hydro" not in options:
+            raise ValueError(f"{config}: no [hydro] table, so no database to store fits in")
+        model = load(config, progress=getattr(args, "progress", False))
+        spec = model.hydro.replace()         # its own caches: every item is asked for
+        path = spec.stored_in
+        if path is None:
+            raise ValueError(f"{config}: its database {spec.source!r} is not a NetCDF file (.nc); "
+                             "fits are stored in NetCDF databases only")
+        t0 = time.perf_counter()
+        with fitcache.recording() as made:
+            spec.memory()
+            spec.added_mass_inf()
+            fit = spec.state_space()
+        items = {key: item for (p, key), item in made.items() if p == path}
+        before = os.path.getsize(path)
+        now = fitstore.store(path, items)
+        print(f"{config}: {os.path.normpath(path)} stores {sum(k == 'fit' for k in now.values())} fit(s) and "
+              f"{sum(k == 'value' for k in now.values())} value(s); this config's fit: "
+              f"{fit.report['n_states']} states, band error {fit.report['overall_error']:.3g}, "
+              f"passive {fit.report['passive']}; {time.perf_counter() - t0:.1f} s, file "
+              f"{before / 1e6:.2f} -> {os.path.getsize(path) / 1e6:.2f} MB", flush=True)
 
 
 def cmd_plot(args):

@@ -1,0 +1,295 @@
+"""Radiation fits stored in the database file itself, so that a first run on any machine reads
+them instead of fitting (WEC-Sim's BEMIO keeps its state-space realisation in its ``.h5`` the
+same way).
+
+A state-space fit costs seconds to tens of seconds (M4 134 ~2–4 s, Wu & Yuan's 75 dofs ~14 s on
+2 cores) and the disk cache of :mod:`hydro.fitcache` only helps a machine that has made it once.
+``mfm fits CONFIG`` (:func:`mfm.io.cli.cmd_fits`) makes what a config's runs use, the default
+fit and the values its water needs (the memory T_K, the consistent A∞), and stores each in a
+NetCDF group of the database file::
+
+    /                      the database, untouched (its content, hence every key, is unchanged)
+    /mfm_fits/k<sha256>    one fit or value each; attributes: kind, the report, how it was made
+
+A stored item is found by its key: the sha256 of the database as the fit sees it, the options and
+the source of the code that makes it (:data:`FIT_SOURCES`, :data:`VALUE_SOURCES`), but not
+numpy's version (unlike the disk cache, whose files promise the bits this machine would make):
+a stored fit is a product of the database, the same bits on every machine that reads it, as the
+BEM coefficients themselves are. A change to that code makes other keys, so the item is no longer
+found and the run fits again, as it would without it (``tests/test_fitstore.py`` fails for the
+shipped databases until ``mfm fits`` is run again).
+
+Arrays are stored as they are (A and B by their nonzero entries, exactly; complex numbers as real
+and imaginary parts), so a fit read back equals the stored one to the last bit.
+"""
+from __future__ import annotations
+
+import ast
+import functools
+import hashlib
+import os
+from pathlib import Path
+
+import numpy as np
+
+GROUP = "mfm_fits"
+# the code each kind of item depends on (hydro/ files): another source is another key
+FIT_SOURCES = ("statespace.py", "vectorfit.py", "passivity.py", "radiation.py")
+VALUE_SOURCES = ("radiation.py", "prepare.py")
+_ENCODING = {"zlib": True, "complevel": 4}
+
+
+def source_digest(kind: str) -> str:
+    """sha256 of the source files that make items of ``kind`` ("fit" or "value")."""
+    h = hashlib.sha256()
+    here = Path(__file__).parent
+    for name in FIT_SOURCES if kind == "fit" else VALUE_SOURCES:
+        h.update((here / name).read_bytes())
+    return h.hexdigest()
+
+
+def fit_key(db, options: dict) -> str:
+    """The key of a fit of ``db`` (the database as the fit sees it) with ``options``."""
+    from .fitcache import fit_key as key
+
+    return key(db, options, sources=FIT_SOURCES, numpy_version=False)
+
+
+def value_key(db, name: str, options: dict) -> str:
+    """The key of the value ``name`` made from ``db`` with ``options``
+    (:func:`hydro.fitcache.cached_value`)."""
+    from .fitcache import fit_key as key
+
+    return key(db, {"value": name, **options}, sources=VALUE_SOURCES, numpy_version=False)
+
+
+# -- reading
+
+def _stamp(path) -> tuple | None:
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return (str(path), st.st_mtime_ns, st.st_size)
+
+
+@functools.lru_cache(maxsize=16)
+def _index(stamp) -> dict:
+    """{key: kind} of the items stored in the file ``stamp`` names (its path, mtime and size:
+    a file written again is read again)."""
+    import netCDF4
+
+    try:
+        data = Path(stamp[0]).read_bytes()
+        with netCDF4.Dataset("stored-fits", mode="r", memory=data) as nc:
+            g = nc.groups.get(GROUP)
+            if g is None:
+                return {}
+            return {name[1:]: str(g.groups[name].getncattr("kind")) for name in g.groups
+                    if name.startswith("k")}
+    except Exception:           # not a NetCDF-4 file, or damaged: nothing stored to read
+        return {}
+
+
+def stored(path) -> dict:
+    """{key: kind} of what the database file at ``path`` stores ({} for none, or not NetCDF)."""
+    stamp = _stamp(path)
+    return {} if stamp is None else dict(_index(stamp))
+
+
+def _group(path, key):
+    import xarray as xr
+
+    data = Path(path).read_bytes()
+    with xr.open_dataset(data, engine="netcdf4", group=f"{GROUP}/k{key}") as ds:
+        return ds.load()
+
+
+def read(path, key: str, kind: str):
+    """The fit (a :class:`hydro.statespace.StateSpaceRadiation`) or value stored under ``key`` in
+    the database file at ``path``, or None when it holds none (or it cannot be read)."""
+    if stored(path).get(key) != kind:
+        return None
+    try:
+        ds = _group(path, key)
+        return _fit_from(ds) if kind == "fit" else _value_from(ds)
+    except Exception:           # a damaged group: made again, as without it
+        return None
+
+
+# -- the stored form
+
+def _sparse(name, a, out, dims):
+    """A 2-d array by its entries whose bits are not zero (so -0.0 is kept): rows, columns,
+    values and its shape."""
+    r, c = np.nonzero(a.view(np.uint64))
+    out[f"{name}_row"] = (dims, r.astype(np.int32))
+    out[f"{name}_col"] = (dims, c.astype(np.int32))
+    out[f"{name}_value"] = (dims, a[r, c])
+    out[f"{name}_shape"] = ((f"{name}_axis",), np.asarray(a.shape, dtype=np.int64))
+
+
+def _dense(ds, name):
+    a = np.zeros(tuple(int(n) for n in ds[f"{name}_shape"].values))
+    a[ds[f"{name}_row"].values, ds[f"{name}_col"].values] = ds[f"{name}_value"].values
+    return a
+
+
+def _plain(x):
+    """``x`` with numpy scalars as Python's (the report's repr must read back by
+    :func:`ast.literal_eval`)."""
+    if isinstance(x, dict):
+        return {_plain(k): _plain(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return type(x)(_plain(v) for v in x)
+    if isinstance(x, np.generic):
+        return x.item()
+    return x
+
+
+def _report_text(report: dict) -> str:
+    report = _plain({k: v for k, v in report.items() if k != "cache"})
+    text = repr(report)
+    try:
+        back = ast.literal_eval(text)
+    except (ValueError, SyntaxError):
+        back = None
+    if back != report:
+        bad = [k for k, v in report.items() if _roundtrip_fails(v)]
+        raise ValueError(f"the fit's report cannot be stored: its entries {bad} do not read back "
+                         "from their repr (a NaN or an object)")
+    return text
+
+
+def _roundtrip_fails(v) -> bool:
+    try:
+        return ast.literal_eval(repr(v)) != v
+    except (ValueError, SyntaxError):
+        return True
+
+
+def _shared(arrays):
+    """Arrays by content: the distinct ones, and which of them each one is (common poles: one
+    set for every entry; a symmetric fit: the residues of (i, j) are those of (j, i))."""
+    index, distinct, which = {}, [], []
+    for a in arrays:
+        a = np.asarray(a)
+        k = index.setdefault(a.tobytes(), len(distinct))
+        if k == len(distinct):
+            distinct.append(a)
+        which.append(k)
+    return distinct, np.asarray(which, dtype=np.int64)
+
+
+def _ragged(name, arrays, v):
+    """Complex arrays of several lengths as one real and one imaginary vector, the distinct
+    arrays' offsets, and each item's distinct array."""
+    distinct, which = _shared(arrays)
+    cat = np.concatenate(distinct) if distinct else np.zeros(0, complex)
+    v[f"{name}_real"] = ((name,), cat.real)
+    v[f"{name}_imag"] = ((name,), cat.imag)
+    v[f"{name}_offsets"] = ((f"{name}_edge",),
+                            np.cumsum([0] + [len(a) for a in distinct]).astype(np.int64))
+    v[f"{name}_of_entry"] = (("entry",), which)
+
+
+def _unragged(ds, name):
+    z = ds[f"{name}_real"].values + 1j * ds[f"{name}_imag"].values
+    o = ds[f"{name}_offsets"].values
+    distinct = [z[o[k]:o[k + 1]] for k in range(len(o) - 1)]
+    return tuple(distinct[int(k)].copy() for k in ds[f"{name}_of_entry"].values)
+
+
+def _fit_dataset(fit, made: dict):
+    import xarray as xr
+
+    v = {}
+    _sparse("A", np.asarray(fit.A, float), v, ("A_nonzero",))
+    _sparse("B", np.asarray(fit.B, float), v, ("B_nonzero",))
+    v["C"] = (("C_row", "C_col"), np.asarray(fit.C, float))
+    v["added_mass_inf"] = (("dof_i", "dof_j"), np.asarray(fit.added_mass_inf, float))
+    v["dofs"] = (("dof",), np.asarray([str(d) for d in fit.dofs]))
+    v["entries"] = (("entry", "pair"), np.asarray(fit.entries, dtype=np.int64).reshape(-1, 2))
+    _ragged("poles", fit.poles, v)
+    _ragged("residues", fit.residues, v)
+    return xr.Dataset(v, attrs={"kind": "fit", "report": _report_text(dict(fit.report)), **made})
+
+
+def _fit_from(ds):
+    from types import MappingProxyType
+
+    from .statespace import StateSpaceRadiation
+
+    fit = StateSpaceRadiation(
+        _dense(ds, "A"), _dense(ds, "B"), np.array(ds["C"].values, dtype=float),
+        np.array(ds["added_mass_inf"].values, dtype=float),
+        tuple(str(d) for d in ds["dofs"].values),
+        tuple((int(i), int(j)) for i, j in ds["entries"].values),
+        _unragged(ds, "poles"), _unragged(ds, "residues"),
+        MappingProxyType(ast.literal_eval(ds.attrs["report"])))
+    for a in (fit.A, fit.B, fit.C, fit.added_mass_inf, *fit.poles, *fit.residues):
+        a.setflags(write=False)          # read-only, as fit_state_space makes them
+    return fit
+
+
+def _value_dataset(value, made: dict):
+    import xarray as xr
+
+    a = np.asarray(value)
+    if a.dtype.kind != "f":
+        raise ValueError(f"a stored value must be a float or an array of floats, not {a.dtype}")
+    dims = tuple(f"axis_{k}" for k in range(a.ndim))
+    return xr.Dataset({"value": (dims, a)},
+                      attrs={"kind": "value", "scalar": int(np.ndim(value) == 0), **made})
+
+
+def _value_from(ds):
+    a = np.array(ds["value"].values, dtype=float)
+    if int(ds.attrs.get("scalar", 0)):
+        return float(a)
+    a.setflags(write=False)
+    return a
+
+
+# -- writing
+
+def store(path, items: dict) -> dict:
+    """Store ``items`` ({key: (kind, fit or value)}) in the database file at ``path``, keeping
+    the items it already stores whose code is current (``source`` attribute) and dropping the
+    others. The file is written anew beside ``path`` and renamed over it, after checking that
+    its database (the root group) reads back identical. Returns {key: kind} of what it stores."""
+    import xarray as xr
+
+    from .database import read_netcdf
+
+    path = Path(path)
+    if path.suffix != ".nc":
+        raise ValueError(f"{str(path)!r}: fits are stored in a NetCDF database (.nc); convert the "
+                         "database first (hydro.prepare.open_any_database, then "
+                         "hydro.database.to_netcdf) and point the config at it")
+    root = read_netcdf(path)
+    groups = {}
+    for key, kind in stored(path).items():
+        ds = _group(path, key)
+        if ds.attrs.get("source") == source_digest(kind) and key not in items:
+            groups[key] = ds
+    import numpy
+    import scipy
+
+    for key, (kind, obj) in items.items():
+        made = {"source": source_digest(kind), "made_with": f"numpy {numpy.__version__}, "
+                f"scipy {scipy.__version__}", "made_by": "mfm fits (hydro.fitstore.store)"}
+        groups[key] = _fit_dataset(obj, made) if kind == "fit" else _value_dataset(obj, made)
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    try:
+        root.to_netcdf(tmp, engine="netcdf4")
+        for key, ds in groups.items():
+            enc = {name: dict(_ENCODING) for name, da in ds.variables.items()
+                   if da.ndim and da.dtype.kind in "fiu"}
+            ds.to_netcdf(tmp, mode="a", group=f"{GROUP}/k{key}", engine="netcdf4", encoding=enc)
+        xr.testing.assert_identical(read_netcdf(tmp), root)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return stored(path)
