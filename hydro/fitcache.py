@@ -35,6 +35,11 @@ from pathlib import Path
 
 import numpy as np
 
+# imported with this module, not on the first stored fit: mfm._programs names a program by the
+# settings of the hydro modules loaded (fitstore's GROUP, ...), so a module loaded halfway through
+# a process would rename the programs made after it
+from . import fitstore
+
 # the most the default folder may hold; a fit of M4 134 (960 states) is about 8 MB
 CACHE_BYTES = 512 * 2**20
 # fits kept in the process (the least recently used dropped first)
@@ -232,8 +237,6 @@ def cached_fit(db, stored=None, **options):
         _memory.move_to_end(key)
         return _record(stored, skey, "fit", _memory[key])
     if read:
-        from . import fitstore
-
         fit = fitstore.read(stored, skey, "fit")
         if fit is not None:
             return _record(stored, skey, "fit",
@@ -252,8 +255,6 @@ def cached_fit(db, stored=None, **options):
 
 
 def _stored_key(db, options):
-    from . import fitstore
-
     return fitstore.fit_key(db, options)
 
 
@@ -292,8 +293,6 @@ def cached_value(db, name: str, options: dict, compute, stored=None):
     read = stored is not None and cache_dir() is not None     # as in cached_fit
     skey = None
     if read or (stored is not None and _recorder is not None):
-        from . import fitstore
-
         skey = fitstore.value_key(db, name, options)
     if key in _values:
         return _record(stored, skey, "value", _values[key])
