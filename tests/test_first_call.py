@@ -463,3 +463,58 @@ def test_programs_run_once_compile_fast_and_give_the_same_numbers(monkeypatch, t
             # largest entry at most
             np.testing.assert_allclose(a, b, rtol=0, atol=64 * np.finfo(float).eps
                                        * max(np.abs(b).max(), 1e-300))
+
+
+def test_a_pipelined_run_steps_before_its_outputs_program_is_ready(monkeypatch, tmp_path):
+    """The outputs' program (the larger of a run's) compiles beside the first chunks, whose
+    outputs wait for it on their own thread: the time loop does not wait for it. Here its
+    compilation waits until the steps' program has run once (20 s at most); a run that waited
+    for it before stepping would record that it compiled first. The dataset is the one made
+    without the wait."""
+    import threading
+    import warnings
+
+    import hydro
+    import mfm
+    from mfm.timedomain import progress
+
+    _fresh(monkeypatch, tmp_path)
+    monkeypatch.setattr(progress, "PIPELINE_MIN_SAMPLES", 16)
+    sea = hydro.Regular(height=1.0, period=6.0)
+    kw = dict(duration=4.0, dt=0.1, radiation="state_space", check_stability=False)
+    model = mfm.load(CONFIGS / "sphere.toml")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plain = mfm.simulate(model, sea, **kw)
+    _fresh(monkeypatch, tmp_path / "again")
+    order, stepped = [], threading.Event()
+    real = _programs.program
+
+    class Wrapped:
+        def __init__(self, made, name):
+            self.made, self.name = made, name
+
+        def compile(self, *args):
+            if self.name == "rollout_outputs":
+                order.append("outputs compiling")
+                stepped.wait(20)
+                order.append("outputs compiled")
+            return self.made.compile(*args)
+
+        def __call__(self, *args):
+            if self.name == "rollout_steps" and not stepped.is_set():
+                order.append("stepped")
+                stepped.set()
+            return self.made(*args)
+
+    def program(fn, name, *args, **kwargs):
+        made = real(fn, name, *args, **kwargs)
+        return Wrapped(made, name) if name in ("rollout_steps", "rollout_outputs") else made
+
+    monkeypatch.setattr(_programs, "program", program)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = mfm.simulate(model, sea, **kw)
+    assert order == ["outputs compiling", "stepped", "outputs compiled"], order
+    for name in ("q", "qd", "joint_force", "hydro_force"):
+        np.testing.assert_array_equal(ds[name].values, plain[name].values, err_msg=name)
