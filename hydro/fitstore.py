@@ -24,7 +24,6 @@ and imaginary parts), so a fit read back equals the stored one to the last bit.
 """
 from __future__ import annotations
 
-import ast
 import functools
 import hashlib
 import os
@@ -135,37 +134,53 @@ def _dense(ds, name):
     return a
 
 
-def _plain(x):
-    """``x`` with numpy scalars as Python's (the report's repr must read back by
-    :func:`ast.literal_eval`)."""
-    if isinstance(x, dict):
-        return {_plain(k): _plain(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return type(x)(_plain(v) for v in x)
+def _encode(x):
+    """The fit's report as JSON values, exactly: tuples and dicts with keys other than strings
+    tagged, so that :func:`_decode` gives back equal Python values (floats by their repr, NaN
+    included). JSON, not a repr read by ``ast.literal_eval``: Wu & Yuan's report (two entries per
+    fitted pair, 5,593 pairs) reads in milliseconds instead of 0.26 s."""
     if isinstance(x, np.generic):
-        return x.item()
-    return x
+        x = x.item()
+    if isinstance(x, dict):
+        if all(isinstance(k, str) for k in x):
+            return {k: _encode(v) for k, v in x.items()}
+        return {"__items__": [[_encode(k), _encode(v)] for k, v in x.items()]}
+    if isinstance(x, tuple):
+        return {"__tuple__": [_encode(v) for v in x]}
+    if isinstance(x, list):
+        return [_encode(v) for v in x]
+    if x is None or isinstance(x, (bool, int, float, str)):
+        return x
+    raise ValueError(f"the fit's report holds a {type(x).__name__} ({x!r}), which is not stored")
+
+
+def _decode(d):
+    if "__tuple__" in d and len(d) == 1:
+        return tuple(d["__tuple__"])
+    if "__items__" in d and len(d) == 1:
+        return {_hashable(k): v for k, v in d["__items__"]}
+    return d
+
+
+def _hashable(k):
+    return tuple(_hashable(v) for v in k) if isinstance(k, list) else k
 
 
 def _report_text(report: dict) -> str:
-    report = _plain({k: v for k, v in report.items() if k != "cache"})
-    text = repr(report)
-    try:
-        back = ast.literal_eval(text)
-    except (ValueError, SyntaxError):
-        back = None
-    if back != report:
-        bad = [k for k, v in report.items() if _roundtrip_fails(v)]
-        raise ValueError(f"the fit's report cannot be stored: its entries {bad} do not read back "
-                         "from their repr (a NaN or an object)")
+    import json
+
+    report = {k: v for k, v in report.items() if k != "cache"}
+    text = json.dumps(_encode(report))
+    # equal as JSON again (NaN is not equal to itself as a float)
+    if json.dumps(_encode(_report_from(text))) != text:
+        raise ValueError("the fit's report does not read back equal from JSON; not stored")
     return text
 
 
-def _roundtrip_fails(v) -> bool:
-    try:
-        return ast.literal_eval(repr(v)) != v
-    except (ValueError, SyntaxError):
-        return True
+def _report_from(text: str) -> dict:
+    import json
+
+    return json.loads(text, object_hook=_decode)
 
 
 def _shared(arrays):
@@ -226,7 +241,7 @@ def _fit_from(ds):
         tuple(str(d) for d in ds["dofs"].values),
         tuple((int(i), int(j)) for i, j in ds["entries"].values),
         _unragged(ds, "poles"), _unragged(ds, "residues"),
-        MappingProxyType(ast.literal_eval(ds.attrs["report"])))
+        MappingProxyType(_report_from(ds.attrs["report"])))
     for a in (fit.A, fit.B, fit.C, fit.added_mass_inf, *fit.poles, *fit.residues):
         a.setflags(write=False)          # read-only, as fit_state_space makes them
     return fit

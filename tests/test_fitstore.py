@@ -193,3 +193,18 @@ def test_fits_stores_with_the_cache_off(sphere, monkeypatch):
 def test_info_says_what_the_database_stores(capsys):
     assert main(["info", str(CONFIGS / "m4_134.toml"), "--no-restoring"]) == 0
     assert "stores 1 radiation fit(s) and 2 value(s)" in capsys.readouterr().out
+
+
+def test_a_report_reads_back_equal_its_types_kept():
+    report = {"omega_fit": (1.0, 2.5), "entry_error": {("a", "b"): 0.1, ("b", "b"): float("inf")},
+              "dropped": [("a", "c")], "passivity_violations": [], "max_real_eig": float("nan"),
+              "passive": True, "n_states": 12, "nested": {"k": (1, (2, 3))}, "by_int": {1: 2},
+              "numpy": np.float64(0.25), "cache": "dropped"}
+    back = FS._report_from(FS._report_text(report))
+    assert "cache" not in back and np.isnan(back.pop("max_real_eig"))
+    expected = {k: v for k, v in report.items() if k not in ("cache", "max_real_eig")}
+    assert back == expected
+    assert type(back["omega_fit"]) is tuple and type(back["dropped"]) is list
+    assert type(back["numpy"]) is float
+    with pytest.raises(ValueError, match="not stored"):
+        FS._report_text({"odd": object()})
