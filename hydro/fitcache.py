@@ -231,11 +231,12 @@ def cached_fit(db, stored=None, **options):
     # MFM_FIT_CACHE=off: every fit made in the process, none read (the benchmarks time fits);
     # `mfm fits` (recording) stores what it makes even so
     read = stored is not None and cache_dir() is not None
-    skey = _stored_key(db, options) if read or (stored is not None and _recorder is not None) \
-        else None
+    recording_ = stored is not None and _recorder is not None
     if key in _memory:
         _memory.move_to_end(key)
+        skey = fitstore.fit_key(db, options) if recording_ else None
         return _record(stored, skey, "fit", _memory[key])
+    skey = fitstore.fit_key(db, options) if read or recording_ else None
     if read:
         fit = fitstore.read(stored, skey, "fit")
         if fit is not None:
@@ -252,10 +253,6 @@ def cached_fit(db, stored=None, **options):
     if path is not None:
         _write(folder, path, _to_plain(fit))
     return _record(stored, skey, "fit", _remember(key, _with_source(fit, "")))
-
-
-def _stored_key(db, options):
-    return fitstore.fit_key(db, options)
 
 
 # what :func:`recording` collects: {(database path, stored key): (kind, fit or value)}
@@ -291,11 +288,11 @@ def cached_value(db, name: str, options: dict, compute, stored=None):
     ``mfm fits`` stored there (:mod:`hydro.fitstore`)."""
     key = fit_key(db, {"value": name, **options})
     read = stored is not None and cache_dir() is not None     # as in cached_fit
-    skey = None
-    if read or (stored is not None and _recorder is not None):
-        skey = fitstore.value_key(db, name, options)
+    recording_ = stored is not None and _recorder is not None
     if key in _values:
+        skey = fitstore.value_key(db, name, options) if recording_ else None
         return _record(stored, skey, "value", _values[key])
+    skey = fitstore.value_key(db, name, options) if read or recording_ else None
     if read:
         value = fitstore.read(stored, skey, "value")
         if value is not None:

@@ -416,9 +416,9 @@ def cmd_fits(args):
             fit = spec.state_space()
         items = {key: item for (p, key), item in made.items() if p == path}
         before = os.path.getsize(path)
-        now = fitstore.store(path, items)
-        print(f"{config}: {os.path.normpath(path)} stores {sum(k == 'fit' for k in now.values())} fit(s) and "
-              f"{sum(k == 'value' for k in now.values())} value(s); this config's fit: "
+        kinds = list(fitstore.store(path, items).values())
+        print(f"{config}: {os.path.normpath(path)} stores {kinds.count('fit')} fit(s) and "
+              f"{kinds.count('value')} value(s); this config's fit: "
               f"{fit.report['n_states']} states, band error {fit.report['overall_error']:.3g}, "
               f"passive {fit.report['passive']}; {time.perf_counter() - t0:.1f} s, file "
               f"{before / 1e6:.2f} -> {os.path.getsize(path) / 1e6:.2f} MB", flush=True)
