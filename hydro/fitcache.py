@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import collections
 import contextlib
-import hashlib
 import os
 import pickle
 import tempfile
@@ -39,6 +38,7 @@ import numpy as np
 # settings of the hydro modules loaded (fitstore's GROUP, ...), so a module loaded halfway through
 # a process would rename the programs made after it
 from . import fitstore
+from .contentkey import content_key
 
 # the most the default folder may hold; a fit of M4 134 (960 states) is about 8 MB
 CACHE_BYTES = 512 * 2**20
@@ -66,47 +66,13 @@ def cache_dir() -> Path | None:
     return Path(base) / "mfm" / "fits"
 
 
-def _update(h, x) -> None:
-    """Hash ``x`` into ``h``: containers item by item, arrays by their bytes (a repr elides the
-    middle of a large array: two arrays could hash alike)."""
-    if isinstance(x, dict):
-        h.update(f"dict{len(x)}".encode())
-        for k in sorted(x, key=repr):
-            _update(h, k)
-            _update(h, x[k])
-        return
-    if isinstance(x, (list, tuple)):
-        h.update(f"{type(x).__name__}{len(x)}".encode())
-        for item in x:
-            _update(h, item)
-        return
-    a = None if isinstance(x, (str, bytes)) else np.asarray(x)
-    if a is not None and a.dtype.kind in "fciub":
-        h.update(f"{a.dtype.str}{a.shape}".encode())
-        h.update(np.ascontiguousarray(a).tobytes())
-    elif a is not None and a.ndim:
-        h.update(repr(a.tolist()).encode())        # labels: every item
-    else:
-        h.update(repr(x).encode())
-
-
 def fit_key(db, options: dict, *, sources=None, numpy_version: bool = True) -> str:
     """sha256 of what a fit depends on: every array, dimension and attribute of ``db`` (the
     database as the fit sees it), the options, the fitting code's source (``sources``: files of
     hydro/, :data:`_SOURCES` by default) and numpy's version (unless ``numpy_version`` is False:
     the key of a fit stored in a database file, :mod:`hydro.fitstore`)."""
-    h = hashlib.sha256()
-    for name in sorted(map(str, db.variables)):
-        v = db.variables[name]
-        _update(h, (name, v.dims, v.values, dict(v.attrs)))
-    _update(h, {k: v for k, v in db.attrs.items() if k != "date_read"})
-    _update(h, dict(options))
-    here = Path(__file__).parent
-    for name in _SOURCES if sources is None else sources:
-        h.update((here / name).read_bytes())
-    if numpy_version:
-        h.update(np.__version__.encode())
-    return h.hexdigest()
+    return content_key(db, options, _SOURCES if sources is None else sources,
+                       numpy_version=numpy_version)
 
 
 def clear() -> None:

@@ -31,6 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .contentkey import content_key
+
 GROUP = "mfm_fits"
 # the code each kind of item depends on (hydro/ files): another source is another key
 FIT_SOURCES = ("statespace.py", "vectorfit.py", "passivity.py", "radiation.py")
@@ -49,17 +51,13 @@ def source_digest(kind: str) -> str:
 
 def fit_key(db, options: dict) -> str:
     """The key of a fit of ``db`` (the database as the fit sees it) with ``options``."""
-    from .fitcache import fit_key as key
-
-    return key(db, options, sources=FIT_SOURCES, numpy_version=False)
+    return content_key(db, options, FIT_SOURCES, numpy_version=False)
 
 
 def value_key(db, name: str, options: dict) -> str:
-    """The key of the value ``name`` made from ``db`` with ``options``
-    (:func:`hydro.fitcache.cached_value`)."""
-    from .fitcache import fit_key as key
-
-    return key(db, {"value": name, **options}, sources=VALUE_SOURCES, numpy_version=False)
+    """The key of the value ``name`` made from ``db`` with ``options`` (as the disk cache names
+    it, :mod:`hydro.fitcache`)."""
+    return content_key(db, {"value": name, **options}, VALUE_SOURCES, numpy_version=False)
 
 
 # -- reading
