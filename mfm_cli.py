@@ -165,6 +165,9 @@ def build_parser():
                        "store them in its NetCDF database, so a first run on any machine reads "
                        "them instead of fitting (hydro.fitstore)")
     p.add_argument("config", nargs="+", help="one or more .toml configs with a [hydro] database")
+    p.add_argument("--values-only", action="store_true",
+                   help="store the radiation memory and the consistent A∞ alone, not the "
+                   "state-space fit (what a frequency-domain study uses)")
     p.set_defaults(func="cmd_fits")
     p = sub.add_parser("plot", help="a config's layout (plan and side view), or a result file: "
                        "time series and spectra (simulate), RAOs (rao), mean power per case "

@@ -208,3 +208,10 @@ def test_a_report_reads_back_equal_its_types_kept():
     assert type(back["numpy"]) is float
     with pytest.raises(ValueError, match="not stored"):
         FS._report_text({"odd": object()})
+
+
+def test_values_only_stores_no_fit(sphere, fresh):
+    cfg, db_path = sphere
+    assert main(["fits", "--values-only", str(cfg)]) == 0
+    assert sorted(FS.stored(db_path).values()) == ["value", "value"]
+    assert FC._memory == {}                      # nothing was fitted

@@ -393,8 +393,9 @@ def cmd_hydro(args):
 def cmd_fits(args):
     """Store in each config's database file what its runs make from the database and nothing
     else: the default state-space fit (every ``radiation`` route through a fit uses it), the
-    radiation memory T_K and the consistent A∞ (:mod:`hydro.fitstore`). Items made before, in this
-    process or the disk cache, are taken from there; the rest are made now."""
+    radiation memory T_K and the consistent A∞ (:mod:`hydro.fitstore`); ``--values-only`` those
+    two alone (a frequency-domain study fits nothing). Items made before, in this process or the
+    disk cache, are taken from there; the rest are made now."""
     import os
 
     from hydro import fitcache, fitstore
@@ -413,14 +414,15 @@ def cmd_fits(args):
         with fitcache.recording() as made:
             spec.memory()
             spec.added_mass_inf()
-            fit = spec.state_space()
+            fit = None if args.values_only else spec.state_space()
         items = {key: item for (p, key), item in made.items() if p == path}
         before = os.path.getsize(path)
         kinds = list(fitstore.store(path, items).values())
+        this = ("" if fit is None else
+                f"; this config's fit: {fit.report['n_states']} states, band error "
+                f"{fit.report['overall_error']:.3g}, passive {fit.report['passive']}")
         print(f"{config}: {os.path.normpath(path)} stores {kinds.count('fit')} fit(s) and "
-              f"{kinds.count('value')} value(s); this config's fit: "
-              f"{fit.report['n_states']} states, band error {fit.report['overall_error']:.3g}, "
-              f"passive {fit.report['passive']}; {time.perf_counter() - t0:.1f} s, file "
+              f"{kinds.count('value')} value(s){this}; {time.perf_counter() - t0:.1f} s, file "
               f"{before / 1e6:.2f} -> {os.path.getsize(path) / 1e6:.2f} MB", flush=True)
 
 
