@@ -201,24 +201,24 @@ def cached_fit(db, stored=None, **options):
     if key in _memory:
         _memory.move_to_end(key)
         skey = fitstore.fit_key(db, options) if recording_ else None
-        return _record(stored, skey, "fit", _memory[key])
+        return record(stored, skey, "fit", _memory[key])
     skey = fitstore.fit_key(db, options) if read or recording_ else None
     if read:
         fit = fitstore.read(stored, skey, "fit")
         if fit is not None:
-            return _record(stored, skey, "fit",
+            return record(stored, skey, "fit",
                            _remember(key, _with_source(fit, f"{stored} (stored)")))
     folder = cache_dir()
     path = None if folder is None else folder / f"{key}.pkl"
     fit = None if path is None else _read(path)
     if fit is not None:
-        return _record(stored, skey, "fit", _remember(key, _with_source(fit, str(path))))
+        return record(stored, skey, "fit", _remember(key, _with_source(fit, str(path))))
     from .statespace import fit_state_space
 
     fit = fit_state_space(db, **options)
     if path is not None:
         _write(folder, path, _to_plain(fit))
-    return _record(stored, skey, "fit", _remember(key, _with_source(fit, "")))
+    return record(stored, skey, "fit", _remember(key, _with_source(fit, "")))
 
 
 # what :func:`recording` collects: {(database path, stored key): (kind, fit or value)}
@@ -238,7 +238,10 @@ def recording():
         _recorder = before
 
 
-def _record(stored, skey, kind, item):
+def record(stored, skey, kind, item):
+    """Note ``item`` (of ``kind``, under the stored key ``skey``, for the database file
+    ``stored``) for :func:`recording`, when it records; returns ``item``. Also what makes
+    other stored kinds (mfm's mooring tables) call."""
     if _recorder is not None and skey is not None:
         _recorder[(str(stored), skey)] = (kind, item)
     return item
@@ -257,21 +260,21 @@ def cached_value(db, name: str, options: dict, compute, stored=None):
     recording_ = stored is not None and _recorder is not None
     if key in _values:
         skey = fitstore.value_key(db, name, options) if recording_ else None
-        return _record(stored, skey, "value", _values[key])
+        return record(stored, skey, "value", _values[key])
     skey = fitstore.value_key(db, name, options) if read or recording_ else None
     if read:
         value = fitstore.read(stored, skey, "value")
         if value is not None:
-            return _record(stored, skey, "value", _keep(key, value))
+            return record(stored, skey, "value", _keep(key, value))
     folder = cache_dir()
     path = None if folder is None else folder / f"{key}.pkl"
     value = None if path is None else _read(path, _readonly)
     if value is not None:
-        return _record(stored, skey, "value", _keep(key, value))
+        return record(stored, skey, "value", _keep(key, value))
     value = _readonly(compute())
     if path is not None:
         _write(folder, path, value)
-    return _record(stored, skey, "value", _keep(key, value))
+    return record(stored, skey, "value", _keep(key, value))
 
 
 def _keep(key, value):

@@ -41,7 +41,11 @@ _ENCODING = {"zlib": True, "complevel": 4}
 
 
 def source_digest(kind: str) -> str:
-    """sha256 of the source files that make items of ``kind`` ("fit" or "value")."""
+    """sha256 of the source files that make items of ``kind`` ("fit" or "value"; the code that
+    stores other kinds, such as mfm's mooring tables, gives their digest to :func:`store`)."""
+    if kind not in ("fit", "value"):
+        raise ValueError(f"kind {kind!r}: hydro knows the code of 'fit' and 'value' items; give "
+                         "the digest of another kind's code to store(sources=)")
     h = hashlib.sha256()
     here = Path(__file__).parent
     for name in FIT_SOURCES if kind == "fit" else VALUE_SOURCES:
@@ -103,8 +107,9 @@ def _group(path, key):
 
 
 def read(path, key: str, kind: str):
-    """The fit (a :class:`hydro.statespace.StateSpaceRadiation`) or value stored under ``key`` in
-    the database file at ``path``, or None when it holds none (or it cannot be read)."""
+    """The fit (a :class:`hydro.statespace.StateSpaceRadiation`) or value (a float or a read-only
+    float array: kinds other than "fit") stored under ``key`` in the database file at ``path``,
+    or None when it holds none (or it cannot be read)."""
     if stored(path).get(key) != kind:
         return None
     try:
@@ -245,7 +250,7 @@ def _fit_from(ds):
     return fit
 
 
-def _value_dataset(value, made: dict):
+def _value_dataset(value, made: dict, kind: str = "value"):
     import xarray as xr
 
     a = np.asarray(value)
@@ -253,7 +258,7 @@ def _value_dataset(value, made: dict):
         raise ValueError(f"a stored value must be a float or an array of floats, not {a.dtype}")
     dims = tuple(f"axis_{k}" for k in range(a.ndim))
     return xr.Dataset({"value": (dims, a)},
-                      attrs={"kind": "value", "scalar": int(np.ndim(value) == 0), **made})
+                      attrs={"kind": kind, "scalar": int(np.ndim(value) == 0), **made})
 
 
 def _value_from(ds):
@@ -266,11 +271,13 @@ def _value_from(ds):
 
 # -- writing
 
-def store(path, items: dict) -> dict:
+def store(path, items: dict, sources: dict | None = None) -> dict:
     """Store ``items`` ({key: (kind, fit or value)}) in the database file at ``path``, keeping
     the items it already stores whose code is current (``source`` attribute) and dropping the
-    others. The file is written anew beside ``path`` and renamed over it, after checking that
-    its database (the root group) reads back identical. Returns {key: kind} of what it stores."""
+    others. ``sources``: the digest of the code of each kind other than "fit" and "value" (an
+    item of a kind it does not name is dropped: its code cannot be judged). The file is written
+    anew beside ``path`` and renamed over it, after checking that its database (the root group)
+    reads back identical. Returns {key: kind} of what it stores."""
     import xarray as xr
 
     from .database import read_netcdf
@@ -281,18 +288,23 @@ def store(path, items: dict) -> dict:
                          "database first (hydro.prepare.open_any_database, then "
                          "hydro.database.to_netcdf) and point the config at it")
     root = read_netcdf(path)
+    current = {"fit": source_digest("fit"), "value": source_digest("value"), **(sources or {})}
     groups = {}
     for key, kind in stored(path).items():
         ds = _group(path, key)
-        if ds.attrs.get("source") == source_digest(kind) and key not in items:
+        if key not in items and kind in current and ds.attrs.get("source") == current[kind]:
             groups[key] = ds
     import numpy
     import scipy
 
     for key, (kind, obj) in items.items():
-        made = {"source": source_digest(kind), "made_with": f"numpy {numpy.__version__}, "
+        if kind not in current:
+            raise ValueError(f"store: no digest of the code that makes {kind!r} items; give it "
+                             f"in sources=")
+        made = {"source": current[kind], "made_with": f"numpy {numpy.__version__}, "
                 f"scipy {scipy.__version__}", "made_by": "mfm fits (hydro.fitstore.store)"}
-        groups[key] = _fit_dataset(obj, made) if kind == "fit" else _value_dataset(obj, made)
+        groups[key] = (_fit_dataset(obj, made) if kind == "fit"
+                       else _value_dataset(obj, made, kind))
     tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
     try:
         root.to_netcdf(tmp, engine="netcdf4")

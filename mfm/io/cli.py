@@ -400,30 +400,34 @@ def cmd_fits(args):
 
     from hydro import fitcache, fitstore
 
+    from ..loads.catenary import table_source
+
     for config in args.config:
         options, _ = load_config(config)
         if "hydro" not in options:
             raise ValueError(f"{config}: no [hydro] table, so no database to store fits in")
-        model = load(config, progress=getattr(args, "progress", False))
-        spec = model.hydro.replace()         # its own caches: every item is asked for
-        path = spec.stored_in
-        if path is None:
-            raise ValueError(f"{config}: its database {spec.source!r} is not a NetCDF file (.nc); "
-                             "fits are stored in NetCDF databases only")
         t0 = time.perf_counter()
         with fitcache.recording() as made:
+            # the load makes the config's mooring tables (mfm.loads.catenary): recorded too
+            model = load(config, progress=getattr(args, "progress", False))
+            spec = model.hydro.replace()         # its own caches: every item is asked for
+            path = spec.stored_in
+            if path is None:
+                raise ValueError(f"{config}: its database {spec.source!r} is not a NetCDF file "
+                                 "(.nc); fits are stored in NetCDF databases only")
             spec.memory()
             spec.added_mass_inf()
             fit = None if args.values_only else spec.state_space()
         items = {key: item for (p, key), item in made.items() if p == path}
         before = os.path.getsize(path)
-        kinds = list(fitstore.store(path, items).values())
+        kinds = list(fitstore.store(path, items, sources={"table": table_source()}).values())
         this = ("" if fit is None else
                 f"; this config's fit: {fit.report['n_states']} states, band error "
                 f"{fit.report['overall_error']:.3g}, passive {fit.report['passive']}")
+        tables = f", {kinds.count('table')} mooring table(s)" if "table" in kinds else ""
         print(f"{config}: {os.path.normpath(path)} stores {kinds.count('fit')} fit(s) and "
-              f"{kinds.count('value')} value(s){this}; {time.perf_counter() - t0:.1f} s, file "
-              f"{before / 1e6:.2f} -> {os.path.getsize(path) / 1e6:.2f} MB", flush=True)
+              f"{kinds.count('value')} value(s){tables}{this}; {time.perf_counter() - t0:.1f} s, "
+              f"file {before / 1e6:.2f} -> {os.path.getsize(path) / 1e6:.2f} MB", flush=True)
 
 
 def cmd_plot(args):

@@ -36,7 +36,8 @@ parameters (six lines of one geometry cost one table: ~2,500 MoorPy calls, 3–5
 and on disk beside the radiation fits (:mod:`hydro.fitcache`'s folder, ``mooring-tables``; off
 with ``MFM_FIT_CACHE=off``), named by the sha256 of the parameters, this module's source and the
 MoorPy, numpy and scipy versions: a later process reads Wu & Yuan's tables (11 s of its
-``mfm.load`` on 2 cores) back, the same to the last bit.
+``mfm.load`` on 2 cores) back, the same to the last bit. ``mfm fits`` also stores a config's
+tables in its database file (:func:`build_table`), where a first run on a new machine reads them.
 
 Outside the table nothing is clipped or extrapolated: the force is NaN, so a run that takes a
 fairlead out stops as non-finite and :meth:`CatenaryLines.describe_nonfinite` names the line, its
@@ -62,6 +63,7 @@ frequency domain, the tension's own linearisation ∂T/∂r_F · r̂_F.
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import equinox as eqx
 import jax
@@ -116,26 +118,54 @@ def _axis(centre, half, step):
     return np.linspace(centre - half, centre + half, max(n, 4))
 
 
-def build_table(x0, z0, extent, step, length, EA, weight, seabed_friction):
+def build_table(x0, z0, extent, step, length, EA, weight, seabed_friction, stored=None):
     """(xs, zs, coef): the grid axes and the nodal data (nx, nz, 4, 2) of the tensor-product
-    not-a-knot cubic spline of (H, V): [f, hx ∂f/∂x, hz ∂f/∂z, hx hz ∂²f/∂x∂z] per node.
-    The grid is centred on the rest span and height (x0, z0) rounded to :data:`CENTRE_QUANTUM`,
-    and cached on its arguments: lines of one geometry make one table, although their spans,
-    computed from fairlead and anchor positions a config gives to 1e-6 m, differ in the last
-    digits (Wu & Yuan's six lines: three spans 775.4999997–775.5000010 m, so three tables of 2,511
-    MoorPy solves each, 10 s on a 2-core machine, where one serves)."""
-    from scipy.interpolate import CubicSpline
+    not-a-knot cubic spline of (H, V): [f, hx ∂f/∂x, hz ∂f/∂z, hx hz ∂²f/∂x∂z] per node
+    (:func:`make_table`). The grid is centred on the rest span and height (x0, z0) rounded to
+    :data:`CENTRE_QUANTUM`, and cached on its arguments: lines of one geometry make one table,
+    although their spans, computed from fairlead and anchor positions a config gives to 1e-6 m,
+    differ in the last digits (Wu & Yuan's six lines: three spans 775.4999997–775.5000010 m, so
+    three tables of 2,511 MoorPy solves each, 10 s on a 2-core machine, where one serves).
+
+    Looked for in the process, then in the database file ``stored`` (where ``mfm fits`` stores
+    a config's tables beside its radiation fits, :mod:`hydro.fitstore`: a first run on a new
+    machine neither imports MoorPy, whose import of matplotlib's pyplot is 1.7 s, nor solves),
+    then on disk; else made."""
+    from hydro import fitcache, fitstore
 
     x0, z0 = (round(float(v) / CENTRE_QUANTUM) * CENTRE_QUANTUM for v in (x0, z0))
     key = tuple(round(float(v), 9) for v in (x0, z0, *extent, *step, length, EA, weight,
                                              seabed_friction))
+    # the same switch as the fits': MFM_FIT_CACHE=off reads no stored item
+    read = stored is not None and fitcache.cache_dir() is not None
+    skey = None if stored is None else stored_table_key(key)
+
+    def kept(table):
+        _TABLE_CACHE[key] = table
+        fitcache.record(stored, skey, "table", _packed(table))   # for `mfm fits`
+        return table
+
     if key in _TABLE_CACHE:
-        return _TABLE_CACHE[key]
+        return kept(_TABLE_CACHE[key])
+    if read:
+        packed = fitstore.read(stored, skey, "table")
+        if packed is not None:
+            return kept(_unpacked(packed))
     path = _table_file(key)
     table = _read_table(path)
     if table is not None:
-        _TABLE_CACHE[key] = table
-        return table
+        return kept(table)
+    table = make_table(x0, z0, extent, step, length, EA, weight, seabed_friction)
+    _write_table(path, table)
+    return kept(table)
+
+
+def make_table(x0, z0, extent, step, length, EA, weight, seabed_friction):
+    """:func:`build_table`'s table made: MoorPy's line (:func:`catenary_forces`) at every node of
+    the grid of half-widths ``extent`` and spacing ``step`` about (x0, z0), and the spline's
+    nodal derivatives."""
+    from scipy.interpolate import CubicSpline
+
     xs, zs = _axis(x0, extent[0], step[0]), _axis(z0, extent[1], step[1])
     # seconds (Wu & Yuan: 2,511 solves, ~7 s on 2 cores): a display that shows them hears how far
     n, rows, every = len(xs) * len(zs), [], phases.every(len(xs))
@@ -149,9 +179,43 @@ def build_table(x0, z0, extent, step, length, EA, weight, seabed_friction):
     Fxz = CubicSpline(zs, Fx, axis=1)(zs, 1)
     hx, hz = xs[1] - xs[0], zs[1] - zs[0]
     coef = np.stack([F, hx * Fx, hz * Fz, hx * hz * Fxz], axis=2)
-    _TABLE_CACHE[key] = (xs, zs, coef)
-    _write_table(path, (xs, zs, coef))
     return xs, zs, coef
+
+
+@functools.cache
+def table_source() -> str:
+    """sha256 of the code that makes a table (:func:`make_table`, :func:`catenary_forces`,
+    :func:`_axis`) and of MoorPy's tolerance: a stored table made by other code is not read, and
+    ``mfm fits`` drops it (not MoorPy's version: a stored table is a product of the config, the
+    same numbers wherever it is read, as a stored fit is)."""
+    import hashlib
+    import inspect
+
+    h = hashlib.sha256(repr(MOORPY_TOL).encode())
+    for f in (make_table, catenary_forces, _axis):
+        h.update(inspect.getsource(f).encode())
+    return h.hexdigest()
+
+
+def stored_table_key(key) -> str:
+    """The key of the table of ``key`` (:func:`build_table`'s parameters) in a database file."""
+    import hashlib
+
+    h = hashlib.sha256(repr(("mooring table", key)).encode())
+    h.update(table_source().encode())
+    return h.hexdigest()
+
+
+def _packed(table):
+    """(xs, zs, coef) as one float vector: [nx, nz, xs, zs, coef (nx, nz, 4, 2) flat]."""
+    xs, zs, coef = table
+    return np.concatenate([[len(xs), len(zs)], xs, zs, np.ravel(coef)])
+
+
+def _unpacked(a):
+    nx, nz = int(a[0]), int(a[1])
+    xs, zs = a[2:2 + nx], a[2 + nx:2 + nx + nz]
+    return xs, zs, a[2 + nx + nz:].reshape(nx, nz, 4, 2)
 
 
 # the most the tables' folder may hold (Wu & Yuan's table: 81 × 31 × 4 × 2 doubles, 160 kB)
@@ -500,8 +564,11 @@ class CatenaryLines(Load):
         for t in parsed:
             w = t["weight"] if "weight" in t else t["mass_per_length"] * float(model.gravity)
             try:
+                # a table stored in the config's database file (`mfm fits`) is read from there
                 xs, zs, c = build_table(t["x0"], t["z0"], t["table_extent"], t["table_step"],
-                                        t["length"], t["EA"], w, t["seabed_friction"])
+                                        t["length"], t["EA"], w, t["seabed_friction"],
+                                        stored=None if model.hydro is None
+                                        else model.hydro.stored_in)
             except ValueError as e:
                 raise ConfigError(f"catenary_lines {t['name']!r}: {e}; narrow table_extent") from None
             coef.append(c)
