@@ -197,7 +197,11 @@ def test_fits_stores_with_the_cache_off(sphere, monkeypatch):
 
 def test_info_says_what_the_database_stores(capsys):
     assert main(["info", str(CONFIGS / "m4_134.toml"), "--no-restoring"]) == 0
-    assert "stores 1 radiation fit(s) and 2 value(s)" in capsys.readouterr().out
+    assert "stores 1 radiation fit(s) and 2 value(s) made from it (`mfm fits`)" in \
+        capsys.readouterr().out
+    assert main(["info", str(CONFIGS / "wu_yuan_m1.toml"), "--no-restoring"]) == 0
+    assert "stores 0 radiation fit(s) and 2 value(s) made from it, 1 mooring table(s)" in \
+        capsys.readouterr().out
 
 
 def test_a_report_reads_back_equal_its_types_kept():

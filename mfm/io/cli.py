@@ -115,8 +115,9 @@ def cmd_info(args):
             from hydro import fitstore
 
             kinds = list(fitstore.stored(model.hydro.stored_in).values())
+            tables = f", {kinds.count('table')} mooring table(s)" if "table" in kinds else ""
             print(f"  stores {kinds.count('fit')} radiation fit(s) and {kinds.count('value')} "
-                  "value(s) made from it (`mfm fits`)" if kinds else
+                  f"value(s) made from it{tables} (`mfm fits`)" if kinds else
                   "  stores no radiation fit (`mfm fits` stores the config's)")
         issues = known_data_issues(model.hydro.source)
         print("  known data issues (not warned at load; every computation uses the symmetric "
