@@ -238,6 +238,11 @@ def recording():
         _recorder = before
 
 
+def recording_now() -> bool:
+    """Whether :func:`recording` is collecting (so that a caller packs an item only then)."""
+    return _recorder is not None
+
+
 def record(stored, skey, kind, item):
     """Note ``item`` (of ``kind``, under the stored key ``skey``, for the database file
     ``stored``) for :func:`recording`, when it records; returns ``item``. Also what makes

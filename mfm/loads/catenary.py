@@ -142,7 +142,8 @@ def build_table(x0, z0, extent, step, length, EA, weight, seabed_friction, store
 
     def kept(table):
         _TABLE_CACHE[key] = table
-        fitcache.record(stored, skey, "table", _packed(table))   # for `mfm fits`
+        if skey is not None and fitcache.recording_now():          # `mfm fits` stores it
+            fitcache.record(stored, skey, "table", _packed(table))
         return table
 
     if key in _TABLE_CACHE:
