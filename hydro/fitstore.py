@@ -293,15 +293,20 @@ def store(path, items: dict, sources: dict | None = None) -> dict:
                          "hydro.database.to_netcdf) and point the config at it")
     root = read_netcdf(path)
     current = {"fit": source_digest("fit"), "value": source_digest("value"), **(sources or {})}
+    # the file's own order first (an item stored again keeps its place), then the new items by
+    # key: storing the same items again writes the same bytes, whatever order they were made in
     groups = {}
     for key, kind in stored(path).items():
+        if key in items:
+            groups[key] = None
+            continue
         ds = _group(path, key)
-        if key not in items and kind in current and ds.attrs.get("source") == current[kind]:
+        if kind in current and ds.attrs.get("source") == current[kind]:
             groups[key] = ds
     import numpy
     import scipy
 
-    for key, (kind, obj) in items.items():
+    for key, (kind, obj) in sorted(items.items()):
         if kind not in current:
             raise ValueError(f"store: no digest of the code that makes {kind!r} items; give it "
                              f"in sources=")
