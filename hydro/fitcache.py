@@ -53,6 +53,13 @@ _values: dict = {}              # cached_value's, by key (a float or a small arr
 _warned = False
 
 
+def reads_stored(stored) -> bool:
+    """Whether the database file ``stored`` (None: none) is read for stored items: not with
+    ``MFM_FIT_CACHE=off``, where every fit, value and mooring table is made in the process (the
+    benchmarks that time them need it)."""
+    return stored is not None and cache_dir() is not None
+
+
 def cache_dir() -> Path | None:
     """The folder of the disk cache, or None when ``MFM_FIT_CACHE`` is ``off`` (then fits and
     values stored in a database file, :mod:`hydro.fitstore`, are not read either: every one is
@@ -66,13 +73,12 @@ def cache_dir() -> Path | None:
     return Path(base) / "mfm" / "fits"
 
 
-def fit_key(db, options: dict, *, sources=None, numpy_version: bool = True) -> str:
+def fit_key(db, options: dict) -> str:
     """sha256 of what a fit depends on: every array, dimension and attribute of ``db`` (the
-    database as the fit sees it), the options, the fitting code's source (``sources``: files of
-    hydro/, :data:`_SOURCES` by default) and numpy's version (unless ``numpy_version`` is False:
-    the key of a fit stored in a database file, :mod:`hydro.fitstore`)."""
-    return content_key(db, options, _SOURCES if sources is None else sources,
-                       numpy_version=numpy_version)
+    database as the fit sees it), the options, the fitting code's source and numpy's version
+    (:func:`hydro.contentkey.content_key`; a fit stored in a database file is keyed without
+    numpy's version, :mod:`hydro.fitstore`)."""
+    return content_key(db, options, _SOURCES)
 
 
 def clear() -> None:
@@ -194,10 +200,9 @@ def cached_fit(db, stored=None, **options):
     the disk cache, else fitted (and kept in the process and on disk). ``MFM_FIT_CACHE=off``
     reads neither the folder nor the database file."""
     key = fit_key(db, options)
-    # MFM_FIT_CACHE=off: every fit made in the process, none read (the benchmarks time fits);
-    # `mfm fits` (recording) stores what it makes even so
-    read = stored is not None and cache_dir() is not None
-    recording_ = stored is not None and _recorder is not None
+    # `mfm fits` (recording) stores what it makes even where nothing stored is read
+    read = reads_stored(stored)
+    recording_ = stored is not None and recording_now()
     if key in _memory:
         _memory.move_to_end(key)
         skey = fitstore.fit_key(db, options) if recording_ else None
@@ -261,8 +266,8 @@ def cached_value(db, name: str, options: dict, compute, stored=None):
     bit; an array comes back read-only. ``stored``: the database file, read first for a value
     ``mfm fits`` stored there (:mod:`hydro.fitstore`)."""
     key = fit_key(db, {"value": name, **options})
-    read = stored is not None and cache_dir() is not None     # as in cached_fit
-    recording_ = stored is not None and _recorder is not None
+    read = reads_stored(stored)                                # as in cached_fit
+    recording_ = stored is not None and recording_now()
     if key in _values:
         skey = fitstore.value_key(db, name, options) if recording_ else None
         return record(stored, skey, "value", _values[key])

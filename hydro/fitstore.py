@@ -303,14 +303,13 @@ def store(path, items: dict, sources: dict | None = None) -> dict:
         ds = _group(path, key)
         if kind in current and ds.attrs.get("source") == current[kind]:
             groups[key] = ds
-    import numpy
     import scipy
 
     for key, (kind, obj) in sorted(items.items()):
         if kind not in current:
             raise ValueError(f"store: no digest of the code that makes {kind!r} items; give it "
                              f"in sources=")
-        made = {"source": current[kind], "made_with": f"numpy {numpy.__version__}, "
+        made = {"source": current[kind], "made_with": f"numpy {np.__version__}, "
                 f"scipy {scipy.__version__}", "made_by": "mfm fits (hydro.fitstore.store)"}
         groups[key] = (_fit_dataset(obj, made) if kind == "fit"
                        else _value_dataset(obj, made, kind))

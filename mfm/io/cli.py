@@ -409,9 +409,10 @@ def cmd_fits(args):
             raise ValueError(f"{config}: no [hydro] table, so no database to store fits in")
         t0 = time.perf_counter()
         with fitcache.recording() as made:
-            # the load makes the config's mooring tables (mfm.loads.catenary): recorded too
+            # recorded from the load on: it makes the config's mooring tables
+            # (mfm.loads.catenary) and may ask for the values below first
             model = load(config, progress=getattr(args, "progress", False))
-            spec = model.hydro.replace()         # its own caches: every item is asked for
+            spec = model.hydro
             path = spec.stored_in
             if path is None:
                 raise ValueError(f"{config}: its database {spec.source!r} is not a NetCDF file "

@@ -136,8 +136,7 @@ def build_table(x0, z0, extent, step, length, EA, weight, seabed_friction, store
     x0, z0 = (round(float(v) / CENTRE_QUANTUM) * CENTRE_QUANTUM for v in (x0, z0))
     key = tuple(round(float(v), 9) for v in (x0, z0, *extent, *step, length, EA, weight,
                                              seabed_friction))
-    # the same switch as the fits': MFM_FIT_CACHE=off reads no stored item
-    read = stored is not None and fitcache.cache_dir() is not None
+    read = fitcache.reads_stored(stored)       # the fits' switch (MFM_FIT_CACHE=off: not read)
     skey = None if stored is None else stored_table_key(key)
 
     def kept(table):
