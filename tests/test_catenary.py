@@ -25,7 +25,7 @@ import mfm
 from mfm.io.config import parse_config
 from mfm.loads import CatenaryLines, JointLoad
 from mfm.frequency.rest import linearise_lines
-from mfm.loads.catenary import catenary_forces
+from mfm.loads.catenary_tables import catenary_forces
 from mfm.mechanics.tree import ConfigError
 
 mp = pytest.importorskip("moorpy")
@@ -654,36 +654,36 @@ def test_moordyn_slow_limit_is_the_quasi_static_line(lines):
 def test_tables_are_kept_on_disk_and_read_back_bit_for_bit(monkeypatch, tmp_path):
     """A table made once is read back by a later process (here: the process's table forgotten)
     without MoorPy, the same bits; another line, or the cache off, makes its own."""
-    from mfm.loads import catenary
+    from mfm.loads import catenary_tables as tables
 
     monkeypatch.setenv("MFM_FIT_CACHE", str(tmp_path))
-    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})
+    monkeypatch.setattr(tables, "_TABLE_CACHE", {})
     calls = []
-    real = catenary.catenary_forces
-    monkeypatch.setattr(catenary, "catenary_forces", lambda *a: calls.append(a) or real(*a))
+    real = tables.catenary_forces
+    monkeypatch.setattr(tables, "catenary_forces", lambda *a: calls.append(a) or real(*a))
     args = (775.5, 75.0, (2.0, 1.0), (1.0, 1.0), 800.0, 1.243e9, 2972.43, 0.0)
-    made = catenary.build_table(*args)
+    made = tables.build_table(*args)
     n = len(calls)
     assert n == 5 * 4 and len(list((tmp_path / "mooring-tables").glob("*.npz"))) == 1
-    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})          # as a new process finds it
-    again = catenary.build_table(*args)
+    monkeypatch.setattr(tables, "_TABLE_CACHE", {})          # as a new process finds it
+    again = tables.build_table(*args)
     assert len(calls) == n                                     # MoorPy not called
     for a, b in zip(made, again):
         np.testing.assert_array_equal(a, b)
-    catenary.build_table(*args[:4], 801.0, *args[5:])          # another length: its own table
+    tables.build_table(*args[:4], 801.0, *args[5:])          # another length: its own table
     assert len(calls) == 2 * n and len(list((tmp_path / "mooring-tables").glob("*.npz"))) == 2
     # a damaged file is made again
     for p in (tmp_path / "mooring-tables").glob("*.npz"):
         p.write_bytes(b"not a table")
-    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})
-    np.testing.assert_array_equal(catenary.build_table(*args)[2], made[2])
+    monkeypatch.setattr(tables, "_TABLE_CACHE", {})
+    np.testing.assert_array_equal(tables.build_table(*args)[2], made[2])
     assert len(calls) == 3 * n
     monkeypatch.setenv("MFM_FIT_CACHE", "off")
-    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})
-    catenary.build_table(*args)
+    monkeypatch.setattr(tables, "_TABLE_CACHE", {})
+    tables.build_table(*args)
     assert len(calls) == 4 * n
     # lines of one geometry whose spans differ in the last digits of their positions share it
-    catenary.build_table(775.5000009, 75.0000004, *args[2:])
+    tables.build_table(775.5000009, 75.0000004, *args[2:])
     assert len(calls) == 4 * n
 
 
@@ -691,10 +691,10 @@ def test_load_says_how_far_its_mooring_table_is(tmp_path, monkeypatch, capsys):
     # mfm.load(progress=...) shows what the load does; a mooring table it must make says its
     # MoorPy solves as they go (Wu & Yuan's 2,511: ~7 s where the cache is empty). A table of
     # 5 spans × 4 heights (table_extent [2, 1] m, table_step [1, 1] m: _axis keeps ≥ 4 nodes)
-    from mfm.loads import catenary
+    from mfm.loads import catenary_tables as tables
 
     monkeypatch.setenv("MFM_FIT_CACHE", "off")              # no table from an earlier run
-    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})
+    monkeypatch.setattr(tables, "_TABLE_CACHE", {})
     ln = wy_lines()[0]
     p = tmp_path / "moored.toml"
     p.write_text('[model]\nname = "one moored hull"\n' + HULL_TOML + f'''[[catenary_lines]]
@@ -710,7 +710,7 @@ table_step = [1.0, 1.0]
 ''')
     quiet = mfm.load(p)
     assert capsys.readouterr().err == ""                    # off by default
-    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})
+    monkeypatch.setattr(tables, "_TABLE_CACHE", {})
     shown = mfm.load(p, progress={"delay": 0, "mininterval": 0})
     err = capsys.readouterr().err
     assert "loading one moored hull" in err
@@ -727,7 +727,7 @@ table_step = [1.0, 1.0]
 
     monkeypatch.setattr(mfm_cli, "PROGRESS_DELAY_LOG", 0.0)
     monkeypatch.setattr(mfm_cli, "PROGRESS_INTERVAL_LOG", 0.0)
-    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})
+    monkeypatch.setattr(tables, "_TABLE_CACHE", {})
     assert mfm_cli.main(["info", str(p)]) == 0
     err = capsys.readouterr().err
     assert "loading one moored hull" in err and "mooring table (MoorPy): 16 of 20 solves" in err

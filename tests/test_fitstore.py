@@ -140,9 +140,9 @@ def test_fits_refuses_what_it_cannot_store(tmp_path, capsys):
 def test_the_shipped_stored_fits_are_current():
     """Each item a shipped database stores was made by today's code (else runs fit again, and
     the first call is slower than the README says): after editing the fitting code or the
-    mooring tables' (mfm.loads.catenary.make_table), run ``mfm fits`` on the configs
+    mooring tables' (mfm.loads.catenary_tables.make_table), run ``mfm fits`` on the configs
     hydro/data/README.md lists."""
-    from mfm.loads.catenary import table_source
+    from mfm.loads.catenary_tables import table_source
 
     digest = {"fit": FS.source_digest("fit"), "value": FS.source_digest("value"),
               "table": table_source()}
@@ -229,27 +229,27 @@ def test_values_only_stores_no_fit(sphere, fresh):
 def test_a_stored_mooring_table_is_read_without_moorpy(sphere, fresh, monkeypatch, tmp_path):
     """``mfm fits`` stores a config's mooring tables too (a first run then neither imports
     MoorPy nor solves): read back, the same bits; another code's table is dropped."""
-    from mfm.loads import catenary
+    from mfm.loads import catenary_tables as tables
 
     cfg, db_path = sphere
-    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})
+    monkeypatch.setattr(tables, "_TABLE_CACHE", {})
     args = (775.5, 75.0, (2.0, 1.0), (1.0, 1.0), 800.0, 1.243e9, 2972.43, 0.0)
     with FC.recording() as made:
-        table = catenary.build_table(*args, stored=str(db_path))
+        table = tables.build_table(*args, stored=str(db_path))
     items = {key: item for (_, key), item in made.items()}
     assert [kind for kind, _ in items.values()] == ["table"]
     with pytest.raises(ValueError, match="sources="):
         FS.store(db_path, items)                 # hydro cannot judge mfm's code
-    FS.store(db_path, items, sources={"table": catenary.table_source()})
+    FS.store(db_path, items, sources={"table": tables.table_source()})
     assert list(FS.stored(db_path).values()) == ["table"]
-    monkeypatch.setattr(catenary, "_TABLE_CACHE", {})
+    monkeypatch.setattr(tables, "_TABLE_CACHE", {})
     shutil.rmtree(tmp_path / "empty-fit-cache")  # on another machine
 
     def moorpy(*a, **k):
         raise AssertionError("MoorPy called: the stored table was not read")
 
-    monkeypatch.setattr(catenary, "catenary_forces", moorpy)
-    again = catenary.build_table(*args, stored=str(db_path))
+    monkeypatch.setattr(tables, "catenary_forces", moorpy)
+    again = tables.build_table(*args, stored=str(db_path))
     for a, b in zip(table, again):
         assert a.shape == b.shape and np.array_equal(a.view(np.uint64), b.view(np.uint64))
     FS.store(db_path, {}, sources={"table": "0" * 64})   # made by other code: dropped

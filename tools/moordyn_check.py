@@ -150,7 +150,7 @@ def main(argv=None):
 
     import mfm
     from mfm.loads import CatenaryLines
-    from mfm.loads.catenary import catenary_forces
+    from mfm.loads.catenary_tables import catenary_forces
 
     warnings.filterwarnings("ignore", message=".*database.*")
     t_start = time.time()

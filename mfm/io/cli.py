@@ -401,7 +401,7 @@ def cmd_fits(args):
 
     from hydro import fitcache, fitstore
 
-    from ..loads.catenary import table_source
+    from ..loads.catenary_tables import table_source
 
     for config in args.config:
         options, _ = load_config(config)
