@@ -24,7 +24,9 @@ any new machine reads it, so the ``m4`` and ``wu_yuan`` rows do not fit; set
 and the ``_cached`` rows then fit again as well).
 
 Each row's wall time is the child process's, from its start (imports and loading included), so a
-row is what the user waits for. Figures depend on the machine and its load: say which when
+row is what the user waits for. Beside it, the CPU seconds the process spent (user + system, every
+thread): the work of that first answer, whatever the cores; its wall time cannot be less than that
+work divided by the machine's cores. Figures depend on the machine and its load: say which when
 quoting them.
 """
 from __future__ import annotations
@@ -32,6 +34,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import resource
 import subprocess
 import sys
 import tempfile
@@ -64,13 +67,31 @@ print("PHASES", round(time.perf_counter() - t0, 2), float(np.abs(r.rao).max()))
 """
 
 
+# the CPU seconds of each row's process (user + system, all its threads), for its line
+CPU: list = []
+
+
+def _cpu_seconds() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
 def _run(argv, env, cwd):
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), _cpu_seconds()
     r = subprocess.run(argv, cwd=cwd, env=env, capture_output=True, text=True)
     wall = time.perf_counter() - t0
+    CPU.append(_cpu_seconds() - c0)
     if r.returncode:
         sys.exit(f"{argv} failed:\n{r.stderr[-3000:]}")
     return wall, r
+
+
+def _work() -> str:
+    """The last row's CPU seconds and what they bound: its wall time on this machine's cores
+    cannot be less than CPU / cores (the compilations, the largest part of a first answer, each
+    run on one thread)."""
+    cores = os.cpu_count() or 1
+    return f"[CPU {CPU[-1]:.1f} s: ≥ {CPU[-1] / cores:.1f} s of wall on {cores} cores]"
 
 
 def _phases(stderr: str) -> list[str]:
@@ -122,28 +143,31 @@ def main(argv=None):
                         if "mfm simulate configs/rm3.toml" in ln)
             cmd = line.split("&&")[-1].strip().split()
             wall, _ = _run([sys.executable, str(ROOT / "mfm_cli.py"), *cmd[1:]], env("rm3"), tmp)
-            print(f"RM3, the README's first command, empty caches: {wall:.1f} s (goal ≤ 3 s)")
+            print(f"RM3, the README's first command, empty caches: {wall:.1f} s (goal ≤ 3 s) "
+                  f"{_work()}")
             if "rm3_cached" in a.only:
                 wall, _ = _run([sys.executable, str(ROOT / "mfm_cli.py"), *cmd[1:]], env("rm3"),
                                tmp)
-                print(f"RM3, the same in a process after one that filled the caches: {wall:.1f} s")
+                print(f"RM3, the same in a process after one that filled the caches: {wall:.1f} s "
+                      f"{_work()}")
         if "m4" in a.only or "m4_cached" in a.only:
             (tmp / "m4.py").write_text(M4)
             wall, _ = _run([sys.executable, "m4.py"], env("m4"), tmp)
             print(f"M4 134 simulate with defaults (120 s at dt 0.006 s), empty caches: {wall:.1f} s "
-                  "(goal ≤ 8 s)")
+                  f"(goal ≤ 8 s) {_work()}")
             if "m4_cached" in a.only:
                 wall, _ = _run([sys.executable, "m4.py"], env("m4"), tmp)
                 print(f"M4 134, the same in a process after one that filled the caches: "
-                      f"{wall:.1f} s (goal ≤ 1.5 s)")
+                      f"{wall:.1f} s (goal ≤ 1.5 s) {_work()}")
         if "wu_yuan_fd" in a.only or "wu_yuan_fd_cached" in a.only:
             (tmp / "fd.py").write_text(FD)
             wall, _ = _run([sys.executable, "fd.py"], env("fd"), tmp)
-            print(f"Wu & Yuan m1 frequency_response at two periods, empty caches: {wall:.1f} s")
+            print(f"Wu & Yuan m1 frequency_response at two periods, empty caches: {wall:.1f} s "
+                  f"{_work()}")
             if "wu_yuan_fd_cached" in a.only:
                 wall, _ = _run([sys.executable, "fd.py"], env("fd"), tmp)
                 print(f"Wu & Yuan m1 frequency_response, the same in a process after one that "
-                      f"filled the caches: {wall:.1f} s")
+                      f"filled the caches: {wall:.1f} s {_work()}")
         if "wu_yuan" in a.only:
             out = tmp / "wy.nc"
             wall, r = _run([sys.executable, str(ROOT / "mfm_cli.py"), "simulate",
@@ -153,7 +177,7 @@ def main(argv=None):
                            env("wy"), tmp)
             phases = _phases(r.stderr)
             print(f"Wu & Yuan m1 time domain, 600 s, empty caches: {wall:.1f} s (goal ≤ 20 s, every "
-                  f"phase shown); phases shown: {phases or 'none'}")
+                  f"phase shown) {_work()}; phases shown: {phases or 'none'}")
     print(f"load average {os.getloadavg()[0]:.1f} at the end")
 
 
