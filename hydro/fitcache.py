@@ -38,7 +38,7 @@ import numpy as np
 # settings of the hydro modules loaded (fitstore's GROUP, ...), so a module loaded halfway through
 # a process would rename the programs made after it
 from . import fitstore
-from .contentkey import content_key
+from .contentkey import content_key, database_hash
 
 # the most the default folder may hold; a fit of M4 134 (960 states) is about 8 MB
 CACHE_BYTES = 512 * 2**20
@@ -73,12 +73,13 @@ def cache_dir() -> Path | None:
     return Path(base) / "mfm" / "fits"
 
 
-def fit_key(db, options: dict) -> str:
+def fit_key(db, options: dict, *, hashed=None) -> str:
     """sha256 of what a fit depends on: every array, dimension and attribute of ``db`` (the
     database as the fit sees it), the options, the fitting code's source and numpy's version
     (:func:`hydro.contentkey.content_key`; a fit stored in a database file is keyed without
-    numpy's version, :mod:`hydro.fitstore`)."""
-    return content_key(db, options, _SOURCES)
+    numpy's version, :mod:`hydro.fitstore`). ``hashed``: the database's
+    :func:`hydro.contentkey.database_hash`, where made before."""
+    return content_key(db, options, _SOURCES, hashed=hashed)
 
 
 def clear() -> None:
@@ -199,15 +200,16 @@ def cached_fit(db, stored=None, **options):
     else the database file ``stored`` (a fit ``mfm fits`` put there, :mod:`hydro.fitstore`), else
     the disk cache, else fitted (and kept in the process and on disk). ``MFM_FIT_CACHE=off``
     reads neither the folder nor the database file."""
-    key = fit_key(db, options)
+    hashed = database_hash(db)              # once for both keys: most of a key's cost
+    key = fit_key(db, options, hashed=hashed)
     # `mfm fits` (recording) stores what it makes even where nothing stored is read
     read = reads_stored(stored)
     recording_ = stored is not None and recording_now()
     if key in _memory:
         _memory.move_to_end(key)
-        skey = fitstore.fit_key(db, options) if recording_ else None
+        skey = fitstore.fit_key(db, options, hashed=hashed) if recording_ else None
         return record(stored, skey, "fit", _memory[key])
-    skey = fitstore.fit_key(db, options) if read or recording_ else None
+    skey = fitstore.fit_key(db, options, hashed=hashed) if read or recording_ else None
     if read:
         fit = fitstore.read(stored, skey, "fit")
         if fit is not None:
@@ -265,13 +267,14 @@ def cached_value(db, name: str, options: dict, compute, stored=None):
     Wu & Yuan, in every first run before). A value read back equals the one written to the last
     bit; an array comes back read-only. ``stored``: the database file, read first for a value
     ``mfm fits`` stored there (:mod:`hydro.fitstore`)."""
-    key = fit_key(db, {"value": name, **options})
-    read = reads_stored(stored)                                # as in cached_fit
+    hashed = database_hash(db)                                 # as in cached_fit
+    key = fit_key(db, {"value": name, **options}, hashed=hashed)
+    read = reads_stored(stored)
     recording_ = stored is not None and recording_now()
     if key in _values:
-        skey = fitstore.value_key(db, name, options) if recording_ else None
+        skey = fitstore.value_key(db, name, options, hashed=hashed) if recording_ else None
         return record(stored, skey, "value", _values[key])
-    skey = fitstore.value_key(db, name, options) if read or recording_ else None
+    skey = fitstore.value_key(db, name, options, hashed=hashed) if read or recording_ else None
     if read:
         value = fitstore.read(stored, skey, "value")
         if value is not None:

@@ -57,15 +57,17 @@ def source_digest(kind: str) -> str:
     return h.hexdigest()
 
 
-def fit_key(db, options: dict) -> str:
-    """The key of a fit of ``db`` (the database as the fit sees it) with ``options``."""
-    return content_key(db, options, FIT_SOURCES, numpy_version=False)
+def fit_key(db, options: dict, *, hashed=None) -> str:
+    """The key of a fit of ``db`` (the database as the fit sees it) with ``options``
+    (``hashed``: :func:`hydro.contentkey.database_hash` of ``db``, where made before)."""
+    return content_key(db, options, FIT_SOURCES, numpy_version=False, hashed=hashed)
 
 
-def value_key(db, name: str, options: dict) -> str:
+def value_key(db, name: str, options: dict, *, hashed=None) -> str:
     """The key of the value ``name`` made from ``db`` with ``options`` (as the disk cache names
     it, :mod:`hydro.fitcache`)."""
-    return content_key(db, {"value": name, **options}, VALUE_SOURCES, numpy_version=False)
+    return content_key(db, {"value": name, **options}, VALUE_SOURCES, numpy_version=False,
+                       hashed=hashed)
 
 
 # -- reading

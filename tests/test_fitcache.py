@@ -83,6 +83,26 @@ def test_the_key_follows_data_options_and_code(sphere_db, monkeypatch):
     assert FC.fit_key(sphere_db, {}) != k
 
 
+def test_a_database_hashed_once_keys_as_hashed_each_time(sphere_db):
+    # cached_fit and cached_value hash the database once for their two keys (the disk cache's
+    # and the database file's): the keys are those each would make alone, and the hash they
+    # share is copied, not advanced, by each
+    from hydro import contentkey, fitstore
+
+    hashed = contentkey.database_hash(sphere_db)
+    before = hashed.hexdigest()
+    for _ in range(2):
+        assert (FC.fit_key(sphere_db, {"order": 4}, hashed=hashed)
+                == FC.fit_key(sphere_db, {"order": 4}))
+        assert fitstore.fit_key(sphere_db, {}, hashed=hashed) == fitstore.fit_key(sphere_db, {})
+        assert (fitstore.value_key(sphere_db, "memory", {"rtol": 1e-3}, hashed=hashed)
+                == fitstore.value_key(sphere_db, "memory", {"rtol": 1e-3}))
+    assert hashed.hexdigest() == before
+    other = sphere_db.copy(deep=True)
+    other.attrs["note"] = "another"
+    assert FC.fit_key(other, {}) != FC.fit_key(sphere_db, {}, hashed=hashed)
+
+
 def test_a_damaged_file_is_fitted_again(sphere_db, folder):
     folder.mkdir()
     path = folder / f"{FC.fit_key(sphere_db, {})}.pkl"
