@@ -115,10 +115,13 @@ def state_space_update(model: Model, *, dt, integrator="rk4", state_space_option
 
     Integrated where the integrator declares its amplification factor R(z) (RK4's) and the
     largest relative error it makes in a fitted mode's response (:func:`integrated_state_error`,
-    z = p dt for every pole p of the fit) is at most :data:`STATE_SPACE_TOLERANCE`; then the states
-    cost one product per evaluation and nothing more (M4 134 over 100 T_p at T_p/200: 0.66× the
-    exact update's time, benchmarks/RESULTS.md; its fit's poles reach |p| dt = 0.09, an error of
-    1.8e-5). Else exact."""
+    z = p dt for every pole p of the fit) is at most :data:`STATE_SPACE_TOLERANCE` (M4 134 at
+    T_p/200: poles to |p| dt = 0.09, an error of 1.8e-5): the run then keeps the integrator's
+    order, where the exact update's velocity, linear within each step, makes the radiation
+    second order (notebooks/speed_accuracy.ipynb). Integrating costs one product with the states
+    per evaluation (RK4: four a step) against the exact update's one per stage offset after the
+    step's start (RK4: two): M4 134 over 100 T_p, the loop 0.70 against 0.47 s
+    (benchmarks/RESULTS.md). Else exact."""
     from ..loads.radiation import StateSpace
 
     integ = _integrators.get(integrator)
