@@ -86,11 +86,18 @@ def _run(argv, env, cwd):
     return wall, r
 
 
+def _cores() -> int:
+    """The cores this process may run on (its CPU affinity where the system says)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:
+        return max(1, os.cpu_count() or 1)
+
+
 def _work() -> str:
-    """The last row's CPU seconds and what they bound: its wall time on this machine's cores
-    cannot be less than CPU / cores (the compilations, the largest part of a first answer, each
-    run on one thread)."""
-    cores = os.cpu_count() or 1
+    """The last row's CPU seconds and what they bound: its wall time on the cores the row's
+    process could use cannot be less than CPU / cores, however its work is scheduled."""
+    cores = _cores()
     return f"[CPU {CPU[-1]:.1f} s: ≥ {CPU[-1] / cores:.1f} s of wall on {cores} cores]"
 
 
@@ -124,7 +131,7 @@ def main(argv=None):
     ap.add_argument("--only", nargs="*",
                     default=["rm3", "rm3_cached", "m4", "m4_cached", "wu_yuan"])
     a = ap.parse_args(argv)
-    print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at the start")
+    print(f"{_cores()} cores, load average {os.getloadavg()[0]:.1f} at the start")
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         for name in ("configs", "hydro"):

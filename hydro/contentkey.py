@@ -37,7 +37,8 @@ def update(h, x) -> None:
 def database_hash(db):
     """The sha256 state after every array, dimension and attribute of ``db`` (its ``date_read``
     attribute aside): the start of every :func:`content_key` of ``db``. Hashing a database is
-    most of a key's cost (M4 134 5 ms, Wu & Yuan's time domain 10 ms), so a caller that keys
+    most of a key's cost (M4 134 4.4 ms, Wu & Yuan's time domain 6.4 ms, a key from it 0.3 ms,
+    on the 2-core project machine), so a caller that keys
     several items of one database hashes it once and passes this as ``hashed=``."""
     h = hashlib.sha256()
     for name in sorted(map(str, db.variables)):

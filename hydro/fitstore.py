@@ -12,8 +12,8 @@ NetCDF group of the database file::
     /mfm_fits/k<sha256>    one fit, value or mooring table each (``kind``), with the digest of
                            the code that made it (``source``) and, for a fit, its report
 
-(mfm's mooring tables, :func:`mfm.loads.catenary_tables.build_table`, are stored the same way: their
-code is mfm's, so ``mfm fits`` gives :func:`store` its digest.)
+(mfm's mooring tables, :func:`mfm.loads.catenary_tables.build_table`, are stored the same way:
+their code is mfm's, so ``mfm fits`` gives :func:`store` its digest.)
 
 A stored item is found by its key: the sha256 of the database as the fit sees it, the options and
 the source of the code that makes it (:data:`FIT_SOURCES`, :data:`VALUE_SOURCES`), but not
