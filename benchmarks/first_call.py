@@ -67,23 +67,20 @@ print("PHASES", round(time.perf_counter() - t0, 2), float(np.abs(r.rao).max()))
 """
 
 
-# the CPU seconds of each row's process (user + system, all its threads), for its line
-CPU: list = []
-
-
 def _cpu_seconds() -> float:
     usage = resource.getrusage(resource.RUSAGE_CHILDREN)
     return usage.ru_utime + usage.ru_stime
 
 
 def _run(argv, env, cwd):
+    """(wall seconds, the finished process, its CPU seconds: user + system, all its threads)."""
     t0, c0 = time.perf_counter(), _cpu_seconds()
     r = subprocess.run(argv, cwd=cwd, env=env, capture_output=True, text=True)
     wall = time.perf_counter() - t0
-    CPU.append(_cpu_seconds() - c0)
+    cpu = _cpu_seconds() - c0
     if r.returncode:
         sys.exit(f"{argv} failed:\n{r.stderr[-3000:]}")
-    return wall, r
+    return wall, r, cpu
 
 
 def _cores() -> int:
@@ -94,11 +91,11 @@ def _cores() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-def _work() -> str:
-    """The last row's CPU seconds and what they bound: its wall time on the cores the row's
-    process could use cannot be less than CPU / cores, however its work is scheduled."""
+def _work(cpu: float) -> str:
+    """A row's CPU seconds and what they bound: its wall time on the cores the row's process
+    could use cannot be less than CPU / cores, however its work is scheduled."""
     cores = _cores()
-    return f"[CPU {CPU[-1]:.1f} s: ≥ {CPU[-1] / cores:.1f} s of wall on {cores} cores]"
+    return f"[CPU {cpu:.1f} s: ≥ {cpu / cores:.1f} s of wall on {cores} cores]"
 
 
 def _phases(stderr: str) -> list[str]:
@@ -149,42 +146,43 @@ def main(argv=None):
             line = next(ln for ln in (ROOT / "README.md").read_text().splitlines()
                         if "mfm simulate configs/rm3.toml" in ln)
             cmd = line.split("&&")[-1].strip().split()
-            wall, _ = _run([sys.executable, str(ROOT / "mfm_cli.py"), *cmd[1:]], env("rm3"), tmp)
+            wall, _, cpu = _run([sys.executable, str(ROOT / "mfm_cli.py"), *cmd[1:]], env("rm3"),
+                                tmp)
             print(f"RM3, the README's first command, empty caches: {wall:.1f} s (goal ≤ 3 s) "
-                  f"{_work()}")
+                  f"{_work(cpu)}")
             if "rm3_cached" in a.only:
-                wall, _ = _run([sys.executable, str(ROOT / "mfm_cli.py"), *cmd[1:]], env("rm3"),
-                               tmp)
+                wall, _, cpu = _run([sys.executable, str(ROOT / "mfm_cli.py"), *cmd[1:]],
+                                    env("rm3"), tmp)
                 print(f"RM3, the same in a process after one that filled the caches: {wall:.1f} s "
-                      f"{_work()}")
+                      f"{_work(cpu)}")
         if "m4" in a.only or "m4_cached" in a.only:
             (tmp / "m4.py").write_text(M4)
-            wall, _ = _run([sys.executable, "m4.py"], env("m4"), tmp)
+            wall, _, cpu = _run([sys.executable, "m4.py"], env("m4"), tmp)
             print(f"M4 134 simulate with defaults (120 s at dt 0.006 s), empty caches: {wall:.1f} s "
-                  f"(goal ≤ 8 s) {_work()}")
+                  f"(goal ≤ 8 s) {_work(cpu)}")
             if "m4_cached" in a.only:
-                wall, _ = _run([sys.executable, "m4.py"], env("m4"), tmp)
+                wall, _, cpu = _run([sys.executable, "m4.py"], env("m4"), tmp)
                 print(f"M4 134, the same in a process after one that filled the caches: "
-                      f"{wall:.1f} s (goal ≤ 1.5 s) {_work()}")
+                      f"{wall:.1f} s (goal ≤ 1.5 s) {_work(cpu)}")
         if "wu_yuan_fd" in a.only or "wu_yuan_fd_cached" in a.only:
             (tmp / "fd.py").write_text(FD)
-            wall, _ = _run([sys.executable, "fd.py"], env("fd"), tmp)
+            wall, _, cpu = _run([sys.executable, "fd.py"], env("fd"), tmp)
             print(f"Wu & Yuan m1 frequency_response at two periods, empty caches: {wall:.1f} s "
-                  f"{_work()}")
+                  f"{_work(cpu)}")
             if "wu_yuan_fd_cached" in a.only:
-                wall, _ = _run([sys.executable, "fd.py"], env("fd"), tmp)
+                wall, _, cpu = _run([sys.executable, "fd.py"], env("fd"), tmp)
                 print(f"Wu & Yuan m1 frequency_response, the same in a process after one that "
-                      f"filled the caches: {wall:.1f} s {_work()}")
+                      f"filled the caches: {wall:.1f} s {_work(cpu)}")
         if "wu_yuan" in a.only:
             out = tmp / "wy.nc"
-            wall, r = _run([sys.executable, str(ROOT / "mfm_cli.py"), "simulate",
+            wall, r, cpu = _run([sys.executable, str(ROOT / "mfm_cli.py"), "simulate",
                             "configs/wu_yuan_m1_td.toml", "--wave", "regular", "--height", "2",
                             "--period", "8", "--duration", "600", "--dt", "0.05", "--progress",
                             "on", "--no-plot", "--out", str(out)],
                            env("wy"), tmp)
             phases = _phases(r.stderr)
             print(f"Wu & Yuan m1 time domain, 600 s, empty caches: {wall:.1f} s (goal ≤ 20 s, every "
-                  f"phase shown) {_work()}; phases shown: {phases or 'none'}")
+                  f"phase shown) {_work(cpu)}; phases shown: {phases or 'none'}")
     print(f"load average {os.getloadavg()[0]:.1f} at the end")
 
 

@@ -362,14 +362,15 @@ def merge_complex(ds: xr.Dataset) -> xr.Dataset:
 #   every later reader the complete new one.
 
 
-def read_netcdf(path) -> xr.Dataset:
-    """The NetCDF file at `path` as an in-memory ``xarray.Dataset`` (no file left open): its bytes
-    read with Python and decoded from memory, so the HDF5 library never opens the path (see the
-    note above: a second HDF5 handle on a file the process holds open can crash it)."""
+def read_netcdf(path, group: str | None = None) -> xr.Dataset:
+    """The NetCDF file at `path` (or its ``group``, a path such as ``"mfm_fits/k…"``) as an
+    in-memory ``xarray.Dataset`` (no file left open): its bytes read with Python and decoded from
+    memory, so the HDF5 library never opens the path (see the note above: a second HDF5 handle on
+    a file the process holds open can crash it)."""
     path = Path(path)
     data = path.read_bytes()
     try:
-        with xr.open_dataset(data, engine="netcdf4") as ds:
+        with xr.open_dataset(data, engine="netcdf4", group=group) as ds:
             return ds.load()
     except (OSError, ValueError) as e:
         raise ValueError(f"{str(path)!r} is not a readable NetCDF file ({e})") from None

@@ -105,11 +105,9 @@ def stored(path) -> dict:
 
 
 def _group(path, key):
-    import xarray as xr
+    from .database import read_netcdf
 
-    data = Path(path).read_bytes()
-    with xr.open_dataset(data, engine="netcdf4", group=f"{GROUP}/k{key}") as ds:
-        return ds.load()
+    return read_netcdf(path, group=f"{GROUP}/k{key}")
 
 
 def read(path, key: str, kind: str):
