@@ -515,6 +515,10 @@ def test_a_pipelined_run_steps_before_its_outputs_program_is_ready(monkeypatch, 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ds = mfm.simulate(model, sea, **kw)
-    assert order == ["outputs compiling", "stepped", "outputs compiled"], order
+    # the outputs' compilation ends after the first step, whichever thread got to its part first
+    # (on a loaded machine the steps may run before the outputs' thread has even traced them);
+    # a run that waited for that compilation would step last
+    assert sorted(order) == ["outputs compiled", "outputs compiling", "stepped"], order
+    assert order[-1] == "outputs compiled", order
     for name in ("q", "qd", "joint_force", "hydro_force"):
         np.testing.assert_array_equal(ds[name].values, plain[name].values, err_msg=name)
