@@ -64,6 +64,16 @@ WATERPLANE_TERMS = (
 # ------------------------------------------------------------------------------------------------
 # Inputs
 
+# The lowest k h at which capytaine 3.0's finite-depth Green function can be evaluated. Its
+# Delhommeau.find_best_exponential_decomposition (capytaine/green_functions/delhommeau.py, the
+# default method "python") raises NotImplementedError "cannot evaluate finite depth Green function
+# for kh<0.1" when kh <= 0.1, and above that fits a sum of exponentials to the finite-depth kernel
+# (capytaine/tools/prony_decomposition.py, 4..30 terms, mean square error < 1e-4) and raises
+# GreenFunctionEvaluationError "cannot evaluate finite depth Green function for kh=…" when no fit
+# is found. Measured (100 tries each, the fit's sample points are jittered at random): every fit
+# fails for kh <= 0.1375, every one succeeds for 0.138 <= kh <= 3e5. 0.14 keeps a margin.
+KH_MIN = 0.14
+
 
 def _check_positive(name, v, allow_inf=False):
     try:
@@ -83,6 +93,46 @@ def _check_omega(omega):
                          f"infinite frequency is added by infinite_frequency=True; for the "
                          f"zero-frequency limit use a small positive omega).")
     return np.unique(w)
+
+
+def check_finite_depth(omegas, water_depth, g, *, deep_from=math.inf, green_function=None):
+    """Refuse, before any solve, the frequencies at which capytaine cannot evaluate the
+    finite-depth Green function: asks the solver's own Green function (its Prony decomposition at
+    each k h, k from ω² = g k tanh(k h); ≈ 1 ms each, cached by capytaine for the solve that
+    follows) rather than trusting a constant, so a later capytaine that does better or worse is
+    judged by what it does. Without this check capytaine logs and skips each failing problem
+    and the run ends, after all the other frequencies (~45 minutes for a fine mesh), with NaN.
+
+    omegas: the finite frequencies (rad/s); those ≥ ``deep_from`` are solved in deep water and
+    not checked. green_function: the solver's (``BEMSolver().engine.green_function``); default a
+    new ``Delhommeau()``. Raises ValueError naming the frequencies, their k h, the limit (KH_MIN,
+    measured) and the lowest ω that works at this depth.
+    """
+    if not math.isfinite(water_depth):
+        return
+    w = np.asarray([x for x in np.atleast_1d(omegas) if math.isfinite(x) and x < deep_from], float)
+    if w.size == 0:
+        return
+    if green_function is None:
+        from capytaine.green_functions.delhommeau import Delhommeau
+
+        green_function = Delhommeau()
+    kh = wavenumber(w, water_depth, g) * water_depth
+    bad = []
+    for om, x in zip(w, kh):
+        try:
+            green_function.find_best_exponential_decomposition(float(x))
+        except Exception as e:  # noqa: BLE001 - NotImplementedError or GreenFunctionEvaluationError
+            bad.append((float(om), float(x), f"{type(e).__name__}: {e}"))
+    if bad:
+        w_ok = math.sqrt(g * KH_MIN / water_depth * math.tanh(KH_MIN))
+        shown = ", ".join(f"{om:.4g} rad/s (kh = {x:.4g})" for om, x, _ in bad[:5])
+        raise ValueError(
+            f"omega: at water_depth = {water_depth:g} m capytaine cannot evaluate the finite-depth "
+            f"Green function at {len(bad)} frequenc{'y' if len(bad) == 1 else 'ies'}: {shown}"
+            f"{' ...' if len(bad) > 5 else ''} ({bad[0][2]}). capytaine's finite-depth kernel "
+            f"needs kh ≥ {KH_MIN} (measured for capytaine 3.0: it fails for kh ≤ 0.1375); give "
+            f"omega ≥ {w_ok:.4g} rad/s at this depth. Nothing was solved.")
 
 
 def _check_directions(wave_directions):
@@ -153,14 +203,28 @@ def _rigid_dofs(name, reference_point):
 
 def layout_symmetry(specs):
     """The symmetry a layout allows: "rotation" (one body of revolution on the z axis), "xOz"
-    (every body of revolution either on y = 0 or paired with its mirror image about y = 0), or
-    "none"."""
+    (every body either its own mirror image about y = 0 — a body of revolution on y = 0, or a
+    mesh whose hull as placed is symmetric, ``hydro.geometry.mesh_symmetric`` — or a body of
+    revolution paired with its mirror image), or "none".
+
+    A mesh body never gives "rotation": capytaine's RotationSymmetricMesh needs the hull as n
+    copies of one wedge, which a mesh file is not (its panels would have to be re-made by
+    revolving a meridian: give the body as shape "revolution" for that). Two mirrored mesh files
+    are not paired either (each must be symmetric itself): pairing them would need the second
+    file's panels to be the first's mirrored, which files made apart seldom are."""
     if all(s["shape"] in geo.REVOLVED for s in specs):
         if len(specs) == 1 and specs[0]["origin"][:2] == [0.0, 0.0]:
             return "rotation"
-        if _mirror_pairs(specs) is not None:
-            return "xOz"
+    if _mirror_pairs(specs) is not None:
+        return "xOz"
     return "none"
+
+
+def _on_xoz(spec):
+    """Whether a body is its own mirror image about y = 0 (solved as its half y ≥ 0)."""
+    if spec["shape"] == "mesh":
+        return geo.mesh_symmetric(spec)
+    return spec["origin"][1] == 0.0
 
 
 def _mirror_pairs(specs):
@@ -169,8 +233,10 @@ def _mirror_pairs(specs):
     pairs, used = {}, set()
     for i, s in enumerate(specs):
         y = s["origin"][1]
-        if y == 0.0:
+        if _on_xoz(s):
             continue
+        if s["shape"] == "mesh":
+            return None
         if y > 0:
             for j, t in enumerate(specs):
                 if j not in used and j != i and geo.mirror_partner(s, t):
@@ -179,7 +245,7 @@ def _mirror_pairs(specs):
                     break
             else:
                 return None
-    if len(used) != sum(1 for s in specs if s["origin"][1] < 0):
+    if len(used) != sum(1 for s in specs if s["shape"] != "mesh" and s["origin"][1] < 0):
         return None
     return pairs
 
@@ -228,7 +294,7 @@ def build_body(specs, dx, *, lid=True, symmetry="auto"):
         for i, s in enumerate(specs):
             if i in lower:
                 continue
-            if s["origin"][1] == 0.0:
+            if _on_xoz(s):
                 h, lm, _ = geo.body_meshes(s, dx, "half", lid=lid)
                 kinds.append((i, "half"))
             else:
@@ -422,6 +488,7 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
         settings["deep_water_kh"] = deep_water_kh
         kh = wavenumber(omegas, water_depth, g) * water_depth
         deep_from = float(min((w for w, k in zip(omegas, kh) if k >= deep_water_kh), default=math.inf))
+    check_finite_depth(omegas, water_depth, g, deep_from=deep_from)
     digest = settings_hash(specs, settings)
     path = None
     if cache:
@@ -497,7 +564,7 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
 
 def _check_finite(ds):
     """Refuse (and never cache) results capytaine left as NaN: it skips problems it cannot solve
-    (finite depth with kh < 0.1; `n_threads` without threadpoolctl) with a log line only."""
+    (finite depth with kh < KH_MIN; `n_threads` without threadpoolctl) with a log line only."""
     finite_w = np.isfinite(ds["omega"].values)
     bad = []
     for v in ("added_mass", "radiation_damping", "excitation_force"):
@@ -509,7 +576,7 @@ def _check_finite(ds):
             bad.append(f"{v} at omega = {np.array2string(w[:5], precision=4)}")
     if bad:
         raise RuntimeError("capytaine returned NaN for " + "; ".join(bad) + ": it skipped those "
-                           "problems (finite depth needs k h ≥ 0.1, i.e. a higher omega_min; "
+                           f"problems (finite depth needs k h ≥ {KH_MIN}, i.e. a higher omega_min; "
                            "n_threads needs threadpoolctl installed). Nothing was cached.")
 
 

@@ -309,14 +309,23 @@ def body_meshes(spec, dx, part="full", *, lid=True):
     dx = spec.get("dx", dx)
     x0, y0, z0 = spec["origin"]
     if spec["shape"] == "mesh":
-        if part != "full":
-            raise ValueError(f"body {spec['name']!r}: a 'mesh' body only gives part='full', got "
-                             f"part={part!r}.")
-        hull = cpt.load_mesh(spec["file"]).translated((x0, y0, z0)).immersed_part()
-        hull = hull.merged() if hasattr(hull, "merged") else hull
-        lid_mesh = hull.generate_lid(z=0.0, faces_max_radius=dx / 2) if lid else None
-        if lid_mesh is not None and lid_mesh.nb_faces == 0:
-            lid_mesh = None
+        if part not in ("full", "half"):
+            raise ValueError(f"body {spec['name']!r}: a 'mesh' body gives part='full' or 'half' "
+                             f"(when its hull is symmetric about y = 0), got part={part!r}.")
+        hull = mesh_hull(spec)
+        lid_mesh = mesh_lid(spec, hull, dx) if lid else None
+        if part == "half":
+            if not mesh_symmetric(spec):
+                raise ValueError(f"body {spec['name']!r}: part='half' needs a hull symmetric about "
+                                 f"y = 0; the mesh {spec['file']!r} at origin {spec['origin']} "
+                                 f"is not.")
+            # clipped() keeps the side opposite the normal: y >= 0
+            hull = hull.clipped(origin=(0.0, 0.0, 0.0), normal=(0.0, -1.0, 0.0),
+                                name=spec["name"])
+            if lid_mesh is not None:
+                lid_mesh = lid_mesh.clipped(origin=(0.0, 0.0, 0.0), normal=(0.0, -1.0, 0.0),
+                                            name=f"{spec['name']}_lid")
+                lid_mesh = lid_mesh if lid_mesh.nb_faces else None
         return hull, lid_mesh, None
     if part not in _PART_SECTORS:
         raise ValueError(f"part = {part!r} is not one of {list(_PART_SECTORS)}.")
@@ -421,3 +430,320 @@ def hull_hydrostatics(hull, reference_point, *, rho=1000.0, g=9.81):
     return {"volume": V, "center_of_buoyancy": xB, "waterplane_area": A,
             "waterplane_stiffness": W, "hydrostatic_stiffness": H}
 
+
+
+# ------------------------------------------------------------------------------------------------
+# Mesh files: placing, checking, lids and symmetry (issue 51)
+
+MESH_TOL = 1e-6          # relative to a length of the mesh: coincident points, the water plane
+_MESH_CACHE: dict = {}   # (file, size, mtime, origin) -> the checked hull (meshes are immutable)
+
+
+def _length_scale(mesh):
+    v = np.asarray(mesh.vertices, float)
+    return float(np.linalg.norm(v.max(axis=0) - v.min(axis=0))) if len(v) else 1.0
+
+
+def _face_array(mesh):
+    """Faces as an (n, 4) int array; a triangle repeats its last vertex (capytaine's layout)."""
+    return np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 4)
+
+
+def mesh_edges(mesh):
+    """The edges of a panel mesh: ``(edges, count, same_direction)``.
+
+    ``edges`` (n_e, 2) vertex indices (sorted pair), ``count`` the number of panels that use each
+    edge and ``same_direction`` whether two panels run along it the same way. A closed surface
+    with consistently ordered panels has count 2 and opposite directions on every edge (each
+    panel's boundary, ordered for its outward normal, runs along a shared edge the other way than
+    its neighbour's); count 1 is a hole's rim, count > 2 a non-manifold edge.
+    """
+    F = _face_array(mesh)
+    a = F.reshape(-1)
+    b = np.roll(F, -1, axis=1).reshape(-1)
+    keep = a != b                        # a triangle's repeated last vertex: no edge
+    a, b = a[keep], b[keep]
+    pairs = np.stack([np.minimum(a, b), np.maximum(a, b)], axis=1)
+    forward = a < b
+    edges, inv, count = np.unique(pairs, axis=0, return_inverse=True, return_counts=True)
+    inv = inv.reshape(-1)
+    n_fwd = np.bincount(inv, weights=forward, minlength=len(edges))
+    same = (count == 2) & (n_fwd != 1)
+    return edges, count, same
+
+
+def _fmt(p):
+    return "(" + ", ".join(f"{float(c):.4g}" for c in p) + ")"
+
+
+def _edges_text(V, edges, origin, k=4):
+    o = np.asarray(origin, float)
+    items = [f"{_fmt(V[i] - o)}–{_fmt(V[j] - o)}" for i, j in edges[:k]]
+    more = f" and {len(edges) - k} more" if len(edges) > k else ""
+    return "; ".join(items) + more
+
+
+def signed_volume(mesh):
+    """Σ_T a·(b×c)/6 over the panels split into triangles: the enclosed volume of a closed
+    surface, positive when the panels are ordered for outward normals, negative when inward."""
+    V = np.asarray(mesh.vertices, float)
+    F = _face_array(mesh)
+    T = np.concatenate([V[F[:, [0, 1, 2]]], V[F[:, [0, 2, 3]]]], axis=0)
+    return float(np.einsum("ij,ij->i", T[:, 0], np.cross(T[:, 1], T[:, 2])).sum() / 6.0)
+
+
+def check_closed(mesh, *, what, origin=(0.0, 0.0, 0.0), waterline=None):
+    """Refuse a panel mesh that is not a closed, consistently ordered, outward-facing surface.
+
+    A hull's hydrostatics (V, centre of buoyancy, hull_hydrostatics) are surface integrals that
+    equal the volume's only for a closed surface: an open end cap loses the volume of the cone it
+    subtends and moves the centre of buoyancy (issue 51: 369 → 347 m³, the centre 0.19 m off, a
+    4.4° heel at rest), with no error from capytaine. ``waterline`` (a z): a rim at that height is
+    allowed (the wetted hull is open at the still-water plane, which closes it), any other rim is
+    a hole. Non-manifold edges (3+ panels) and panels ordered against their neighbours are refused
+    too; a surface ordered inward (negative enclosed volume) is refused with the fix. ``what``
+    starts each message; edges are named by their end points less ``origin`` (the file's frame).
+    Raises ValueError; returns None.
+    """
+    V = np.asarray(mesh.vertices, float)
+    edges, count, same = mesh_edges(mesh)
+    tol = MESH_TOL * _length_scale(mesh)
+    rim = edges[count == 1]
+    if waterline is not None and len(rim):
+        at_wl = np.all(np.abs(V[rim][:, :, 2] - waterline) <= tol, axis=1)
+        rim = rim[~at_wl]
+    if len(rim):
+        raise ValueError(
+            f"{what} is open: {len(rim)} edge(s) belong to one panel only"
+            f"{' below the water line' if waterline is not None else ''} (file frame, m): "
+            f"{_edges_text(V, rim, origin)}. A hull must be a closed surface (end caps and bottom "
+            f"included) for its displaced volume, centre of buoyancy and stiffness to be right; "
+            f"close the holes (e.g. trimesh: m.fill_holes(), then check m.is_watertight) and "
+            f"give the file again.")
+    multi = edges[count > 2]
+    if len(multi):
+        raise ValueError(
+            f"{what} has {len(multi)} edge(s) shared by more than two panels (file frame, m): "
+            f"{_edges_text(V, multi, origin)}: duplicated or crossing panels; a hull is one closed "
+            f"surface. Remove the extra panels and give the file again.")
+    flipped = edges[same]
+    if len(flipped):
+        raise ValueError(
+            f"{what} has panels ordered against their neighbours along {len(flipped)} edge(s) "
+            f"(file frame, m): {_edges_text(V, flipped, origin)}: some normals point in, some "
+            f"out. Make the ordering consistent (e.g. trimesh: trimesh.repair.fix_normals(m)) "
+            f"and give the file again.")
+    vol = signed_volume(mesh)
+    if vol < 0:
+        raise ValueError(
+            f"{what} faces inward: its panels enclose {vol:.6g} m³ (negative: normals into the "
+            f"body; capytaine needs them out into the water). Reverse the vertex order of every "
+            f"panel (e.g. trimesh: m.invert()) and give the file again.")
+
+
+def check_collocation(meshes, *, what, origin=(0.0, 0.0, 0.0), tol=MESH_TOL, max_named=4):
+    """Refuse panels whose collocation point lies on another panel.
+
+    capytaine evaluates the potential at each panel's centre (its collocation point). When that
+    point lies on another panel's edge, the Rankine part of the influence of that panel (a
+    log-singular line integral along its edges) is NaN: capytaine then fails every frequency
+    ("Green function returned a NaN in the interaction matrix. It could be due to overlapping
+    panels") after the whole run's set-up, and ends with a hint about kh and threads. A centre
+    inside another panel (duplicated or crossing panels) is refused too: the two panels are the
+    same surface twice. Checked before any solve, over the hull and lid panels together (a lid
+    panel's centre on a hull panel is as bad); candidates from a k-d tree of the panel centres,
+    within each panel's circumscribed radius, so the cost is O(N log N).
+    Raises ValueError naming the panels (centres in the file's frame, less ``origin``).
+    """
+    from scipy.spatial import cKDTree
+
+    meshes = [m for m in meshes if m is not None and m.nb_faces]
+    if not meshes:
+        return
+    verts, faces, off = [], [], 0
+    for m in meshes:
+        verts.append(np.asarray(m.vertices, float))
+        faces.append(_face_array(m) + off)
+        off += len(verts[-1])
+    V = np.concatenate(verts)
+    F = np.concatenate(faces)
+    P = V[F]                                               # (n, 4, 3)
+    C = np.concatenate([np.asarray(m.faces_centers, float) for m in meshes])
+    R = np.linalg.norm(P - C[:, None, :], axis=2).max(axis=1)
+    eps = tol * max(float(R.max()), 1e-300)
+    tree = cKDTree(C)
+    near = tree.query_ball_point(C, R + eps)
+    jj = np.concatenate([np.full(len(lst), j) for j, lst in enumerate(near)]).astype(np.int64)
+    ii = np.concatenate([np.asarray(lst, dtype=np.int64) for lst in near])
+    keep = ii != jj
+    ii, jj = ii[keep], jj[keep]
+    if ii.size == 0:
+        return
+    c = C[ii]                                              # (m, 3) collocation points
+    A = P[jj]                                              # (m, 4, 3) the other panel
+    B = np.roll(A, -1, axis=1)
+    e = B - A
+    L2 = np.einsum("mkd,mkd->mk", e, e)
+    s = np.clip(np.einsum("mkd,mkd->mk", c[:, None] - A, e) / np.where(L2 > 0, L2, 1.0), 0, 1)
+    d_edge = np.linalg.norm(c[:, None] - (A + s[..., None] * e), axis=2)
+    d_edge = np.where(L2 > 0, d_edge, np.linalg.norm(c[:, None] - A, axis=2)).min(axis=1)
+    # inside: on the panel's plane and inside one of its two triangles (0, 1, 2), (0, 2, 3)
+    inside = np.zeros(len(ii), dtype=bool)
+    for t in ((0, 1, 2), (0, 2, 3)):
+        a, b, cc = A[:, t[0]], A[:, t[1]], A[:, t[2]]
+        n = np.cross(b - a, cc - a)
+        nn = np.linalg.norm(n, axis=1)
+        ok = nn > 0
+        h = np.abs(np.einsum("md,md->m", c - a, n)) / np.where(ok, nn, 1.0)
+        w0 = np.einsum("md,md->m", np.cross(b - a, c - a), n)
+        w1 = np.einsum("md,md->m", np.cross(cc - b, c - b), n)
+        w2 = np.einsum("md,md->m", np.cross(a - cc, c - cc), n)
+        inside |= ok & (h <= tol * R[jj]) & (w0 >= 0) & (w1 >= 0) & (w2 >= 0)
+    on_edge = d_edge <= tol * R[jj]
+    bad = np.flatnonzero(on_edge | inside)
+    if bad.size == 0:
+        return
+    o = np.asarray(origin, float)
+    items = []
+    for k in bad[:max_named]:
+        where = "on an edge of" if on_edge[k] else "inside"
+        items.append(f"panel {int(ii[k])} (centre {_fmt(C[ii[k]] - o)}) lies {where} panel "
+                     f"{int(jj[k])} (corners {', '.join(_fmt(p - o) for p in P[jj[k]][:3 if F[jj[k], 2] == F[jj[k], 3] else 4])})")
+    more = f"; and {bad.size - max_named} more" if bad.size > max_named else ""
+    raise ValueError(
+        f"{what}: {bad.size} panel collocation point(s) lie on another panel, which capytaine "
+        f"cannot solve (NaN influence, every frequency fails after the set-up): "
+        + "; ".join(items) + more + " (file frame, m; panels numbered in the hull as placed and "
+        "cut at z = 0, then the lid). Remove duplicated or crossing panels (a fin or plate "
+        "touching the hull through a panel's centre, a T-junction) and give the file again.")
+
+
+def _remove_waterline_deck(hull, tol):
+    """Drop the panels lying in the still-water plane z = 0 (a hull file closed by a deck at its
+    water line): capytaine would solve them as body surface on the free surface, their projected
+    area cancels the bottom's in the water-plane integrals (C33 = 0) and they hide the interior
+    from generate_lid (0 lid panels). The wetted hull is open at z = 0 by convention."""
+    F = _face_array(hull)
+    z = np.asarray(hull.vertices, float)[F][:, :, 2]
+    deck = np.all(np.abs(z) <= tol, axis=1)
+    if not deck.any():
+        return hull
+    return hull.extract_faces(np.flatnonzero(~deck).tolist())
+
+
+def mesh_hull(spec):
+    """The wetted hull of a ``shape: "mesh"`` body: the file's mesh translated by ``origin``, cut
+    at z = 0, any deck panels in the plane z = 0 removed, and checked: closed below the water line
+    with consistent outward normals (:func:`check_closed`, on the file's mesh as given and on the
+    cut hull) and no collocation point on another panel (:func:`check_collocation`). Raises
+    ValueError naming the body, the file and the edges or panels. Cached per file content stamp
+    and origin (capytaine meshes are immutable)."""
+    import capytaine as cpt
+
+    f = spec["file"]
+    key = _mesh_key(spec)
+    if key in _MESH_CACHE:
+        return _MESH_CACHE[key]
+    what = f"body {spec['name']!r}: 'file' = {f!r}"
+    raw = cpt.load_mesh(f)
+    raw = raw.merged() if hasattr(raw, "merged") else raw
+    if raw.nb_faces == 0:
+        raise ValueError(f"{what}: the file holds no panels; give a mesh of the hull.")
+    # a closed file (the whole body) is checked as a whole; a file of the wetted surface only
+    # (open at its own water line, as WAMIT .gdf files are) is checked once placed and cut
+    edges, count, _ = mesh_edges(raw)
+    whole = not np.any(count == 1)
+    if whole:
+        check_closed(raw, what=f"{what}: the mesh")
+    placed = raw.translated(tuple(spec["origin"]))
+    hull = placed.immersed_part()
+    hull = hull.merged() if hasattr(hull, "merged") else hull
+    if hull.nb_faces == 0:
+        raise ValueError(f"{what}: no panel lies below z = 0 with 'origin' = {spec['origin']} "
+                         f"(the mesh spans z = {placed.vertices[:, 2].min():.4g} to "
+                         f"{placed.vertices[:, 2].max():.4g} m once placed); set origin's z so "
+                         f"that the hull is immersed to its draft.")
+    tol = MESH_TOL * _length_scale(placed)
+    hull = _remove_waterline_deck(hull, tol)
+    check_closed(hull, what=f"{what}: the hull as placed (origin {spec['origin']}) and cut at "
+                 f"z = 0", origin=spec["origin"], waterline=0.0)
+    check_collocation([hull], what=f"{what}: the hull as placed", origin=spec["origin"])
+    _MESH_CACHE[key] = hull
+    return hull
+
+
+def mesh_lid(spec, hull, dx):
+    """The water-plane lid of a mesh hull (capytaine's ``generate_lid`` at z = 0, panels of
+    radius ≤ dx/2), or None for a hull that does not pierce the surface. A piercing hull for
+    which no lid panel is found is an error naming ``lid`` (a lid is asked for, none is given:
+    the irregular frequencies it removes stay in the results), not a silent 0 lid panels."""
+    dx = spec.get("dx", dx)
+    edges, count, _ = mesh_edges(hull)
+    if not np.any(count == 1):
+        return None                                   # fully submerged: no water plane
+    lid = hull.generate_lid(z=0.0, faces_max_radius=dx / 2, name=f"{spec['name']}_lid")
+    if lid.nb_faces == 0:
+        raise ValueError(f"body {spec['name']!r}: 'lid': the hull of {spec['file']!r} pierces "
+                         f"the water plane but capytaine's generate_lid found no lid panel inside "
+                         f"its water line (dx {dx:g} m): give a smaller dx for this body, or set "
+                         f"lid = false (irregular frequencies then stay in the results).")
+    check_collocation([hull, lid], what=f"body {spec['name']!r}: 'file' = {spec['file']!r}: "
+                      f"the hull and its lid", origin=spec["origin"])
+    return lid
+
+
+def mesh_is_xoz_symmetric(hull, placed=None, tol=MESH_TOL, rtol=1e-6):
+    """Whether a hull (as placed and cut at z = 0) is its own mirror image about y = 0, so that
+    the BEM needs only the half y ≥ 0 (capytaine's ReflectionSymmetricMesh: about half the cost
+    per frequency, CAPYTAINE.md).
+
+    Two tests. (1) The corners: every vertex of ``placed`` (the whole mesh as placed, before the
+    cut; the cut's own vertices fall on whichever diagonal a panel has, so they are not mirrored
+    in most STL files) has a partner (x, −y, z) within ``tol`` of the mesh's size. (2) The
+    surface between them: the half y ≥ 0 and its mirror image give the hull's own volume, centre
+    of buoyancy and water-plane stiffness (hull_hydrostatics, exact for the panels) within
+    ``rtol`` (relative to V, the size, and the largest stiffness term). A triangulation whose
+    diagonals are not mirrored passes for flat panels (the same surface); on curved ones it
+    differs by the panels' chordal error, which (2) measures.
+    """
+    from scipy.spatial import cKDTree
+    import capytaine as cpt
+
+    L = _length_scale(hull)
+    if placed is not None:
+        v = np.asarray(placed.vertices, float)
+        d, _ = cKDTree(v).query(v * np.array([1.0, -1.0, 1.0]))
+        if not np.all(d <= tol * L):
+            return False
+    half = hull.clipped(origin=(0.0, 0.0, 0.0), normal=(0.0, -1.0, 0.0))
+    if half.nb_faces == 0:
+        return False
+    whole = cpt.Mesh.join_meshes(half, half.mirrored("xOz"))
+    try:
+        a = hull_hydrostatics(hull, (0.0, 0.0, 0.0))
+        b = hull_hydrostatics(whole, (0.0, 0.0, 0.0))
+    except ValueError:
+        return False
+    W = np.abs(a["waterplane_stiffness"]).max()
+    return bool(abs(a["volume"] - b["volume"]) <= rtol * abs(a["volume"])
+                and np.all(np.abs(a["center_of_buoyancy"] - b["center_of_buoyancy"]) <= rtol * L)
+                and np.all(np.abs(a["waterplane_stiffness"] - b["waterplane_stiffness"])
+                           <= rtol * W))
+
+
+def mesh_symmetric(spec):
+    """:func:`mesh_is_xoz_symmetric` of a mesh body as placed (cached with its hull)."""
+    hull = mesh_hull(spec)
+    key = ("sym",) + _mesh_key(spec)
+    if key not in _MESH_CACHE:
+        import capytaine as cpt
+
+        raw = cpt.load_mesh(spec["file"])
+        raw = raw.merged() if hasattr(raw, "merged") else raw
+        _MESH_CACHE[key] = mesh_is_xoz_symmetric(hull, raw.translated(tuple(spec["origin"])))
+    return _MESH_CACHE[key]
+
+
+def _mesh_key(spec):
+    st = os.stat(spec["file"])
+    return (spec["file"], st.st_size, st.st_mtime_ns, tuple(spec["origin"]))

@@ -40,7 +40,15 @@ and the BEM settings in ``[hydro.bem]`` (every key checked, unknown keys are err
                                 #   ≈ 3× faster; default: the finite depth everywhere
     rho = 1000.0                # kg/m³; default [hydro] rho, else 1000
     g = 9.81                    # m/s²; default [hydro] g, else [model] gravity
+    equilibrium_check = true    # refuse a hull that cannot float its body (below); default true
     notes = "..."               # free text
+
+Before any solve, ``mfm hydro`` checks each mesh hull (:func:`check_hulls`): closed below the water
+line with outward normals, no panel centre on another panel, a lid when ``lid = true`` (every
+refusal names the edges or panels), the lowest frequency against what capytaine's finite-depth
+Green function accepts (``hydro.bem.check_finite_depth``), and that a mesh body free in heave
+floats at the draft its ``origin`` gives (ρV against its mass, the centre of buoyancy against
+its centre of mass).
 
 Bodies without a ``geometry`` table are dry (not in the database). The reference point of each
 body's 6 modes defaults to its CoM at q = 0: the MFM applies loads about the CoM, and
@@ -67,13 +75,23 @@ from .config import load_config, read_config
 from ..errors import ConfigError
 
 BEM_KEYS = {"omega_min", "omega_max", "n_omega", "omega", "headings_deg", "water_depth", "dx",
-            "lid", "symmetry", "infinite_frequency", "rho", "g", "deep_water_kh", "notes"}
+            "lid", "symmetry", "infinite_frequency", "rho", "g", "deep_water_kh", "notes",
+            "equilibrium_check"}
 GEOMETRY_KEYS = {"shape", "radius", "draft", "base", "knuckle_radius", "profile", "origin",
                  "reference_point", "file", "dx"}
 SYMMETRIES = ("auto", "xOz", "rotation", "none")
 
 
-KH_MIN = 0.1  # capytaine 3.0 (Delhommeau): no finite-depth Green function below kh = 0.1
+# capytaine 3.0's finite-depth Green function fails for kh <= 0.1375 (measured; the source and
+# the measurement are quoted at hydro.bem.KH_MIN); its own message says "kh<0.1", which let a run
+# with kh 0.113 start and fail after 45 minutes
+KH_MIN = 0.14
+EQUILIBRIUM_VOLUME_TOL = 0.05   # |ρV − m| / m of a body free in heave
+EQUILIBRIUM_HEEL_TOL_DEG = 1.0  # the heel (or trim) at rest of a free floater, degrees
+
+
+class HullWarning(UserWarning):
+    """A mesh hull that may be placed wrongly (not refused: the body need not float alone)."""
 
 # ------------------------------------------------------------------------------------------------
 # Settings
@@ -198,7 +216,8 @@ def bem_settings(raw: dict | None, *, hydro: dict | None = None, gravity: float 
             key = "omega" if "omega" in raw else "omega_min"
             raise ConfigError(f"{w}.{key}: ω = {w0:g} rad/s gives kh = {kh:.3g} at water_depth "
                               f"{depth:g} m; capytaine's finite-depth Green function needs "
-                              f"kh >= {KH_MIN} (ω >= {w_min:.4g} rad/s here): raise the lowest "
+                              f"kh >= {KH_MIN} (ω >= {w_min:.4g} rad/s here; capytaine 3.0 fails "
+                              f"for kh <= 0.1375, measured: hydro.bem.KH_MIN): raise the lowest "
                               f"frequency")
     deep_kh = raw.get("deep_water_kh")
     if deep_kh is not None:
@@ -207,11 +226,13 @@ def bem_settings(raw: dict | None, *, hydro: dict | None = None, gravity: float 
             raise ConfigError(f"{w}.deep_water_kh: {deep_kh:g} with water_depth \"inf\": every "
                               "frequency is already solved in deep water; remove the key or give "
                               "a finite water_depth")
+    _bool(raw.get("equilibrium_check", True), f"{w}.equilibrium_check")
     record = {k: raw[k] for k in sorted(raw)}
     kwargs = {"omega": omega, "dx": dx, "wave_directions": [math.radians(b) for b in headings],
               "water_depth": depth, "rho": rho, "g": g, "lid": lid, "symmetry": sym,
               "infinite_frequency": inf, "deep_water_kh": deep_kh}
-    return {"kwargs": kwargs, "record": record, "headings_deg": headings}
+    return {"kwargs": kwargs, "record": record, "headings_deg": headings,
+            "equilibrium_check": raw.get("equilibrium_check", True)}
 
 
 # ------------------------------------------------------------------------------------------------
@@ -271,6 +292,185 @@ def body_specs(config_path, raw: dict | None = None, bodies=None) -> list[dict]:
     except ValueError as e:
         raise ConfigError(f"bodies: {e}") from None
     return specs
+
+
+# ------------------------------------------------------------------------------------------------
+# Hull checks (before any solve)
+
+
+def _heave_free(b) -> str | None:
+    """Why body ``b`` carries its own weight in heave (its heave coordinate free, no spring), or
+    None: a free or planar root moving in heave without heave stiffness, or a vertical prismatic
+    joint without stiffness (RM3's float on its spar). A fixed, revolute or sprung body hangs
+    partly on its parent and need not float on its own."""
+    j = b.joint
+    stiff = np.asarray(j.stiffness, float)
+    if b.parent is None and j.kind in ("free", "planar") and "heave" in j.dofs:
+        k = stiff[j.dofs.index("heave")] if stiff.size == len(j.dofs) else 0.0
+        return None if k != 0.0 or j.locked else f"a {j.kind} root moving in heave"
+    if j.kind == "prismatic" and j.axis is not None and not j.locked:
+        axis = np.asarray(j.axis, float)
+        if abs(abs(axis[2]) - np.linalg.norm(axis)) <= 1e-9 and not np.any(stiff != 0.0):
+            return "a vertical prismatic joint without stiffness"
+    return None
+
+
+def _group(b, bodies) -> list:
+    """``b`` and the bodies whose weight it carries: its descendants, except those free in heave
+    themselves (and theirs), which float on their own."""
+    out, todo = [b], [b]
+    while todo:
+        p = todo.pop()
+        for c in bodies:
+            if c.parent == p.name and _heave_free(c) is None:
+                out.append(c)
+                todo.append(c)
+    return out
+
+
+def check_hulls(specs, bodies, raw, settings) -> None:
+    """Check the hulls of a config before any solve (cheap: meshes and hydrostatics, no BEM).
+
+    1. Each mesh body (``hydro.geometry.mesh_hull``): the file's mesh closed (below the water line
+       once placed) with outward normals, no panel collocation point on another panel; and with
+       ``lid = true`` a lid found (``mesh_lid``). Errors name ``bodies[i] ('name').geometry.file``
+       (or ``.dx`` / ``hydro.bem.lid``) and the edges or panels.
+    2. Equilibrium, for the groups that hold a mesh body and float on their own: a body free in
+       heave (:func:`_heave_free`: a free/planar root moving in heave, or a vertical prismatic
+       joint, without stiffness) with the bodies whose weight it carries (:func:`_group`: its
+       descendants except those free in heave themselves). Its buoyancy must carry its weight,
+       |ρ ΣV − Σm| ≤ 5 % of Σm (V from each hull as placed, cut at z = 0), else the body sinks
+       or rises from the draft the BEM is solved at. And when the group is rigid (fixed joints
+       only) and its root turns in roll or pitch, the heel at rest θ = ρgV d / K (d the
+       horizontal distance of the centre of buoyancy from the vertical through the centre of
+       mass, K the buoyancy and water-plane stiffness about the centre of mass, roll and pitch
+       apart) must stay ≤ 1°. Bodies on a hinge (revolute), fixed to a parent that is held, or
+       sprung are not checked alone: they hang partly on their parent. Groups of bodies of
+       revolution only are not checked here (their draft is stated, not derived from a file).
+       A config with load tables (moorings, PTOs, joint loads, body matrices, ...) gets warnings
+       (``HullWarning``) instead of errors: those loads may carry the difference.
+       ``[hydro.bem] equilibrium_check = false`` turns errors into warnings too.
+    3. A mesh whose file looks centred on the body's centre of mass (the public RM3 files are)
+       placed with the default origin (z = 0) is named with the fix ``origin = [x, y, z_com]``
+       (issue 51: a 712 m³ base became 275 m³ cut at the water line, silently).
+    """
+    from hydro import geometry as geo
+
+    import warnings
+
+    kw = settings["kwargs"]
+    rho, dx = kw["rho"], kw["dx"]
+    index = {rb.get("name"): i for i, rb in enumerate(raw.get("bodies", []))}
+    by_name = {b.name: b for b in bodies}
+    spec_of = {s["name"]: s for s in specs}
+
+    def where(name):
+        return f"bodies[{index.get(name, '?')}] ({name!r}).geometry"
+
+    hulls = {}
+    for s in specs:
+        if s["shape"] != "mesh":
+            continue
+        try:
+            hulls[s["name"]] = geo.mesh_hull(s)
+        except ValueError as e:
+            raise ConfigError(f"{where(s['name'])}.file: {e}") from None
+        if kw["lid"]:
+            try:
+                geo.mesh_lid(s, hulls[s["name"]], dx)
+            except ValueError as e:
+                raise ConfigError(f"hydro.bem.lid (or {where(s['name'])}.dx): {e}") from None
+
+    loads = sorted(k for k in raw if k not in ("model", "bodies", "hydro"))
+    strict = bool(settings.get("equilibrium_check", True)) and not loads
+    why_soft = (f" (a warning, not an error: the config's {loads} may carry the difference)"
+                if loads else " (a warning: [hydro.bem] equilibrium_check = false)")
+
+    def complain(msg):
+        if strict:
+            raise ConfigError(msg + " Nothing was solved. If the body is meant to float so (held "
+                              "by something this config does not hold), set [hydro.bem] "
+                              "equilibrium_check = false.")
+        warnings.warn(msg + why_soft, HullWarning, stacklevel=3)
+
+    def hydrostatics(name, origin=None):
+        sp = spec_of[name] if origin is None else dict(spec_of[name], origin=origin)
+        if sp["shape"] == "mesh":
+            h = hulls[name] if origin is None else geo.mesh_hull(sp)
+        else:
+            h = geo.body_meshes(sp, dx, "full", lid=False)[0]
+        return h
+
+    def centred_hint(name):
+        """The origin that puts the file's origin at the CoM, when it makes ρV ≈ m (or None)."""
+        b, sp = by_name[name], spec_of[name]
+        c = np.asarray(b.com, float)
+        if sp["origin"][2] == c[2]:
+            return None
+        alt = [sp["origin"][0], sp["origin"][1], float(c[2])]
+        try:
+            h = geo.hull_hydrostatics(hydrostatics(name, alt), c, rho=rho, g=kw["g"])
+        except ValueError:
+            return None
+        return alt, rho * h["volume"]
+
+    for b in bodies:
+        why = _heave_free(b)
+        if why is None:
+            continue
+        group = _group(b, bodies)
+        names = [m.name for m in group]
+        if not any(spec_of.get(n, {}).get("shape") == "mesh" for n in names):
+            continue
+        mass = sum(m.mass for m in group)
+        G = sum(m.mass * np.asarray(m.com, float) for m in group) / mass
+        wet = [n for n in names if n in spec_of]
+        hs = {n: geo.hull_hydrostatics(hydrostatics(n), G, rho=rho, g=kw["g"]) for n in wet}
+        V = sum(h["volume"] for h in hs.values())
+        err = (rho * V - mass) / mass
+        who = (f"{b.name!r}" if len(group) == 1 else
+               f"{b.name!r} with the bodies it carries {names[1:]}")
+        if abs(err) > EQUILIBRIUM_VOLUME_TOL:
+            mesh_names = [n for n in wet if spec_of[n]["shape"] == "mesh"]
+            n0 = mesh_names[0]
+            sp = spec_of[n0]
+            hint = (f"Set origin's z so that the mesh floats at its draft (origin is added to the "
+                    f"file's coordinates; z = 0 is the still-water line).")
+            alt = centred_hint(n0) if len(wet) == 1 else None
+            if alt is not None and abs(alt[1] - mass) <= EQUILIBRIUM_VOLUME_TOL * mass:
+                o = alt[0]
+                hint = (f"The file looks centred on the body's centre of mass: placed at origin = "
+                        f"[{o[0]:g}, {o[1]:g}, {o[2]:g}] (z of the com) it displaces ρV = "
+                        f"{alt[1]:.6g} kg ({(alt[1] - mass) / mass:+.1%}); give origin = "
+                        f"[{o[0]:g}, {o[1]:g}, {o[2]:g}] in its [bodies.geometry].")
+            complain(f"{where(n0)}.origin: {who} is free in heave ({why}) but its hull"
+                     f"{'s' if len(wet) > 1 else ''} as placed (file {os.path.basename(sp['file'])!r}"
+                     f" at origin {sp['origin']}, cut at z = 0) displace{'' if len(wet) > 1 else 's'}"
+                     f" V = {V:.6g} m³, ρV = {rho * V:.6g} kg, against its mass m = {mass:.6g} kg "
+                     f"({err:+.1%}; accepted: within ±{EQUILIBRIUM_VOLUME_TOL:.0%}): it would not "
+                     f"float at the draft the BEM is solved at. {hint}")
+            continue
+        rigid = all(m.joint.kind == "fixed" for m in group[1:])
+        if b.parent is not None or not rigid:
+            continue
+        B = sum(h["volume"] * np.asarray(h["center_of_buoyancy"]) for h in hs.values()) / V
+        H = sum(h["hydrostatic_stiffness"] for h in hs.values())
+        # buoyancy ρgV at x_B about G: a pitch moment ρgV (x_B − x_G) against K55, a roll moment
+        # ρgV (y_B − y_G) against K44 (hydrostatic_stiffness about G holds both the water plane
+        # and ρgV (z_B − z_G); the weight has no moment about G)
+        for axis, dof, k, off in (("pitch", "pitch", 4, B[0] - G[0]), ("roll", "roll", 3, B[1] - G[1])):
+            if dof not in b.joint.dofs:
+                continue
+            K = H[k, k]
+            theta = math.degrees(math.atan2(rho * kw["g"] * V * abs(off), K)) if K > 0 else 90.0
+            if theta > EQUILIBRIUM_HEEL_TOL_DEG:
+                n0 = [n for n in wet if spec_of[n]["shape"] == "mesh"][0]
+                complain(f"{where(n0)}.origin: {who} turns in {axis} ({b.joint.kind} root) and "
+                         f"its centre of buoyancy {np.round(B, 4).tolist()} m lies {abs(off):.4g} m "
+                         f"({'x' if k == 4 else 'y'}) from the vertical through its centre of "
+                         f"mass {np.round(G, 4).tolist()} m: it would {axis} by {theta:.2f}° at "
+                         f"rest (accepted: ≤ {EQUILIBRIUM_HEEL_TOL_DEG:g}°; K = {K:.4g} N m/rad). "
+                         f"Check the mesh's origin x, y and the bodies' com.")
 
 
 # ------------------------------------------------------------------------------------------------
@@ -469,6 +669,15 @@ def _check_finite(ds, infinite_frequency) -> None:
                            "hydro.bem cached this result, delete the cache file or pass cache=False.")
 
 
+def _deep_from(kw) -> float:
+    """The lowest ω that ``hydro.bem.solve`` solves in deep water (``deep_water_kh``), else ∞."""
+    if kw.get("deep_water_kh") is None or not math.isfinite(kw["water_depth"]):
+        return math.inf
+    h = kw["water_depth"]
+    return float(min((w for w in kw["omega"] if _wavenumber(w, h, kw["g"]) * h
+                      >= kw["deep_water_kh"]), default=math.inf))
+
+
 def _human(nbytes: int) -> str:
     return f"{nbytes / 1e6:.2f} MB" if nbytes >= 1e5 else f"{nbytes / 1e3:.1f} kB"
 
@@ -560,6 +769,15 @@ def generate(config_path, *, out=None, force=False, progress=True, n_threads=Non
             print(f"mfm hydro: n_threads={n_threads} needs the package threadpoolctl, which is "
                   f"missing; using the default threads (set OMP_NUM_THREADS to limit them)")
             n_threads = None
+    # the hulls before any solve: a bad mesh or a body that cannot float at its draft is named now,
+    # not after the whole run (issue 51)
+    check_hulls(specs, bodies, raw, settings)
+    try:
+        bem.check_finite_depth(kw["omega"], kw["water_depth"], kw["g"],
+                               deep_from=_deep_from(kw))
+    except ValueError as e:
+        key = "omega" if "omega" in (hydro.get("bem") or {}) else "omega_min"
+        raise ConfigError(f"hydro.bem.{key}: {e}") from None
     t0 = time.perf_counter()
     ds = bem.solve(specs, n_threads=n_threads, progress=progress, cache=cache,
                    cache_dir=cache_dir, **kw)
