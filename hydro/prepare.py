@@ -283,11 +283,28 @@ class HydroSpec:
 
     def check_grid(self, memory_length: float) -> float:
         """:func:`hydro.radiation.check_grid` of a kernel of length `memory_length` (s) as a run
-        uses it: the dofs the model moves, the wave band (:meth:`wave_band`); warns."""
+        uses it: the dofs the model moves, the wave band (:meth:`wave_band`); warns.
+
+        The warning names what the user can do (:func:`grid_advice`) instead of only the step
+        π/T_K: T_K is measured on the interpolated K, which holds the grid's own alias of K near
+        2π/Δω, so π/T_K asks for a step finer than the one that would pass (issue 51: dω for
+        T_K = 353 s, a grid no one makes) and grows again with each refinement."""
+        import warnings
+
+        from .database import HydroDatabaseWarning
         from .radiation import check_grid
 
-        return check_grid(self.database(), memory_length, on_fail="warn", band=self.wave_band(),
-                          dofs=self.moving)
+        db = self.database()
+        band = self.wave_band()
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            ratio = check_grid(db, memory_length, on_fail="warn", band=band, dofs=self.moving)
+        for w in caught:
+            text = str(w.message)
+            if issubclass(w.category, HydroDatabaseWarning) and "too coarse" in text:
+                text = grid_advice(db, memory_length, ratio, text, band=band)
+            warnings.warn(text, w.category, stacklevel=2)
+        return ratio
 
     def state_space(self, **options):
         """The passive state-space fit of :mod:`hydro.statespace` (cached per options). The fit
@@ -364,6 +381,44 @@ class HydroSpec:
                     W.append(Wk)
             self._cache[key] = (np.stack(Wc), np.stack(W))
         return self._cache[key]
+
+
+def grid_advice(db, memory_length: float, ratio: float, message: str, *, band=None,
+                tol: float = 0.05) -> str:
+    """The grid check's message (:func:`hydro.radiation.check_grid`) with what the user can do.
+
+    The check fails when K beyond t_N = π/Δω, the part the ω grid cannot tell from its own
+    alias, changes the radiation impedance by E > tol (``ratio`` = E/tol). Three ways out:
+
+    - ``radiation="state_space"``: fits A(ω), B(ω) on the grid itself; no K beyond it is used.
+    - ``memory = t_N``: the window the grid resolves; the impedance then misses that same part.
+    - a finer grid. Linear interpolation of B attenuates the alias image of K's peak by
+      sinc²: its size goes as Δω² (check_grid's docstring), so when the excess is the alias the
+      step Δω·sqrt(1/ratio)/1.5 passes (the 1.5: a margin for K's own tail). When K's own memory
+      is that long the step must reach π/T_K; which of the two holds is not known from the grid
+      alone, so both are given, each with its n_omega over the grid's range. π/T_K alone was the
+      old advice: for a T_K of the alias image it asks for a grid no one makes.
+    """
+    om = np.asarray(db["omega"].values, dtype=float)
+    lo, hi = (om[0], om[-1]) if band is None else (float(band[0]), float(band[1]))
+    d = np.diff(om)
+    meet = (om[1:] >= lo) & (om[:-1] <= hi)
+    dw = float(d[meet].max() if meet.any() else d.max())
+    t_N = math.pi / dw
+    span = float(om[-1] - om[0])
+    alias = dw * math.sqrt(1.0 / max(ratio, 1.0)) / 1.5
+    own = math.pi / memory_length
+    head = message.split(" Recompute the database")[0].rstrip(". ")
+    return (f"{head}. What you can do: (1) radiation='state_space' (mfm.simulate(..., "
+            f"radiation='state_space'); mfm simulate --radiation state_space): it fits A(ω), "
+            f"B(ω) on this grid and uses no K beyond it; (2) memory={t_N:.4g} "
+            f"(mfm.simulate(..., memory={t_N:.4g})): the kernel window this grid resolves, "
+            f"π/Δω, K beyond it dropped; (3) a finer ω grid: when the excess is the grid's alias "
+            f"of K (K decayed within π/Δω; its size goes as Δω²) a step of about {alias:.3g} "
+            f"rad/s (n_omega ≈ {int(math.ceil(span / alias)) + 1} over {om[0]:.4g}–"
+            f"{om[-1]:.4g} rad/s, now {len(om)}); only when K's own memory is T_K = "
+            f"{memory_length:.4g} s does it need {own:.3g} rad/s (n_omega ≈ "
+            f"{int(math.ceil(span / own)) + 1}).")
 
 
 def _segment_sums(idx, vals, n_out):

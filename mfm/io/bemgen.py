@@ -462,7 +462,9 @@ def check_hulls(specs, bodies, raw, settings) -> None:
             if dof not in b.joint.dofs:
                 continue
             K = H[k, k]
-            theta = math.degrees(math.atan2(rho * kw["g"] * V * abs(off), K)) if K > 0 else 90.0
+            if K <= 0.0:
+                continue       # unstable at rest: a matter of the masses, not of the mesh here
+            theta = math.degrees(math.atan2(rho * kw["g"] * V * abs(off), K))
             if theta > EQUILIBRIUM_HEEL_TOL_DEG:
                 n0 = [n for n in wet if spec_of[n]["shape"] == "mesh"][0]
                 complain(f"{where(n0)}.origin: {who} turns in {axis} ({b.joint.kind} root) and "
