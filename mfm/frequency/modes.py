@@ -71,12 +71,12 @@ def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: i
 
     freqs, modes, zeta, zeta_rad = [], [], [], []
     w_start = hi if math.isfinite(hi) else 1.0
-    lam0 = scipy.linalg.eigh(Ks, condensed(M_at(w_start))[0], eigvals_only=True) if n else []
+    lam0 = _eig_pair(Ks, condensed(M_at(w_start))[0])[0] if n else []
     for m in range(n):
         w = math.sqrt(max(lam0[m], 1e-30))
         for _ in range(iterations):
             Me, G = condensed(M_at(w))
-            lam, vec = scipy.linalg.eigh(Ks, Me)
+            lam, vec = _eig_pair(Ks, Me)
             w_new = math.sqrt(max(lam[m], 1e-30))
             if abs(w_new - w) < 1e-10 * w:
                 break
@@ -110,6 +110,31 @@ def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: i
     return results.natural(model, sys.loads, np.array(freqs), modes, np.array(zeta),
                            np.array(zeta_rad), np.array(mins), {"radiation": radiation},
                            min_det_damped=np.array(mins_damped))
+
+
+def _eig_pair(K, M):
+    """The generalised eigenpairs K φ = λ M φ (λ ascending, φ real, φᵀ M φ = 1 where it is
+    positive). ``scipy.linalg.eigh`` where M is positive definite; else (a radiation strategy's
+    A(ω) at a frequency where its mass is indefinite: a convolution's Ogilvie transform of a
+    truncated K(t) at the end of a database, far from the mode the iteration is after) the
+    general eigenproblem, its real parts: the iteration moves on to the mode's own frequency, where
+    the mass is positive again. Raises LinAlgError only where neither solves."""
+    import scipy.linalg
+
+    try:
+        return scipy.linalg.eigh(K, M)
+    except np.linalg.LinAlgError:
+        lam, vec = scipy.linalg.eig(K, M)
+        keep = np.isfinite(lam)
+        lam, vec = lam[keep].real, vec[:, keep].real
+        order = np.argsort(lam)
+        lam, vec = lam[order], vec[:, order]
+        norm = np.einsum("im,ij,jm->m", vec, M, vec)
+        vec = vec / np.sqrt(np.where(norm > 0, norm, 1.0))
+        if lam.size < K.shape[0]:             # pad: the iteration indexes every mode
+            lam = np.concatenate([lam, np.full(K.shape[0] - lam.size, lam.max(initial=1.0))])
+            vec = np.concatenate([vec, np.zeros((K.shape[0], K.shape[0] - vec.shape[1]))], 1)
+        return lam, vec
 
 
 def _damped_minima(model, sys, grid, stiff, free, options):

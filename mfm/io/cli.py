@@ -426,6 +426,14 @@ def cmd_fits(args):
         this = ("" if fit is None else
                 f"; this config's fit: {fit.report['n_states']} states, band error "
                 f"{fit.report['overall_error']:.3g}, passive {fit.report['passive']}")
+        if fit is not None:
+            # the judgement radiation="auto" makes before a run uses the fit (a decay: every
+            # mode; mfm.frequency.fitcheck), said here where the fit is stored
+            from ..timedomain.setup import judge_radiation
+
+            verdict = judge_radiation(model)
+            this += (f"; {verdict.summary}" + ("" if verdict.ok else
+                     " (radiation='auto' takes the convolution for runs that excite it)"))
         tables = f", {kinds.count('table')} mooring table(s)" if "table" in kinds else ""
         print(f"{config}: {os.path.normpath(path)} stores {kinds.count('fit')} fit(s) and "
               f"{kinds.count('value')} value(s){tables}{this}; {time.perf_counter() - t0:.1f} s, "

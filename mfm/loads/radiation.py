@@ -31,6 +31,28 @@ from hydro import phases
 
 STRATEGIES = ("convolution", "state_space", "state_space_exact", "none")
 
+# frequencies per block of the convolution's Filon weights ((block, n_t) complex: 70,000 times of
+# a 353 s memory make 72 MB a block)
+_OMEGA_BLOCK = 64
+
+
+def convolution_irf(spec):
+    """(t, K (n_t, n, n)): the radiation kernel K(τ) of the moved dofs (:attr:`HydroSpec.moving`)
+    on the grid of the convolution's frequency-domain coefficients: graded near τ = 0, where
+    entries with slowly decaying damping have a narrow spike (25 steps of step/100), then uniform
+    to max(4 T_K, 60 s) at step = min(0.02 s, π/(4 ω_max)). Made once per spec (kept in its
+    cache: the moved dofs only, since K of 48 dofs over 4 T_K would be gigabytes)."""
+    key = ("convolution_irf",)
+    cache = spec._cache
+    if key not in cache:
+        om_db = np.asarray(spec.database()["omega"].values)
+        step = min(0.02, np.pi / np.nanmax(om_db) / 4)
+        t = np.concatenate([np.linspace(0.0, 25 * step, 2501)[:-1],
+                            np.arange(25 * step, max(4 * spec.memory(), 60.0), step)])
+        mv = np.asarray(spec.moving)
+        cache[key] = (t, np.ascontiguousarray(spec.impulse_response(t)[:, mv][:, :, mv]))
+    return cache[key]
+
 
 class NoRadiation(eqx.Module):
     name: ClassVar[str] = "none"
@@ -122,16 +144,29 @@ class Convolution(NoRadiation):
         return self.dofs, -F, None
 
     def coefficients(self, spec, omega):
-        from hydro.radiation import added_mass_from_irf, damping_from_irf
+        """A(ω) = A∞ − ∫₀^{t_e} K(τ) sin ωτ dτ / ω and B(ω) = ∫₀^{t_e} K(τ) cos ωτ dτ (Ogilvie), K of
+        the moved dofs on :func:`convolution_irf`'s grid (kept on the spec: a natural-frequency
+        search asks for one ω at a time, dozens of times); the other dofs keep A∞ and B = 0 (no
+        joint moves them: their rows of H are zero). Filon weights per block of ``_OMEGA_BLOCK``
+        frequencies (their (n_ω, n_t) table stays small whatever the memory)."""
+        from hydro.radiation import filon_weights
 
-        om_db = np.asarray(spec.database()["omega"].values)
-        # graded near τ = 0, where entries with slowly decaying damping have a narrow spike
-        step = min(0.02, np.pi / om_db.max() / 4)
-        t = np.concatenate([np.linspace(0.0, 25 * step, 2501)[:-1],
-                            np.arange(25 * step, max(4 * spec.memory(), 60.0), step)])
-        K = spec.impulse_response(t)
-        return (np.asarray(added_mass_from_irf(K, t, spec.added_mass_inf(), omega)),
-                np.asarray(damping_from_irf(K, t, omega)))
+        omega = np.atleast_1d(np.asarray(omega, dtype=float))
+        t, K = convolution_irf(spec)
+        mv = np.asarray(spec.moving)
+        A_inf = np.asarray(spec.added_mass_inf())
+        A = np.array(np.broadcast_to(A_inf, (len(omega),) + A_inf.shape))
+        B = np.zeros_like(A)
+        if not mv.size:
+            return A, B
+        rows, cols = mv[:, None], mv[None, :]
+        for lo in range(0, len(omega), _OMEGA_BLOCK):
+            w = omega[lo:lo + _OMEGA_BLOCK]
+            W = filon_weights(t, w)                         # ∫ f e^{iωτ}: cos + i sin
+            blk = np.tensordot(W, K, axes=(1, 0))           # (n_w, n, n)
+            A[lo:lo + len(w), rows, cols] = A_inf[rows, cols][None] - blk.imag / w[:, None, None]
+            B[lo:lo + len(w), rows, cols] = blk.real
+        return A, B
 
     def provenance(self):
         return {"radiation": self.name, "memory_length_s": self.memory_length,

@@ -43,21 +43,59 @@ STATE_SPACE_TOLERANCE = 1e-3
 
 
 def choose_radiation(model: Model, *, dt, n_steps, integrator="rk4", memory=None,
-                     state_space_options=None):
+                     state_space_options=None, sea=None, loads=None):
     """The radiation strategy ``radiation="auto"`` takes, and why: ``(name, reason)``.
 
     First the convolution or the state space (:func:`convolution_or_state_space`: the
     convolution's work against :data:`AUTO_CONVOLUTION_LIMIT`, no fit needed); then, for the
     state space, how its states advance (:func:`state_space_update`, from the fit: integrated by
-    the integrator where that is as good as exact and cheaper, else advanced exactly). The reason
-    is recorded in the result (``radiation_choice``)."""
+    the integrator where that is as good as exact and cheaper, else advanced exactly); then the
+    fit judged on the model's own modes and its response to ``sea`` over the run
+    (:func:`judge_radiation`, ``loads`` the run's extra loads): past its tolerances, the
+    convolution. The reason is recorded in the result (``radiation_choice``)."""
     name, why = convolution_or_state_space(model, dt=dt, n_steps=n_steps, integrator=integrator,
                                            memory=memory)
     if name != "state_space_exact":
         return name, why
     name, how = state_space_update(model, dt=dt, integrator=integrator,
                                    state_space_options=state_space_options)
-    return name, f"{why}; {how}"
+    verdict = judge_radiation(model, loads=loads, sea=sea, duration=n_steps * float(dt),
+                              state_space_options=state_space_options,
+                              stage_offsets=stage_offsets(integrator))
+    return judged_choice(name, f"{why}; {how}", verdict)
+
+
+def judge_radiation(model: Model, *, loads=None, sea=None, duration=None,
+                    state_space_options=None, added_mass="lhs", stage_offsets=(0.0, 0.5, 1.0),
+                    q0=None):
+    """The verdict of :func:`mfm.frequency.fitcheck.judge_fit` on the model's state-space fit
+    (``state_space_options``): its modes about the static equilibrium over ``duration`` seconds
+    and its response to ``sea``'s components, against the database's A(ω), B(ω), for the model
+    with its extra ``loads`` in still water (the loads of the run's checks: the same compiled
+    linearisation, :func:`mfm.frequency.rest.still_water_loads`). Where no equilibrium is found
+    (a body that sinks alone), about ``q0`` (default zeros)."""
+    from ..frequency import fitcheck, rest
+
+    lds = rest.still_water_loads(model, loads, added_mass=added_mass,
+                                 stage_offsets=stage_offsets)
+    try:
+        sys = rest._linear_system(model, lds)
+    except ValueError:
+        start = np.zeros(model.n_coordinates) if q0 is None else np.asarray(q0, float)
+        sys = rest._linear_system(model, lds, start)
+    spec = model.hydro
+    components = None if sea is None else sea.components(spec.water_depth, spec.g)
+    return fitcheck.judge_fit(model, sys, state_space_options=state_space_options,
+                              components=components, horizon=duration)
+
+
+def judged_choice(name, why, verdict):
+    """(name, why) of a state-space choice after its fit's ``verdict``: kept where it passed,
+    else ``"convolution"`` (the Cummins integral evaluated directly: no fit to be wrong), with
+    the verdict's summary in the reason either way."""
+    if verdict.ok:
+        return name, f"{why}; {verdict.summary}"
+    return "convolution", f"{why}; but {verdict.summary}: the convolution instead"
 
 
 def convolution_or_state_space(model: Model, *, dt, n_steps, integrator="rk4", memory=None):

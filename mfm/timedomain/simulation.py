@@ -24,8 +24,8 @@ from .checks import (nonfinite_message, refuse_impossible, warn_accuracy, warn_s
 from .progress import phase, progress_bar, progress_options
 from .record import OUTPUTS
 from .rollout import prepare_run, rollout, rollout_call, rollout_jit  # noqa: F401
-from .setup import (choose_radiation, convolution_or_state_space, model_loads,  # noqa: F401
-                    stage_offsets, state_space_update)
+from .setup import (choose_radiation, convolution_or_state_space, judge_radiation,  # noqa: F401
+                    judged_choice, model_loads, stage_offsets, state_space_update)
 
 
 def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="rk4",
@@ -51,8 +51,11 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     ramp: s, the start-up ramp of the excitation (½(1 − cos πt/ramp)).
     radiation: ``"auto"`` (default: the cheaper of the convolution and the state space for this
         run, the state space's states integrated by the integrator where it does that as well as
-        exactly (RK4 at the usual steps), else advanced exactly: :func:`choose_radiation`; the
-        choice and why are in the attribute ``radiation_choice``),
+        exactly (RK4 at the usual steps), else advanced exactly, and the fit judged on the
+        model's own modes and its response to the sea against the database
+        (:mod:`mfm.frequency.fitcheck`): past its tolerances the convolution. :func:`choose_radiation`;
+        the choice and why are in the attribute ``radiation_choice``, the judgement's errors in
+        ``fit_mode_error`` and ``fit_sea_error``),
         ``"convolution"`` (direct, window T_K from the decay of K; ``memory`` overrides it,
         s), ``"state_space"`` (the passive fit of :mod:`hydro.statespace`, options in
         ``state_space_options``, its states integrated by the integrator),
@@ -121,6 +124,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     q0 = initial_vector(model, q0, "q0")
     qd0 = initial_vector(model, qd0, "qd0")
     free = []
+    judged = {}
     # The checks' linearisation at q0 (the model's jet at rest, ~6 s to compile for M4 134)
     # compiles on a second thread while this one builds the run's water (its radiation fit, in
     # numpy) and compiles the run. An error here returns at once: that compilation finishes on
@@ -164,6 +168,26 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
             # pulls back (those of no_restoring(model, q0, loads=<the extra loads>), `mfm info`'s)
             J, K = rest.linearised_at_rest(model, q0, loads)
             free = rest.free_coordinates(model, K)
+        if auto and radiation.startswith("state_space"):
+            # the fit judged on the model's own modes and its response to the sea
+            # (mfm.frequency.fitcheck), from the checks' compiled linearisation; past its
+            # tolerances the run is remade with the convolution, which has no fit to be wrong
+            phase(bar, "judging the radiation fit on the model's modes")
+            verdict = judge_radiation(model, loads=extra, sea=sea, duration=duration,
+                                      state_space_options=state_space_options,
+                                      added_mass=added_mass, stage_offsets=stage_offsets(integ),
+                                      q0=q0)
+            judged = verdict.attrs()
+            radiation, choice = judged_choice(radiation, choice, verdict)
+            if not verdict.ok:
+                phase(bar, "preparing the loads (the convolution)")
+                loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
+                                    radiation=radiation, memory=memory, added_mass=added_mass,
+                                    integrator=integ) + extra
+                phase(bar, "compiling")
+                run = prepare_run(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ,
+                                  loads=loads, save_every=save_every, t0=t0, recording=OUTPUTS,
+                                  chunked=bar is not None)
     except BaseException:
         if bar is not None:
             bar.close()
@@ -182,7 +206,8 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                     complete="true", ramp_s=ramp, memory_s=memory,
                     sea="still water" if sea is None else repr(sea),
                     sea_label="still water" if sea is None else str(sea), radiation_choice=choice,
-                    no_restoring=", ".join(free) if check_stability else "not checked")
+                    no_restoring=", ".join(free) if check_stability else "not checked",
+                    **judged)
     finite = np.isfinite(q).all(axis=1) & np.isfinite(qd).all(axis=1)
     if not finite.all():
         k = int(np.argmax(~finite))
