@@ -119,6 +119,15 @@ def cmd_info(args):
             print(f"  stores {kinds.count('fit')} radiation fit(s) and {kinds.count('value')} "
                   f"value(s) made from it{tables} (`mfm fits`)" if kinds else
                   "  stores no radiation fit (`mfm fits` stores the config's)")
+        spec = model.hydro
+        for k, name in enumerate(spec.db_names):
+            # what the database floats, beside what the config's body weighs (a mesh placed at
+            # the wrong draft, or a database made for another body, shows here first)
+            b = model.bodies[int(spec.body_index[k])]
+            cob = np.asarray(spec.db["center_of_buoyancy"].values[k], dtype=float)
+            print(f"  {name}: displaced volume {spec.volume[k]:.6g} m³ (ρV {spec.rho * spec.volume[k]:.6g}"
+                  f" kg against the body's mass {b.mass:.6g} kg), centre of buoyancy "
+                  f"{np.round(cob, 4).tolist()} m against its CoM {np.round(b.com, 4).tolist()} m")
         issues = known_data_issues(model.hydro.source)
         print("  known data issues (not warned at load; every computation uses the symmetric "
               "part of A, B, A∞):" if issues else "  no known data issues")

@@ -298,7 +298,9 @@ class Water(Load):
         excitation = options.get("excitation", True)
         A_rel, B, X, H0 = self._frequency_coefficients(kin0, omega, heading, options, excitation)
         w = omega[:, None, None]
-        Z = np.einsum("ai,wab,bj->wij", H0, -w**2 * A_rel - 1j * w * B, H0)
+        # Hᵀ Z H as two matrix products (a three-operand einsum without a contraction order is
+        # one loop over every index: Wu & Yuan's 78 dofs on 450 frequencies, 8 s against 0.1 s)
+        Z = H0.T[None] @ (-w**2 * A_rel - 1j * w * B) @ H0[None]
         if X is None:
             return FrequencyTerms(impedance=Z)
         return FrequencyTerms(impedance=Z, force=np.einsum("ai,wa->wi", H0, X))
