@@ -44,7 +44,8 @@ MOVED_MODULES = {
     "mfm.config": ("mfm.io.config",),
     "mfm.parsing": ("mfm.validation",),
     "mfm.build": ("mfm.io.build",),
-    "mfm.cli": ("mfm.io.cli", "mfm_cli"),
+    # mfm.cli is a module of its own (mfm/cli.py), so that `python -m mfm.cli` runs: a stand-in
+    # in sys.modules has no spec for runpy ("mfm.cli.__spec__ is None")
     "mfm.plotting": ("mfm.io.plotting",),
     "mfm.bemgen": ("mfm.io.bemgen",),
     "mfm.water": ("mfm.loads.water", "hydro.prepare"),

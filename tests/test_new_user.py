@@ -721,3 +721,15 @@ def test_readme_double_pendulum_command_moves_and_a_run_at_rest_says_why(tmp_pat
     out = capsys.readouterr().out
     assert re.search(r"stayed at rest .*no --initial or --initial-velocity.*"
                      r"e\.g\. --initial upper\.angle=0\.5 \(rad\)", out), out
+
+
+def test_python_m_mfm_cli_runs_the_command():
+    """`python -m mfm.cli` (a path the old layout promised) is the mfm command: before, a stand-in
+    module in sys.modules had no spec and runpy stopped ("mfm.cli.__spec__ is None")."""
+    import subprocess
+    import sys
+
+    r = subprocess.run([sys.executable, "-m", "mfm.cli", "--help"], capture_output=True,
+                       text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "usage: mfm" in r.stdout and "__spec__" not in r.stderr

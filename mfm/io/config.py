@@ -311,6 +311,23 @@ def load_config(path: str | Path) -> tuple[dict, list[BodySpec]]:
     return options, bodies
 
 
+def read_config_data(data, source: str = "<config>") -> tuple[dict, dict, list[BodySpec]]:
+    """:func:`read_config` of a config given in Python: ``data`` a dict (the tables TOML would
+    parse to) or a TOML text (a str). ``source`` names it in errors and provenance. Returns (the
+    config as a dict, options, bodies)."""
+    if isinstance(data, str):
+        try:
+            data = tomllib.loads(data)
+        except tomllib.TOMLDecodeError as e:
+            raise ConfigError(f"{source}: not valid TOML: {e}") from None
+    elif not isinstance(data, dict):
+        raise ConfigError(f"{source}: {type(data).__name__}; give a dict of the config's tables "
+                          "or its TOML text")
+    options, bodies = parse_config(data, source)
+    options["source"] = source
+    return data, options, bodies
+
+
 def read_config(path: str | Path) -> tuple[dict, dict, list[BodySpec]]:
     """Read and validate a TOML config file: (the TOML as read, options, bodies), the file read
     and parsed once for every use (:func:`mfm.io.build.load` and its database check)."""
