@@ -64,6 +64,12 @@ OPTIONAL = {
 }
 REQUIRED_ATTRS = ("rho", "g", "water_depth")
 
+#: the water densities (kg/m³) and gravities (m/s²) a database is accepted with: fresh water 1000,
+#: sea water 1025, dense brines ~1200; g 9.78–9.83 on Earth, 10 in textbook examples. Outside them
+#: is a unit slip (ρ 1.025 in t/m³, 102.5 or g 0.981 off by 10), refused by :func:`check_values`
+RHO_RANGE = (800.0, 1300.0)
+G_RANGE = (9.0, 10.5)
+
 
 class HydroDatabaseWarning(UserWarning):
     """A database is usable but suspicious (asymmetric matrices, negative damping, coarse grid)."""
@@ -103,11 +109,12 @@ def _check_bodies(db, names):
 
 # ----------------------------------------------------------------------------------------- validate
 def validate(db: xr.Dataset, bodies=None, *, sym_rtol: float = 0.05,
-             damping_noise: float = 0.02, source=None) -> xr.Dataset:
+             damping_noise: float = 0.02, source=None, warn: bool = True) -> xr.Dataset:
     """Check `db` against the schema; raise on errors, warn on suspicious data. Returns `db`.
 
     Errors (ValueError / KeyError): a required variable, dimension, coordinate or attribute is
-    missing or has the wrong dims; omega not finite/positive/ascending; dof labels not
+    missing or has the wrong dims; a value out of range (:func:`check_values`: rho, g, depth,
+    omega finite/positive/ascending, headings in radians, volumes, heave stiffness); dof labels not
     ``dof_labels(body)``; ``added_mass_inf`` absent; a body named in `bodies` absent.
 
     Warnings (:class:`HydroDatabaseWarning`):
@@ -117,6 +124,9 @@ def validate(db: xr.Dataset, bodies=None, *, sym_rtol: float = 0.05,
       noise of about ±1 % of its peak, hence the default 2 %); the frequency and dof are named.
       Dofs whose damping peak is below 1e-6 of the largest of their kind (translation or
       rotation), e.g. yaw of an axisymmetric body, are noise and not checked.
+
+    ``warn=False`` runs the errors only (:func:`hydro.prepare.open_any_database` does, behind
+    every reader; the warnings come when a model uses the database, :class:`HydroSpec`).
 
     Each warning is given once per database per process (a database: its file `source`, or its
     arrays' content without one), not at every load. A shipped database's documented data issue
@@ -141,13 +151,11 @@ def validate(db: xr.Dataset, bodies=None, *, sym_rtol: float = 0.05,
     for a in REQUIRED_ATTRS:
         if a not in db.attrs:
             raise ValueError(f"the hydro database has no attribute {a!r}; required: {REQUIRED_ATTRS}.")
+    check_values(db, source)
     if db.attrs.get("convention", CONVENTION) != CONVENTION:
         raise ValueError(f"attribute convention = {db.attrs['convention']!r}; the database must use "
                          f"{CONVENTION!r} (conjugate the complex amplitudes at the reader).")
     om = np.asarray(db["omega"].values, dtype=float)
-    if not (np.all(np.isfinite(om)) and np.all(om > 0) and np.all(np.diff(om) > 0)):
-        raise ValueError(f"coordinate omega must be finite, > 0 and ascending; got {om[:5]}… "
-                         "(move omega=0 / inf into added_mass_zero / added_mass_inf).")
     body_names = [str(b) for b in db["body"].values]
     expected = dof_labels(body_names)
     for dim in MATRIX_DIMS:
@@ -164,6 +172,8 @@ def validate(db: xr.Dataset, bodies=None, *, sym_rtol: float = 0.05,
         _check_bodies(db, [bodies] if isinstance(bodies, str) else list(bodies))
     _check_finite(db, om)
 
+    if not warn:
+        return db
     labels = expected
     found = [_asymmetry(name, np.asarray(db[name].values, dtype=float), labels, om, sym_rtol)
              for name in ("added_mass", "radiation_damping", "added_mass_inf")]
@@ -171,6 +181,110 @@ def validate(db: xr.Dataset, bodies=None, *, sym_rtol: float = 0.05,
                                    labels, om, damping_noise))
     _give_warnings([f for f in found if f is not None], db, source)
     return db
+
+
+def _where(source) -> str:
+    return f"hydro database {str(source)!r}: " if source is not None else "hydro database: "
+
+
+def _magnitude_hint(value, typical) -> str:
+    """' (… off by 10?)' where `value` is `typical` times a power of ten (10, 10³ …), else ''."""
+    if not (np.isfinite(value) and value > 0):
+        return ""
+    e = np.log10(value / typical)
+    k = int(np.round(e))
+    if k != 0 and abs(e - k) < 0.05:
+        return f": {value:g} is {typical:g} × 10^{k}, a unit slip"
+    return ""
+
+
+def check_values(db: xr.Dataset, source=None) -> None:
+    """The values every database must have, whatever reader made it (run by :func:`validate`,
+    which :func:`hydro.prepare.open_any_database` runs on every file it reads: the project's
+    NetCDF, capytaine's, NEMOH, WAMIT). Each error names the file (`source`), the variable, the
+    value and what is accepted:
+
+    - attributes ``rho`` within :data:`RHO_RANGE` kg/m³ and ``g`` within :data:`G_RANGE` m/s²
+      (ρ < 0, ρ 1.025 in t/m³, g 0.981: a slip by 10 or 10³ is named as one); ``water_depth`` > 0
+      or inf;
+    - coordinate ``omega``: finite, > 0, strictly ascending (labels out of order put every
+      coefficient at another frequency); ``wave_direction``: finite, radians within [−2π, 2π]
+      (headings in degrees are refused);
+    - ``displaced_volume`` finite and >= 0 per body (a thin plate has 0); the heave water-plane
+      stiffness C33 >= 0 per body (ρ g A_wp: negative means inverted normals or a sign slip).
+    """
+    where = _where(source)
+    for name, (lo, hi), unit, typical, fix in (
+            ("rho", RHO_RANGE, "kg/m³", 1025.0, "1025 for sea water, 1000 for fresh water"),
+            ("g", G_RANGE, "m/s²", 9.81, "9.81")):
+        if name not in db.attrs:
+            continue
+        try:
+            v = float(db.attrs[name])
+        except (TypeError, ValueError):
+            raise ValueError(f"{where}attribute {name} = {db.attrs[name]!r} is not a number; "
+                             f"accepted: {lo:g}–{hi:g} {unit} ({fix})") from None
+        if not (np.isfinite(v) and lo <= v <= hi):
+            hint = _magnitude_hint(v, typical) or _magnitude_hint(v, 1000.0 if name == "rho" else 9.81)
+            raise ValueError(
+                f"{where}attribute {name} = {v!r} {unit}; accepted: {lo:g}–{hi:g} {unit} ({fix})"
+                f"{hint}. The coefficients of a BEM database are computed with its {name}: fix the "
+                f"value where it came from (the file's attribute, or hydro.{name} / {name}= for a "
+                "WAMIT run, whose data are scaled by it) or regenerate the database.")
+    if "water_depth" in db.attrs:
+        try:
+            h = float(db.attrs["water_depth"])
+        except (TypeError, ValueError):
+            h = float("nan")
+        if not h > 0:
+            raise ValueError(f"{where}attribute water_depth = {db.attrs['water_depth']!r} m; "
+                             "accepted: > 0 m, or inf for deep water")
+    if "omega" in db.coords:
+        om = np.asarray(db["omega"].values, dtype=float)
+        bad = ~np.isfinite(om) | (om <= 0)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise ValueError(f"{where}coordinate omega[{k}] = {float(om[k])!r} rad/s; accepted: finite "
+                             "frequencies > 0 rad/s (omega = 0 and inf belong in added_mass_zero "
+                             "and added_mass_inf)")
+        d = np.diff(om)
+        if np.any(d <= 0):
+            k = int(np.argmax(d <= 0))
+            raise ValueError(
+                f"{where}coordinate omega is not strictly ascending: omega[{k}] = {float(om[k])!r}, "
+                f"omega[{k + 1}] = {float(om[k + 1])!r} rad/s; accepted: distinct frequencies in "
+                "ascending order. Labels out of order put the coefficients at other frequencies: "
+                "regenerate the database (or, if only the order is wrong and every label is right, "
+                "db.sortby('omega'))")
+    if "wave_direction" in db.coords:
+        beta = np.atleast_1d(np.asarray(db["wave_direction"].values, dtype=float))
+        bad = ~np.isfinite(beta) | (np.abs(beta) > 2 * np.pi * (1 + 1e-9))
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise ValueError(
+                f"{where}coordinate wave_direction[{k}] = {float(beta[k])!r} rad; accepted: headings in "
+                f"radians within [−2π, 2π]. Degrees? Convert them: numpy.deg2rad ({float(beta[k])!r}° = "
+                f"{np.deg2rad(beta[k]):.6g} rad)")
+    if "displaced_volume" in db:
+        vol = np.atleast_1d(np.asarray(db["displaced_volume"].values, dtype=float))
+        names = [str(b) for b in db["body"].values] if "body" in db.coords else list(range(len(vol)))
+        bad = ~np.isfinite(vol) | (vol < 0)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise ValueError(
+                f"{where}displaced_volume of body {names[k]!r} = {float(vol[k])!r} m³; accepted: a finite "
+                "volume >= 0 m³ (the hull's submerged volume; a negative one is a mesh with inward "
+                "normals or a sign slip): fix the mesh and regenerate the database")
+    if "waterplane_stiffness" in db and db["waterplane_stiffness"].ndim == 2:
+        W = np.asarray(db["waterplane_stiffness"].values, dtype=float)
+        labels = [str(x) for x in db["influenced_dof"].values] if "influenced_dof" in db.coords else None
+        for i in range(2, W.shape[0], 6):
+            if np.isfinite(W[i, i]) and W[i, i] < 0:
+                lab = labels[i] if labels else i
+                raise ValueError(
+                    f"{where}waterplane_stiffness[{lab}, {lab}] = {float(W[i, i])!r} N/m; accepted: >= 0 "
+                    "(ρ g times the water-plane area): a negative heave stiffness is a mesh with "
+                    "inward normals or a sign slip: fix the source and regenerate the database")
 
 
 # The data issues of the shipped databases that the checks above find, documented (with why they
@@ -433,7 +547,7 @@ def _ours(ds: xr.Dataset) -> xr.Dataset:
 
 
 # ---------------------------------------------------------------------------------- capytaine
-def from_capytaine(ds: xr.Dataset, body_names=None) -> xr.Dataset:
+def from_capytaine(ds: xr.Dataset, body_names=None, *, source=None) -> xr.Dataset:
     """Convert a capytaine 3 dataset to the internal schema.
 
     `ds` as produced by capytaine's ``BEMSolver.fill_dataset`` / ``cpt.assemble_dataset``, or read
@@ -444,6 +558,8 @@ def from_capytaine(ds: xr.Dataset, body_names=None) -> xr.Dataset:
     ``waterplane_stiffness``, ``hydrostatic_stiffness`` are carried when present (the project's BEM
     generator ``mfm hydro`` writes them with the schema names). A single body's bare dof names
     ("Heave") get the body name (capytaine's ``body`` coordinate, else `body_names`, else "body0").
+    The finite ω > 0 must be strictly ascending as capytaine writes them (ω = 0 and ∞ anywhere):
+    labels out of order are refused, naming `source` (the file), not sorted into wrong places.
     """
     ds = merge_complex(ds)
     freq_dim = next((d for d in ("omega", "freq", "period", "wavenumber", "wavelength")
@@ -500,6 +616,14 @@ def from_capytaine(ds: xr.Dataset, body_names=None) -> xr.Dataset:
     if not np.any(np.isinf(om)):
         raise ValueError("the capytaine dataset has no omega = inf: add numpy.inf to the omega values "
                          "of the radiation problems to get added_mass_inf (required).")
+    d = np.diff(om[finite])
+    if np.any(d <= 0):
+        k = int(np.argmax(d <= 0))
+        raise ValueError(
+            f"{_where(source)}the finite omega are not strictly ascending: {float(om[finite][k])!r} then "
+            f"{float(om[finite][k + 1])!r} rad/s (values {om.tolist()[:8]}…); accepted: distinct "
+            "frequencies in ascending order, as capytaine writes them (0 and inf anywhere). Labels "
+            "out of order put the coefficients at other frequencies: regenerate the database")
     order = np.argsort(om[finite])
     ofin = om[finite][order]
 

@@ -177,7 +177,7 @@ def from_other_capytaine(raw: xr.Dataset, path, names=None) -> xr.Dataset:
                        compat="override")
     if "body" in ds.coords and ds["body"].ndim == 0:
         ds = ds.drop_vars("body")
-    db = from_capytaine(ds.drop_vars([c for c in ("body_name",) if c in ds.coords]))
+    db = from_capytaine(ds.drop_vars([c for c in ("body_name",) if c in ds.coords]), source=path)
     if estimated:
         db["added_mass_inf"] = (("influenced_dof", "radiating_dof"), estimate_added_mass_inf(db))
         db.attrs["added_mass_inf_source"] = (

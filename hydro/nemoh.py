@@ -41,6 +41,16 @@ moves the water-plane moments from (x_G, y_G) to the body's reference point wher
 keeps only the entries 33, 34, 35, 44, 55, 45 — the treatment :mod:`hydro.wamit` gives WAMIT's
 .hst (there too the gravity term is m g z_G with m = rho V).
 
+Each body's own hydrostatics. Where a body's mesh file (as Nemoh.cal names it, e.g.
+``mesh/float.dat``) is in the run folder, its displaced volume and centre of buoyancy are computed
+from it (:func:`mesh_hydrostatics`) and compared with its Hydrostatics file: within 1 % the files
+are used as above; otherwise the files belong to another mesh and the mesh's hydrostatics (V, B,
+the water-plane stiffness, KH about G) are used, with a warning naming both. NEMOH v3.0.2's
+hydrosCal writes the hydrostatics of all bodies together into every ``hydrostatics_<b>.dat``
+(WEC-Sim's RM3 example: 1,612.5 m³ and z_B = −9.163 m for float and spar alike; their meshes give
+725.8 and 886.7 m³, z_B −1.293 and −15.60 m, as NEMOH v2.3 and WAMIT). Without the meshes, files
+that give every body the same volume and centre of buoyancy are refused, naming them and the fix.
+
 Infinite-frequency added mass. NEMOH gives none (an IRF.tec from v3 with the IRF flag set holds
 one, but most runs have none): ``added_mass_inf`` is estimated from A(ω) and B(ω) by Ogilvie's
 relation (:func:`hydro.radiation.estimate_added_mass_inf`; attrs["added_mass_inf_source"]).
@@ -367,6 +377,119 @@ def _sym(C, i, j):
     return C[i, j] if C[i, j] != 0.0 else C[j, i]
 
 
+# ------------------------------------------------------------------------- body meshes (.dat)
+def read_mesh(path):
+    """A NEMOH mesh file (``.dat``, the format Nemoh.cal names: a line ``2 Isym``, the nodes
+    ``id x y z`` up to a line of zeros, the panels ``n1 n2 n3 n4`` (1-based; a triangle repeats a
+    node) up to a line of zeros): (nodes (n, 3), panels (m, 4) 0-based, xOz symmetric). With
+    Isym = 1 only the half y >= 0 is stored; :func:`mesh_hydrostatics` mirrors it."""
+    path = Path(path)
+    lines = [ln.split() for ln in path.read_text(errors="replace").splitlines() if ln.strip()]
+    try:
+        head = [int(float(x)) for x in lines[0][:2]]
+        sym = len(head) > 1 and head[1] == 1
+        k, nodes, ids = 1, [], []
+        while int(float(lines[k][0])) != 0:
+            ids.append(int(float(lines[k][0])))
+            nodes.append([float(x.replace("D", "E")) for x in lines[k][1:4]])
+            k += 1
+        k += 1
+        panels = []
+        while k < len(lines) and any(int(float(x)) != 0 for x in lines[k][:4]):
+            panels.append([int(float(x)) for x in lines[k][:4]])
+            k += 1
+    except (IndexError, ValueError):
+        raise NemohFormatError(f"{path}: not a NEMOH mesh (a line '2 Isym', nodes 'id x y z' up to "
+                               "a line '0 0. 0. 0.', panels 'n1 n2 n3 n4' up to '0 0 0 0'): "
+                               "truncated or another format") from None
+    V = np.array(nodes, dtype=float).reshape(-1, 3)
+    P = np.array(panels, dtype=int).reshape(-1, 4)
+    pos = {i: n for n, i in enumerate(ids)}
+    try:
+        P = np.vectorize(pos.__getitem__)(P) if P.size else P
+    except KeyError as e:
+        raise NemohFormatError(f"{path}: a panel names node {e.args[0]}, which is not in the node "
+                               "list (truncated or damaged mesh)") from None
+    if len(V) < 3 or len(P) < 1 or not np.all(np.isfinite(V)):
+        raise NemohFormatError(f"{path}: {len(V)} nodes and {len(P)} panels (or a non-finite "
+                               "coordinate); a NEMOH mesh holds a hull's panels")
+    return V, P, sym
+
+
+def mesh_hydrostatics(path, ref, rho, g, *, cog=None):
+    """Displaced volume, centre of buoyancy and water-plane stiffness of one body from its own
+    NEMOH mesh file (the wetted surface, z <= 0, open at the water plane; mirrored about xOz where
+    the file says Isym = 1). Exact for the polyhedron closed by its water-plane polygon
+    (the formulas of :func:`hydro.geometry.hull_hydrostatics`): V = Σ a·(b×c)/6 over the panels'
+    triangles, x_B = Σ V_T (a+b+c)/4 / V, ∫_wp f dA = −Σ A_T,z · mean of f at the edge midpoints.
+    The panel order (normals in or out) is taken from the sign of V.
+
+    Returns {"volume", "cob" (3,), "waterplane_area", "waterplane_stiffness" (6, 6) about `ref`
+    (33, 34, 35, 44, 55, 45), "hydrostatic_stiffness" (6, 6): about `cog` (default `ref`) as
+    NEMOH's mesher writes KH: the water-plane terms about (x_G, y_G) and rho g V (z_B − z_G) on
+    44/55 (mass rho V at G)}."""
+    V, P, sym = read_mesh(path)
+    T = np.concatenate([V[P[:, [0, 1, 2]]], V[P[:, [0, 2, 3]]]], axis=0)
+    if sym:
+        M = T[:, [0, 2, 1]] * np.array([1.0, -1.0, 1.0])          # mirrored, order reversed
+        T = np.concatenate([T, M], axis=0)
+    if np.max(T[..., 2]) > 1e-6 * max(np.ptp(T[..., 2]), 1.0):
+        raise NemohFormatError(f"{path}: nodes above the water plane (z up to {np.max(T[..., 2]):.4g} "
+                               "m); a NEMOH body mesh is the wetted surface, z <= 0")
+    a, b, c = T[:, 0], T[:, 1], T[:, 2]
+    vt = np.einsum("ij,ij->i", a, np.cross(b, c)) / 6.0
+    sign = 1.0 if vt.sum() >= 0 else -1.0
+    vt = sign * vt
+    vol = float(vt.sum())
+    if not vol > 0:
+        raise NemohFormatError(f"{path}: the mesh encloses no volume ({vol!r} m³)")
+    cob = (vt[:, None] * (a + b + c) / 4.0).sum(axis=0) / vol
+    az = sign * np.cross(b - a, c - a)[:, 2] / 2.0
+    mids = np.stack([(a + b) / 2, (b + c) / 2, (c + a) / 2], axis=1)
+    rg = rho * g
+
+    def water_plane(point):
+        X, Y = mids[..., 0] - point[0], mids[..., 1] - point[1]
+
+        def wp(f):
+            return float(-(az * f.mean(axis=1)).sum())
+        A, Sx, Sy = wp(np.ones_like(X)), wp(X), wp(Y)
+        W = np.zeros((6, 6))
+        W[2, 2] = rg * A
+        W[2, 3] = W[3, 2] = rg * Sy
+        W[2, 4] = W[4, 2] = -rg * Sx
+        W[3, 3] = rg * wp(Y ** 2)
+        W[4, 4] = rg * wp(X ** 2)
+        W[3, 4] = W[4, 3] = -rg * wp(X * Y)
+        return W, A
+
+    W, area = water_plane(np.asarray(ref, dtype=float))
+    G = np.asarray(ref if cog is None else cog, dtype=float)
+    K, _ = water_plane(G)
+    K[3, 3] += rg * vol * (cob[2] - G[2])
+    K[4, 4] += rg * vol * (cob[2] - G[2])
+    return {"volume": vol, "cob": cob, "waterplane_area": area, "waterplane_stiffness": W,
+            "hydrostatic_stiffness": K}
+
+
+def body_mesh_file(root, mesh):
+    """The file of a body's mesh as Nemoh.cal names it (``mesh/float.dat``: either slash, any
+    letter case of each part, relative to the run folder), or None."""
+    parts = [q for q in re.split(r"[\\/]", mesh.strip()) if q and q != "."]
+    here = Path(root)
+    for part in parts:
+        if not here.is_dir():
+            return None
+        found = next((q for q in here.iterdir() if q.name.lower() == part.lower()), None)
+        if found is None:
+            return None
+        here = found
+    return here if here.is_file() else None
+
+
+_HS_RTOL = 0.01          # a hydrostatics file agrees with its body's mesh: V and z_B within 1 %
+
+
 # ------------------------------------------------------------------------------------ reader
 def find_nemoh_cal(path) -> Path:
     """The ``Nemoh.cal`` of a NEMOH run given as the file itself, its folder or its Results/."""
@@ -474,28 +597,61 @@ def read_nemoh(path, body_names=None, *, rho=None, g=None, estimate_inf: bool = 
     C = np.zeros((n, n))
     W = np.zeros((n, n))
     vol, cob, cogs, used = np.zeros(nb), np.zeros((nb, 3)), np.zeros((nb, 3)), []
+    rho_, g_ = info["rho"], info["g"]
+    files = [hydrostatics_files(root, b, nb) for b in range(nb)]
+    meshes = [body_mesh_file(root, bodies[b]["mesh"]) for b in range(nb)]
+    hs_read = [read_hydrostatics(hs) if hs is not None else None for _, hs in files]
+    from_mesh, notes = [], []
     for b in range(nb):
-        kh, hs = hydrostatics_files(root, b, nb)
-        if kh is None or hs is None:
+        (kh, hs), h, mesh = files[b], hs_read[b], meshes[b]
+        o = 6 * b
+        m = None
+        if mesh is not None:
+            m = mesh_hydrostatics(mesh, ref[b], rho_, g_, cog=h["cog"] if h is not None else ref[b])
+        if h is not None and kh is not None and (m is None or _agrees(h, m)):
+            K = read_kh(kh)
+            C[o:o + 6, o:o + 6] = K
+            W[o:o + 6, o:o + 6] = waterplane_part(K, h["volume"], h["cob"], h["cog"], ref[b], rho_, g_)
+            vol[b], cob[b], cogs[b] = h["volume"], h["cob"], h["cog"]
+            used += [str(kh), str(hs)]
+            continue
+        if m is None:
             want = (f"KH_{b}.dat and Hydrostatics_{b}.dat" + (" (or KH.dat and Hydrostatics.dat)" if nb == 1 else ""))
             raise FileNotFoundError(
                 f"{root}: no hydrostatics for body {b + 1} ({names[b]!r}): looked for {want} in "
-                f"{root / 'Mesh'}, {root} and {root / 'Mechanics'} (any letter case). NEMOH's mesher "
+                f"{root / 'Mesh'}, {root} and {root / 'Mechanics'} (any letter case), and for its "
+                f"mesh {bodies[b]['mesh']!r} (Nemoh.cal) to compute them from. NEMOH's mesher "
                 "writes them; copy each body's files to those names")
-        K = read_kh(kh)
-        h = read_hydrostatics(hs)
-        o = 6 * b
-        C[o:o + 6, o:o + 6] = K
-        W[o:o + 6, o:o + 6] = waterplane_part(K, h["volume"], h["cob"], h["cog"], ref[b], info["rho"],
-                                               info["g"])
-        vol[b], cob[b], cogs[b] = h["volume"], h["cob"], h["cog"]
-        used += [str(kh), str(hs)]
+        # the body's own mesh: its hydrostatics replace files that belong to another mesh
+        C[o:o + 6, o:o + 6] = m["hydrostatic_stiffness"]
+        W[o:o + 6, o:o + 6] = m["waterplane_stiffness"]
+        vol[b], cob[b] = m["volume"], m["cob"]
+        cogs[b] = h["cog"] if h is not None else ref[b]
+        used.append(str(mesh))
+        from_mesh.append(names[b])
+        if h is not None:
+            notes.append(f"{hs} gives {names[b]!r} V = {h['volume']:.6g} m³, z_B = {h['cob'][2]:.4g} m; "
+                         f"its mesh {mesh} encloses V = {m['volume']:.6g} m³, z_B = {m['cob'][2]:.4g} m")
+    if not from_mesh and nb > 1:
+        _refuse_union(root, cal, names, files, hs_read, bodies)
+    if notes:
+        import warnings
+
+        from .database import HydroDatabaseWarning
+        warnings.warn(
+            f"{cal}: the hydrostatics files do not belong to their bodies' meshes ("
+            + "; ".join(notes) + "): hydrostatics computed from each body's own mesh instead "
+            "(NEMOH v3.0.2's hydrosCal writes those of all bodies together into every "
+            "hydrostatics_<b>.dat). To silence this, write each body's own KH_<b>.dat and "
+            "Hydrostatics_<b>.dat (or remove the wrong ones).", HydroDatabaseWarning, stacklevel=2)
     ds["displaced_volume"] = (("body",), vol)
     ds["center_of_buoyancy"] = (("body", "axis"), cob)
     ds["hydrostatic_stiffness"] = (fm[1:], C)
     ds["hydrostatic_stiffness"].attrs["includes"] = (
         "NEMOH KH as given, per body about the point G of its Hydrostatics.dat: water-plane terms and "
-        "rho g V (z_B - z_G) in 44/55 (mass rho V at G)")
+        "rho g V (z_B - z_G) in 44/55 (mass rho V at G)" + (
+            f"; for {', '.join(from_mesh)}: the same terms computed from the body's own mesh "
+            "(hydro.nemoh.mesh_hydrostatics)" if from_mesh else ""))
     ds["waterplane_stiffness"] = (fm[1:], W)
     ds["waterplane_stiffness"].attrs["includes"] = (
         "water-plane terms only (33, 34, 35, 44, 55, 45 about the reference point); rho g V (z_B - z_G) "
@@ -507,13 +663,43 @@ def read_nemoh(path, body_names=None, *, rho=None, g=None, estimate_inf: bool = 
                 "nemoh_conversion": "none: NEMOH's exp(-i omega t) is the internal convention; "
                                     "X = |X| exp(i angle)",
                 "nemoh_center_of_gravity": "; ".join(f"{nm}: {np.array2string(cogs[k], precision=6)}"
-                                                     for k, nm in enumerate(names))}
+                                                     for k, nm in enumerate(names)),
+                "nemoh_hydrostatics": ("from each body's mesh (the hydrostatics files belong to "
+                                       f"another mesh or are missing): {', '.join(from_mesh)}"
+                                       if from_mesh else "the KH and Hydrostatics files")}
     if estimate_inf:
         ds["added_mass_inf"] = (fm[1:], estimate_added_mass_inf(ds))
         ds.attrs["added_mass_inf_source"] = (
             "estimated (NEMOH gives no A_inf): median over the radiation band of A(omega) + "
             "(1/omega) int K(t) sin(omega t) dt, hydro.radiation.estimate_added_mass_inf")
     return ds
+
+
+def _agrees(h, m) -> bool:
+    """A Hydrostatics.dat agrees with its body's mesh: V and z_B within 1 % (of V, of V^(1/3))."""
+    L = m["volume"] ** (1.0 / 3.0)
+    return (abs(h["volume"] - m["volume"]) <= _HS_RTOL * m["volume"]
+            and np.all(np.abs(h["cob"] - m["cob"]) <= _HS_RTOL * L))
+
+
+def _refuse_union(root, cal, names, files, hs_read, bodies):
+    """Refuse files that give every body the same displaced volume and centre of buoyancy: two
+    bodies that do not overlap cannot share both; it is the hydrostatics of all of them together
+    (NEMOH v3.0.2's hydrosCal writes that into each hydrostatics_<b>.dat)."""
+    h0 = hs_read[0]
+    L = h0["volume"] ** (1.0 / 3.0)
+    if all(np.isclose(h["volume"], h0["volume"], rtol=1e-6)
+           and np.allclose(h["cob"], h0["cob"], atol=1e-6 * L) for h in hs_read[1:]):
+        listed = ", ".join(str(hs) for _, hs in files)
+        raise NemohFormatError(
+            f"{cal}: the hydrostatics files {listed} give all {len(names)} bodies {names} the same "
+            f"displaced volume {h0['volume']:.6g} m³ and centre of buoyancy "
+            f"{np.round(h0['cob'], 4).tolist()} m: the hydrostatics of all the bodies together, "
+            "not of each (NEMOH v3.0.2's hydrosCal writes that into every hydrostatics_<b>.dat). "
+            "Fix: put each body's mesh where Nemoh.cal names it ("
+            + ", ".join(f"'{b['mesh']}'" for b in bodies)
+            + f", relative to {root}), from which each body's hydrostatics are computed, or write "
+            "each body's own KH_<b>.dat and Hydrostatics_<b>.dat (NEMOH's mesher run on one body)")
 
 
 def is_nemoh(path) -> bool:

@@ -455,6 +455,15 @@ def modal_form(ss):
 
 
 def open_any_database(path, *, names=None, rho=None, g=None) -> xr.Dataset:
+    """Any hydro database file as the internal schema (:func:`_open_any`: every reader), checked
+    by the one validation behind all of them (:func:`hydro.database.validate`'s errors, naming
+    `path`; its warnings come when a model uses the database)."""
+    from .database import validate
+
+    return validate(_open_any(path, names=names, rho=rho, g=g), source=str(path), warn=False)
+
+
+def _open_any(path, *, names=None, rho=None, g=None) -> xr.Dataset:
     """Any hydro database as the internal schema, in memory, by what `path` names:
 
     - a ``.nc``: our NetCDF (:func:`to_netcdf`), a capytaine 3 file of ``mfm hydro`` /
@@ -485,7 +494,7 @@ def open_any_database(path, *, names=None, rho=None, g=None) -> xr.Dataset:
             return _ours(raw)                                # ours has A∞ as a variable
         if ("waterplane_stiffness" in raw.data_vars and "omega" in raw.coords
                 and np.any(np.isinf(np.asarray(raw["omega"].values, dtype=float)))):
-            return from_capytaine(raw)                       # mfm hydro's capytaine file
+            return from_capytaine(raw, source=path)          # mfm hydro's capytaine file
         # (the project's own files keep their behaviour: names and rho there are the generator's)
         db = formats.from_other_capytaine(raw, path, names=names)
         _same_setting(db, path, rho=rho, g=g)

@@ -276,7 +276,9 @@ def read_wamit(stem_or_paths, rho: float = 1000.0, g: float = 9.81, body_names=N
     ds["center_of_buoyancy"] = (("body", "axis"), ref + cob_rel)
     # ---- .hst: hydrostatics and the water-plane part
     if "hst" in paths:
-        rh = np.array([r[:3] for r in _rows(paths["hst"], 3)])
+        raw_h, line_h = _rows(paths["hst"], 3, lines=True)
+        rh = np.array([r[:3] for r in raw_h])
+        _check_hst(paths["hst"], rh, line_h, n, nb)
         C = np.zeros((n, n))
         C[rh[:, 0].astype(int) - 1, rh[:, 1].astype(int) - 1] = rh[:, 2]
         C = C * rho * g * L ** (k_ab - 1)
@@ -351,6 +353,33 @@ def _rows_fast(path, ncol_min):
     flat = values.tolist()
     rows = [flat[e - c:e] for e, c in zip(ends, counts.tolist())]
     return rows, numbers
+
+
+def _check_hst(path, rh, lines, n, nb):
+    """Raise unless the .hst lists every (i, j) of the n = 6 × n_bodies modes exactly once, as
+    WAMIT writes it (the full matrix, zeros included): a file cut short at a line end still
+    parses, and its missing entries (read as zeros) would take away the stiffness of the modes
+    it lost without a word."""
+    ij = rh[:, :2].astype(int)
+    bad = (ij < 1) | (ij > n)
+    if bad.any():
+        k = int(np.argmax(bad.any(axis=1)))
+        raise ValueError(f"{path}, line {lines[k]}: mode pair ({ij[k, 0]}, {ij[k, 1]}); accepted: "
+                         f"modes 1 … {n} (6 per body, {nb} bodies in the .out)")
+    seen = {}
+    for (i, j), ln in zip(map(tuple, ij), lines):
+        if (i, j) in seen:
+            raise ValueError(f"{path}, line {ln}: entry ({i}, {j}) repeated (first on line "
+                             f"{seen[(i, j)]}); the file is damaged: re-export it from WAMIT")
+        seen[(i, j)] = ln
+    if len(seen) != n * n:
+        missing = [(i, j) for i in range(1, n + 1) for j in range(1, n + 1) if (i, j) not in seen]
+        raise ValueError(
+            f"{path}: {len(seen)} of the {n * n} entries (i, j = 1 … {n}: 6 modes × {nb} bodies) "
+            f"after line {lines[-1]}; missing {missing[:4]}"
+            f"{f' and {len(missing) - 4} more' if len(missing) > 4 else ''}. "
+            "WAMIT writes the full matrix, zeros included: the file is cut short or damaged "
+            "(its missing entries would be read as zero stiffness); re-export it from WAMIT")
 
 
 def _check_complete(path, key, items, what, lines):

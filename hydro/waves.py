@@ -13,6 +13,9 @@ Re[a_j e^{iφ_j} X(ω_j, β_j) e^{−iω_j t}] (see `hydro.excitation`).
 Sea states are immutable descriptions; `.components(water_depth, g)` discretises one into a
 `WaveComponents` object:
 
+Every heading is in radians (0 = towards +x); a sea's heading beyond ±2π (degrees given where
+radians are meant) is refused by `check_heading`, naming the fix ``math.radians(...)``.
+
 - `Regular(height, period, heading, phase)`: one component, a = H/2.
 - `Jonswap`, `PiersonMoskowitz`, `UserSpectrum`: one-sided spectra S(ω) (m² s/rad) discretised with
   a_j = sqrt(2 S(ω_j) Δω_j) and seeded uniform phases. Frequencies:
@@ -53,6 +56,7 @@ __all__ = [
     "UserSpectrum",
     "MeasuredElevation",
     "Spreading",
+    "check_heading",
     "wavenumber",
     "elevation",
     "ramp",
@@ -103,6 +107,23 @@ def _finite(name: str, value) -> float:
         raise TypeError(f"{name} must be a real number, got {value!r}") from None
     if not math.isfinite(v):
         raise ValueError(f"{name} must be finite, got {value!r}")
+    return v
+
+
+def check_heading(value, name: str = "heading") -> float:
+    """A wave heading in radians: finite; beyond ±2π it warns (:class:`SeaStateWarning`). The one
+    check of every sea's heading (Regular, Jonswap, PiersonMoskowitz, UserSpectrum,
+    MeasuredElevation: their mean heading, which a Spreading spreads about). A value beyond 2π is
+    most likely a heading in degrees given where radians are meant (``heading=30`` runs at 30 rad =
+    1718.9°): the warning names the value and the fix (``math.radians(30)``). It still runs, taken
+    modulo 2π (β + 2π is the same heading: the excitation wraps it)."""
+    v = _finite(name, value)
+    if abs(v) > 2.0 * math.pi * (1.0 + 1e-12):
+        warnings.warn(
+            f"{name} = {value!r} rad ({math.degrees(v):.6g}°) is beyond ±2π: headings are in "
+            f"radians (0 = waves travelling towards +x). If {value!r} is in degrees, give "
+            f"{name}=math.radians({value!r}) (= {math.radians(v):.6g} rad); the command line's "
+            "--heading takes degrees.", SeaStateWarning, stacklevel=4)
     return v
 
 
@@ -407,7 +428,7 @@ class Regular:
     def __post_init__(self):
         object.__setattr__(self, "height", _positive("height", self.height))
         object.__setattr__(self, "period", _positive("period", self.period))
-        object.__setattr__(self, "heading", _finite("heading", self.heading))
+        object.__setattr__(self, "heading", check_heading(self.heading))
         object.__setattr__(self, "phase", _finite("phase", self.phase))
 
     def __str__(self):
@@ -492,7 +513,7 @@ class _SpectralSea:
 
     def _check_common(self):
         object.__setattr__(self, "seed", _seed(self.seed))
-        object.__setattr__(self, "heading", _finite("heading", self.heading))
+        object.__setattr__(self, "heading", check_heading(self.heading))
         object.__setattr__(self, "spreading", _spreading(self.spreading))
         object.__setattr__(self, "n_components", _n_components(self.n_components))
         object.__setattr__(self, "omega_range", _omega_range(self.omega_range))
@@ -783,7 +804,7 @@ class MeasuredElevation:
             raise ValueError("t must be uniformly spaced and ascending (resample the record first)")
         object.__setattr__(self, "t", t)
         object.__setattr__(self, "eta", eta)
-        object.__setattr__(self, "heading", _finite("heading", self.heading))
+        object.__setattr__(self, "heading", check_heading(self.heading))
         object.__setattr__(self, "spreading", _spreading(self.spreading))
         object.__setattr__(self, "seed", _seed(self.seed))
         object.__setattr__(self, "omega_range", _omega_range(self.omega_range))
