@@ -9,10 +9,13 @@ kept under the sha256 of all three (with numpy's version: its linear algebra mak
 - on disk, as a pickle under ``$XDG_CACHE_HOME/mfm/fits`` (default ``~/.cache/mfm/fits``), so
   that a later process reads it in about 0.1 s (M4 134), like jax's compilation cache
   (:mod:`mfm._xla`). ``MFM_FIT_CACHE`` names another folder, or ``off`` for none. The folder
-  holds at most :data:`CACHE_BYTES`, the least recently used dropped first. A file that cannot
-  be read is fitted again and written anew; a folder that cannot be written is warned about once
-  and the run goes on without it. Pickles run code when read: the folder is the user's own, as
-  jax's is.
+  holds at most :data:`CACHE_BYTES`, the least recently used dropped first. Each file is sealed
+  (:func:`seal`): the sha256 of its pickle is written with it, in one file put in place whole
+  (written beside, then renamed), and checked before the pickle is read; a file that fails
+  (a flipped bit, a torn or foreign file, one of an older format) is removed, said so once (a
+  :class:`CacheWarning` naming the file and why) and made again. A folder that cannot be
+  written is warned about once and the run goes on without it. Pickles run code when read: the
+  folder is the user's own, as jax's is.
 
 A fit read back equals the one written to the last bit; its report gains ``cache``: the file it
 came from (``""`` when it was fitted in this process). Smaller values that every process would
@@ -26,6 +29,7 @@ from __future__ import annotations
 
 import collections
 import contextlib
+import hashlib
 import os
 import pickle
 import tempfile
@@ -47,6 +51,11 @@ MEMORY_ITEMS = 16
 # the code a fit depends on: a change in any of these files is another key
 _SOURCES = ("statespace.py", "vectorfit.py", "passivity.py", "radiation.py", "fitcache.py",
             "prepare.py")
+
+# the first bytes of a sealed cache file (seal()): what follows is the sha256 of the payload, then
+# the payload. A file without them (an older format, a foreign or torn file) is not read.
+MAGIC = b"mfm-sealed-1\n"
+_DIGEST = 32
 
 _memory: collections.OrderedDict = collections.OrderedDict()
 _values: dict = {}              # cached_value's, by key (a float or a small array each)
@@ -123,21 +132,87 @@ def _from_plain(fields: dict):
     return fit
 
 
-def _read(path: Path, convert=_from_plain):
-    """``convert`` of what the file at ``path`` holds, or None (no file, or one that cannot be
-    read)."""
+class CacheWarning(RuntimeWarning):
+    """A cache entry that failed its check (a flipped bit, a torn or foreign file): removed and
+    made again. The answer is the one a clean cache gives; only the time differs."""
+
+
+class Damaged(Exception):
+    """A sealed cache entry that fails its check (its message says how)."""
+
+
+def seal(payload: bytes) -> bytes:
+    """``payload`` as a cache file holds it: :data:`MAGIC`, its sha256, then itself."""
+    return MAGIC + hashlib.sha256(payload).digest() + bytes(payload)
+
+
+def unseal(blob: bytes) -> bytes:
+    """The payload of a file :func:`seal` made, checked against its sha256; raises
+    :class:`Damaged` saying why where it does not match (or the file is not sealed)."""
+    head = len(MAGIC) + _DIGEST
+    if not blob.startswith(MAGIC):
+        raise Damaged("not a sealed mfm cache entry (torn, foreign, or of an older format)"
+                      if blob else "empty (a torn write)")
+    if len(blob) < head:
+        raise Damaged(f"cut short at {len(blob)} bytes (a torn write)")
+    payload = blob[head:]
+    if hashlib.sha256(payload).digest() != blob[len(MAGIC):head]:
+        raise Damaged(f"its content does not match its sha256 ({len(payload)} bytes; a flipped "
+                      "bit or a torn write)")
+    return payload
+
+
+_discarded: set = set()
+
+
+def discard(path: Path, why: str, what: str = "cache entry") -> None:
+    """Remove the damaged cache file ``path`` (it is made again by the caller) and say so: once
+    for a file and a reason in a process (a file that cannot be removed is not said again on
+    every read)."""
     try:
-        with open(path, "rb") as f:
-            return convert(pickle.load(f))
+        os.unlink(path)
+        removed = "removed and made again"
     except FileNotFoundError:
+        removed = "made again"
+    except OSError as e:
+        removed = f"made again (it could not be removed: {e.strerror})"
+    if (str(path), why) not in _discarded:      # where it cannot be removed: said once
+        _discarded.add((str(path), why))
+        warnings.warn(f"mfm: the {what} {path} is damaged: {why}; {removed}, the answer is "
+                      "unchanged", CacheWarning, stacklevel=3)
+
+
+def read_sealed(path: Path, what: str = "cache entry") -> bytes | None:
+    """The checked payload of the sealed file at ``path``; None where there is none, or where it
+    is damaged (then it is removed, with a :class:`CacheWarning`)."""
+    try:
+        blob = path.read_bytes()
+    except OSError:              # none, or a folder that cannot be read: made (and its write
+        return None              # warned about where the folder cannot be written either)
+    try:
+        payload = unseal(blob)
+    except Damaged as e:
+        discard(path, str(e), what)
         return None
-    except Exception:                 # a damaged or foreign file: fitted again, written anew
+    try:
+        os.utime(path)                # recently used: dropped last
+    except OSError:
+        pass
+    return payload
+
+
+def _read(path: Path, convert=_from_plain):
+    """``convert`` of what the sealed file at ``path`` holds, or None (no file, or a damaged
+    one: removed, with a warning, and made again by the caller)."""
+    payload = read_sealed(path, "state-space fit cache entry")
+    if payload is None:
         return None
-    finally:
-        try:
-            os.utime(path)            # recently used: dropped last
-        except OSError:
-            pass
+    try:
+        return convert(pickle.loads(payload))
+    except Exception as e:           # sealed but not ours to read (another code's pickle)
+        discard(path, f"its pickle cannot be read ({type(e).__name__}: {e})",
+                "state-space fit cache entry")
+        return None
 
 
 def write_whole(path: Path, write) -> None:
@@ -163,8 +238,8 @@ def _write(folder: Path, path: Path, plain) -> None:
     is warned about once."""
     global _warned
     try:
-        write_whole(path, lambda f: pickle.dump(plain, f,
-                                                protocol=pickle.HIGHEST_PROTOCOL))
+        blob = seal(pickle.dumps(plain, protocol=pickle.HIGHEST_PROTOCOL))
+        write_whole(path, lambda f: f.write(blob))
         trim(folder)
     except Exception as e:            # the cache is a shortcut: never the reason a run fails
         if not _warned:

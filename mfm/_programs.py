@@ -21,6 +21,9 @@ tests/test_first_call.py).
 
 Where. Beside the compilation cache, in its folder ``mfm-programs`` (off with it, or alone with
 ``MFM_PROGRAM_CACHE=off``); at most :data:`FOLDER_BYTES`, the least recently used dropped first.
+Each file is sealed with the sha256 of its content (:func:`hydro.fitcache.seal`) and put in
+place whole; one that fails the check (a flipped bit, a torn file) is removed, warned about once
+and made anew, never deserialised.
 Serialisation needs the ``flatbuffers`` package (a dependency of mfm); without it, the ordinary
 path.
 """
@@ -282,7 +285,7 @@ class Program:
             return
         try:
             loaded = _load(path)
-        except Exception:      # an unreadable or foreign file: made anew below
+        except Exception:      # an unreadable file: made anew below (a damaged one: _load)
             loaded = None
         if loaded is not None:
             exported, self._out_tree = loaded
@@ -363,21 +366,31 @@ def _export(jitted, args, static, tree):
 
 
 def _load(path: Path):
-    if not path.exists():
+    """The program saved at ``path`` and its outputs' structure, or None: no file, or a damaged
+    one (it fails its sha256, or what it holds does not come back), which is removed with a
+    warning (:func:`hydro.fitcache.discard`) and made anew by the caller."""
+    payload = fitcache.read_sealed(path, _WHAT)
+    if payload is None:
         return None
-    blob = path.read_bytes()
-    n = int.from_bytes(blob[:8], "little")
-    out_tree = pickle.loads(blob[8:8 + n])
-    exported = jax.export.deserialize(bytearray(blob[8 + n:]))
-    os.utime(path)                     # recently used: kept longest
+    try:
+        n = int.from_bytes(payload[:8], "little")
+        out_tree = pickle.loads(payload[8:8 + n])
+        exported = jax.export.deserialize(bytearray(payload[8 + n:]))
+    except Exception as e:     # sealed by another code: not this process's to read
+        fitcache.discard(path, f"it cannot be read back ({type(e).__name__}: {e})", _WHAT)
+        return None
     return exported, out_tree
+
+
+_WHAT = "saved traced program"
 
 
 def _save(path: Path, exported, out_tree) -> None:
     tree = pickle.dumps(out_tree)
     pickle.loads(tree)                 # a structure that does not come back is not saved
-    blob = len(tree).to_bytes(8, "little") + tree + bytes(exported.serialize())
+    # sealed with its sha256 (checked when read: a flipped bit is made anew, not deserialised),
     # whole or absent, whatever another process does; the least recently used dropped past
-    # FOLDER_BYTES (the fit cache's two helpers)
+    # FOLDER_BYTES (the fit cache's helpers)
+    blob = fitcache.seal(len(tree).to_bytes(8, "little") + tree + bytes(exported.serialize()))
     fitcache.write_whole(path, lambda f: f.write(blob))
     fitcache.trim(path.parent, FOLDER_BYTES, "*.bin")

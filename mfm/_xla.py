@@ -29,6 +29,12 @@ loads them instead. The results are the same bits (the same executable). Set
 ``MFM_COMPILATION_CACHE`` to a folder to use that one, or to ``off`` to keep no cache; jax's own
 setting (``JAX_COMPILATION_CACHE_DIR`` or ``jax.config``) wins over both.
 
+In the folder mfm chooses, each entry is sealed with the sha256 of its content and put in place
+whole (written beside, then renamed: :class:`_SealedCache`); jax alone writes in place and never
+replaces an entry, so a torn one (a kill, a full disk) was warned about and compiled again on
+every run. Now an entry that fails its check is removed, said once, compiled again and replaced.
+A folder named by jax's own setting is left in jax's format (other programs may share it).
+
 XLA reads ``XLA_FLAGS`` once, when jax starts its backend: mfm adds the option there at import,
 unless ``XLA_FLAGS`` already names it (yours wins; ``=1024`` restores XLA's default). If jax's
 backend is already running when mfm is imported (jax used before ``import mfm``), the option cannot
@@ -162,6 +168,7 @@ def _set_cache() -> str | None:
     if switched_off(setting):
         return None
     path = setting or default_cache_dir()
+    _seal_entries(path)
     jax.config.update("jax_compilation_cache_dir", path)
     if jax.config.jax_persistent_cache_min_compile_time_secs == 1.0:     # jax's default
         # a first run also compiles a dozen programs of 0.1–0.6 s (tables, the memories' start,
@@ -175,6 +182,131 @@ def _set_cache() -> str | None:
         else:
             jax.config.update("jax_compilation_cache_max_size", CACHE_BYTES)
     return path
+
+
+
+def _seal_entries(path: str) -> None:
+    """Have jax keep its compilation cache at ``path`` (mfm's folder) in :class:`_SealedCache`:
+    by wrapping jax's ``get_file_cache``, which makes the cache when jax first compiles. A jax
+    without these internals keeps its own cache (mfm's entries then read as damaged there and
+    are compiled again: never a wrong answer)."""
+    try:
+        from jax._src import compilation_cache as cc
+        from jax._src.lru_cache import LRUCache
+    except Exception:
+        return
+    if getattr(cc.get_file_cache, "_mfm_sealed", None) is not None:
+        cc.get_file_cache._mfm_sealed.add(os.path.abspath(path))
+        return
+    jax_own = cc.get_file_cache
+    sealed_paths = {os.path.abspath(path)}
+
+    def get_file_cache(where):
+        made = jax_own(where)
+        if (made is not None and type(made[0]) is LRUCache and isinstance(where, str)
+                and os.path.abspath(where) in sealed_paths):
+            try:
+                return _sealed_cache(LRUCache)(where, max_size=made[0].max_size if
+                                               made[0].eviction_enabled else -1), made[1]
+            except Exception:
+                return made
+        return made
+
+    get_file_cache._mfm_sealed = sealed_paths
+    cc.get_file_cache = get_file_cache
+
+
+_sealed_class = None
+
+
+def _sealed_cache(base):
+    """jax's :class:`LRUCache` whose entries carry the sha256 of their content
+    (:func:`hydro.fitcache.seal`), are written whole (beside, then renamed) and replaced when
+    written again, and whose damaged entries are removed with a warning naming the file."""
+    global _sealed_class
+    if _sealed_class is not None:
+        return _sealed_class
+    import tempfile
+
+    from hydro import fitcache
+
+    what = "jax compilation cache entry"
+
+    class _SealedCache(base):
+        def _file(self, key):
+            return self.path / f"{key}-cache"
+
+        def get(self, key):
+            blob = super().get(key)
+            if blob is None:
+                return None
+            try:
+                return fitcache.unseal(blob)
+            except fitcache.Damaged as e:
+                if not blob.startswith(fitcache.MAGIC) and _jax_readable(blob):
+                    return blob            # an entry jax wrote before mfm sealed them
+                self._drop(key, str(e))
+                return None
+
+        def _drop(self, key, why):
+            with self._locked():
+                try:
+                    os.unlink(self.path / f"{key}-atime")
+                except OSError:
+                    pass
+                fitcache.discard(self._file(key), why, what)
+
+        def _locked(self):
+            import contextlib
+
+            if not self.eviction_enabled:
+                return contextlib.nullcontext()
+            self.lock.acquire(timeout=self.lock_timeout_secs)
+
+            @contextlib.contextmanager
+            def held():
+                try:
+                    yield
+                finally:
+                    self.lock.release()
+            return held()
+
+        def put(self, key, value):
+            # jax puts only what it compiled: the entry was missing or damaged, so replace it
+            blob = fitcache.seal(value)
+            if self.eviction_enabled and len(blob) > self.max_size:
+                return super().put(key, value)        # jax's own refusal and warning
+            import time
+
+            with self._locked():
+                self._evict_if_needed(additional_size=len(blob))
+                atime = self.path / f"{key}-atime"
+                atime.write_bytes(time.time_ns().to_bytes(8, "little"))
+                fd, tmp = tempfile.mkstemp(dir=self.path, prefix=".", suffix=".tmp")
+                try:
+                    with os.fdopen(fd, "wb") as f:
+                        f.write(blob)
+                    os.replace(tmp, self._file(key))
+                except BaseException:
+                    try:
+                        os.unlink(tmp)
+                    except OSError:
+                        pass
+                    raise
+
+    _sealed_class = _SealedCache
+    return _SealedCache
+
+
+def _jax_readable(blob: bytes) -> bool:
+    """Whether an unsealed entry decompresses as jax's (its own check: zlib's adler32)."""
+    try:
+        from jax._src import compilation_cache as cc
+
+        cc.decompress_executable(blob)
+        return True
+    except Exception:
+        return False
 
 
 COMPILATION_CACHE = _set_cache()

@@ -593,3 +593,97 @@ def optimum(model, loads, seas, *, labels, units, optimum, baseline, lower, uppe
                 **provenance(model, loads, **settings, wall_time_s=time.perf_counter() - start),
                 "source": model.hydro.source}
     return ds
+
+
+# ------------------------------------------------------------------------------- saving
+class ResultNotSaved(OSError):
+    """A result file that could not be written where asked. The message names the file, the
+    error and where the result went instead: ``saved`` (a file in the system's temporary folder)
+    or None, in which case ``dataset`` is all there is (returned to a caller in Python)."""
+
+    def __init__(self, message, target=None, saved=None, dataset=None):
+        super().__init__(message)
+        self.target, self.saved, self.dataset = target, saved, dataset
+
+
+def is_partial(ds) -> bool:
+    """Whether a result is a run that stopped before its end (``complete = "false"``)."""
+    return str(ds.attrs.get("complete", "")).lower() == "false"
+
+
+def _holds_partial(path: Path) -> bool:
+    """Whether the file at ``path`` is no better than a partial run: one marked incomplete, or one
+    that cannot be read as NetCDF (a torn file). A file without the mark (a complete run, another
+    command's result, someone's own file) is kept."""
+    try:
+        import netCDF4
+
+        with netCDF4.Dataset(path) as f:
+            return str(getattr(f, "complete", "")).lower() == "false"
+    except Exception:
+        try:
+            with xr.open_dataset(path) as f:
+                return is_partial(f)
+        except Exception:
+            return True
+
+
+def partial_path(path) -> Path:
+    """Where a partial run goes when ``path`` holds a complete one: ``<name>.partial.nc``."""
+    path = Path(path)
+    return path.with_name(f"{path.stem}.partial{path.suffix}")
+
+
+def _why(e: BaseException) -> str:
+    import errno
+
+    text = getattr(e, "strerror", None) or str(e) or type(e).__name__
+    if isinstance(e, OSError) and e.errno == errno.ENOSPC:
+        return f"{text}: the disk is full"
+    if "HDF error" in str(e) or "NetCDF" in str(e):
+        return f"{text} (the NetCDF library's error: a full disk, a quota, or a folder gone)"
+    return text
+
+
+def save_netcdf(ds, path, *, announce=None) -> Path:
+    """Write the result ``ds`` to ``path`` without ever putting a worse file in place of a good
+    one, and return the path written:
+
+    - written whole to a temporary file beside ``path``, renamed onto it only once complete
+      (:func:`hydro.database.write_netcdf`): a failed write leaves the earlier file as it was;
+    - a partial run (``complete = "false"``) never replaces a complete file: it goes to
+      ``<name>.partial.nc`` beside it (:func:`partial_path`), and ``announce`` (a function of
+      one line of text, e.g. ``print``) is told so;
+    - a write that fails (a full disk, a folder made read-only, a NetCDF error) is tried again in
+      the system's temporary folder, and :class:`ResultNotSaved` raised, naming the file, the
+      error and where the result is now (that file, or only the dataset in memory).
+    """
+    from hydro.database import write_netcdf
+
+    path = Path(path)
+    target = path
+    if is_partial(ds) and path.exists() and not _holds_partial(path):
+        target = partial_path(path)
+        if announce is not None:
+            announce(f"{path} holds a complete run and is kept; this partial run is written "
+                     f"beside it, to {target}")
+    try:
+        return write_netcdf(ds, target)
+    except Exception as e:
+        why = _why(e)
+        error = e
+    import tempfile
+
+    saved = None
+    try:
+        saved = Path(tempfile.mkdtemp(prefix="mfm-unsaved-")) / target.name
+        write_netcdf(ds, saved)
+        where = f"the result was saved to {saved} instead"
+    except Exception as e2:
+        saved = None
+        where = (f"it could not be saved in the temporary folder either ({_why(e2)}): the result "
+                 "exists only in memory (the dataset returned, or attached to this error as "
+                 "`.dataset`)")
+    kept = " (the file there before is unchanged)" if target.exists() else ""
+    raise ResultNotSaved(f"{target} could not be written ({why}){kept}; {where}",
+                         target=target, saved=saved, dataset=ds) from error

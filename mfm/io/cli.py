@@ -166,6 +166,20 @@ def _sea(args, command="simulate"):
                          **kw)
 
 
+def _save_result(ds, out):
+    """Write a result to ``out`` (:func:`mfm.results.save_netcdf`: whole or not at all; a partial
+    run never over a complete file, but beside it). Returns (the path written or None, the
+    :class:`mfm.results.ResultNotSaved` to raise once the summary is printed, or None); a failed
+    write is said on stderr at once, with where the result went."""
+    def say(text):
+        print(f"mfm: {text}", file=sys.stderr)
+    try:
+        return results.save_netcdf(ds, out, announce=say), None
+    except results.ResultNotSaved as e:
+        say(str(e))
+        return e.saved, e
+
+
 def cmd_simulate(args):
     out = _writable(args.out)              # before the run, not after it
     png = out.with_suffix(".png")
@@ -179,7 +193,6 @@ def cmd_simulate(args):
     model = load(args.config, body_coupling=False if args.no_body_coupling else None,
                  progress=args.progress)
     sea = _sea(args)
-    from hydro.database import write_netcdf
 
     command = "mfm " + " ".join(sys.argv[1:]) if sys.argv[1:] else "mfm simulate"
     t0 = time.perf_counter()
@@ -193,17 +206,18 @@ def cmd_simulate(args):
         # keep what was computed: the run up to the last finite sample, marked incomplete
         if e.dataset is not None:
             results.with_command(e.dataset, command)
-            write_netcdf(e.dataset, out)
-            print(f"mfm simulate: the run stopped; the {e.dataset.time.size} samples up to "
-                  f"t = {float(e.dataset.time[-1]):g} s are in {out} (attribute complete = false)",
-                  file=sys.stderr)
+            written, failed = _save_result(e.dataset, out)     # never over a complete file
+            if written is not None:
+                print(f"mfm simulate: the run stopped; the {e.dataset.time.size} samples up to "
+                      f"t = {float(e.dataset.time[-1]):g} s are in {written} (attribute complete "
+                      "= false)", file=sys.stderr)
         raise
     wall = time.perf_counter() - t0
     ds = results.with_command(ds, command)
-    write_netcdf(ds, out)
+    written, failed = _save_result(ds, out)
     n = int(round(args.duration / args.dt))
     print(f"{model.name}: {n} steps of {args.dt:g} s with {args.integrator} in {wall:.2f} s "
-          f"(including compilation) -> {out}")
+          f"(including compilation) -> {written or 'nowhere (not saved)'}")
     half = ds.isel(time=slice(len(ds.time) // 2, None))
     t_half = float(half.time[0])
     print(f"  over the second half (t ≥ {t_half:g} s):")
@@ -218,6 +232,8 @@ def cmd_simulate(args):
     print("  " + _restoring_text(ds.attrs.get("no_restoring", "not checked")))
     if sea is None and _at_rest(ds):
         print("  " + _at_rest_text(model, args))
+    if failed is not None:
+        raise failed                 # the summary is above; the file is where the error says
     if not args.no_plot:
         from .plotting import save_result_plot
 
@@ -280,8 +296,6 @@ def _constraints(items):
 def cmd_optimize(args):
     import numpy as np
 
-    from hydro.database import write_netcdf
-
     from ..studies.optimize import optimize
 
     out = _writable(args.out)
@@ -294,7 +308,7 @@ def cmd_optimize(args):
     wall = time.perf_counter() - t0
     command = "mfm " + " ".join(sys.argv[1:]) if sys.argv[1:] else "mfm optimize"
     ds = results.with_command(ds, command)
-    write_netcdf(ds, out)
+    results.save_netcdf(ds, out)           # whole, or an error naming where it went
     print(f"{model.name}: optimum of the mean absorbed power in {sea!r} in {wall:.1f} s "
           f"({int(ds.iterations)} iterations, including compilation) -> {out}")
     for k, name in enumerate(ds.parameter.values):
@@ -383,9 +397,7 @@ def cmd_rao(args):
                                 radiation=args.radiation)
     nat = natural_frequencies(model)
     ds = results.with_natural_frequencies(ds, nat, args.config)
-    from hydro.database import write_netcdf
-
-    write_netcdf(split_complex(ds), out)
+    results.save_netcdf(split_complex(ds), out)     # whole, or an error naming where it went
     print(f"{model.name}: RAOs at {args.n} frequencies {args.omega_min:g}–{args.omega_max:g} rad/s "
           f"-> {out}")
     print(f"  natural frequencies (eigen): {np.round(nat['eigen'].values, 4).tolist()} rad/s")
