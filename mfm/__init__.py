@@ -18,7 +18,7 @@ import jax  # noqa: E402
 
 jax.config.update("jax_enable_x64", True)
 
-from . import frequency, loads, results  # noqa: E402
+from . import frequency, loads, radiation, results  # noqa: E402
 from .timedomain import integrators  # noqa: E402
 from .io.build import compile_tree, load  # noqa: E402
 from .frequency import equilibrium, frequency_response, natural_frequencies  # noqa: E402
@@ -59,5 +59,5 @@ __all__ = ["AccuracyWarning", "ConfigError", "Model", "PerformanceWarning", "Sea
            "energies", "equilibrium", "evaluate", "floquet", "forward_dynamics", "frequency",
            "frequency_response", "integrators", "kinematics", "largest_stable_dt",
            "linear_response", "load", "loads", "mass_matrix", "model_loads",
-           "natural_frequencies", "optimize", "reaction_loads", "reduce", "results", "rollout", "simulate",
+           "natural_frequencies", "optimize", "radiation", "reaction_loads", "reduce", "results", "rollout", "simulate",
            "simulate_batch", "spectral_response", "sweep"]

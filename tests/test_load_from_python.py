@@ -61,3 +61,15 @@ def test_relative_paths_of_a_text_config_need_base(tmp_path, monkeypatch):
         mfm.load(42)
     with pytest.raises(mfm.ConfigError, match="<toml text>: not valid TOML"):
         mfm.load("[model\nname = 1")
+
+
+def test_a_missing_database_of_a_config_with_hulls_says_how_to_make_it(tmp_path):
+    """Issue 54 item 7: a config that describes its hulls ([bodies.geometry]) and names a database
+    that does not exist yet is told to run `mfm hydro CONFIG`."""
+    text = (CONFIGS / "two_flap.toml").read_text()
+    assert 'database = "../hydro/data/two_flap.nc"' in text
+    cfg = tmp_path / "mine.toml"
+    cfg.write_text(text.replace('database = "../hydro/data/two_flap.nc"',
+                                'database = "mine.nc"'))
+    with pytest.raises(FileNotFoundError, match=r"make its database with `mfm hydro .*mine\.toml`"):
+        mfm.load(cfg)

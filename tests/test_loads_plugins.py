@@ -143,12 +143,15 @@ def test_a_load_imports_only_the_mechanics_and_the_load_protocol():
     # the loads: they import nothing of mfm but mfm._xla (checked below)
     # (mfm.loads.catenary_tables: the catenary load's tables, made on the host from MoorPy; it
     # imports nothing of mfm, checked below)
+    # (mfm.radiation: the radiation strategies as objects, the description every front door and
+    # the water's frequency terms resolve; it imports nothing of mfm, checked below)
     allowed = ("mfm.mechanics", "mfm.loads.base", "mfm.loads.pto", "mfm.loads.radiation",
                "mfm.loads.catenary_tables", "mfm.validation", "mfm.errors", "mfm._xla",
-               "mfm._programs")
+               "mfm._programs", "mfm.radiation")
     for leaf in ("mfm._xla", "mfm._programs"):
         assert {d for d in graph[leaf] if d.startswith("mfm")} <= {"mfm._xla"}, graph[leaf]
     assert not {d for d in graph["mfm.loads.catenary_tables"] if d.startswith("mfm")}
+    assert not {d for d in graph["mfm.radiation"] if d.startswith("mfm")}
     runners = ("mfm.loads", "mfm.loads.registry", "mfm.loads.assembly")
     for m, deps in graph.items():
         if m.startswith("mfm.loads") and m not in runners:

@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from .. import results
+from ..radiation import label as radiation_label
 from ..loads import body_matrix
 from ..loads.base import MODES
 from ..mechanics.model import Model
@@ -45,7 +46,17 @@ def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: i
     (root), ``min_det_damped`` (root_damped); it reads like the former dict (``nat["eigen"]``).
     """
     model = check_model(model)
-    import scipy.linalg
+    if omega_grid is not None:
+        try:
+            grid = np.asarray(omega_grid, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"omega_grid: {omega_grid!r} is not an array of frequencies "
+                             "(rad/s)") from None
+        if grid.ndim != 1 or grid.size < 3 or not np.all(np.isfinite(grid)) \
+                or np.any(grid <= 0) or np.any(np.diff(grid) <= 0):
+            raise ValueError(f"omega_grid: give at least 3 positive, finite, ascending "
+                             f"frequencies in rad/s (got {np.array2string(grid, threshold=8)}); "
+                             "or None for 2,000 over the database's range")
 
     options = {"radiation": radiation}
     sys = linear_system(model, q0, loads=loads)
@@ -108,7 +119,7 @@ def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: i
     mins_damped = _damped_minima(model, sys, grid, stiff, free, options)
     modes = np.array(modes).T if modes else np.zeros((model.n_coordinates, 0))
     return results.natural(model, sys.loads, np.array(freqs), modes, np.array(zeta),
-                           np.array(zeta_rad), np.array(mins), {"radiation": radiation},
+                           np.array(zeta_rad), np.array(mins), {"radiation": radiation_label(radiation)},
                            min_det_damped=np.array(mins_damped))
 
 

@@ -25,6 +25,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .. import _programs, results
+from ..radiation import label as radiation_label
 from ..loads.assembly import applied_loads, compile_view, state_offsets
 from ..loads.base import Context
 from ..mechanics.dynamics import Evaluation, gravity_loads, reaction_loads
@@ -195,13 +196,15 @@ def frequency_response(model: Model, omega, heading: float = 0.0, *, q0=None,
         raise ValueError(f"omega: {omega!r} is not an array of frequencies (rad/s)") from None
     if omega.ndim != 1 or omega.size == 0 or not np.all(np.isfinite(omega)) or np.any(omega <= 0):
         raise ValueError(f"omega: give positive, finite frequencies in rad/s (got {omega!r})")
-    heading = float(heading)
+    from hydro.waves import check_heading
+
+    heading = check_heading(heading)     # radians: a heading in degrees warns with the fix
     options = {"radiation": radiation, "state_space_options": state_space_options}
     sys = linear_system(model, q0, loads=loads)
     x = _amplitudes(model, sys, omega, heading, options)
     extra = [ld.frequency_outputs(model, sys.kin0, x, omega) for ld in sys.loads]
     reactions = _joint_reactions(model, sys, omega, heading, options, x) if joint_reactions else None
-    settings = {"radiation": radiation}
+    settings = {"radiation": radiation_label(radiation)}
     if state_space_options:
         settings["state_space_options"] = repr(state_space_options)
     return results.frequency(model, sys.loads, omega, x, sys.q0, sys.kin0, heading, settings,

@@ -27,6 +27,7 @@ import numpy as np
 import xarray as xr
 from hydro.seabatch import components_many
 
+from ..radiation import label as radiation_label
 from .. import results
 from ..loads.pto import linear_ptos, mean_absorbed_power
 from ..mechanics.model import Model
@@ -212,6 +213,6 @@ def _sweep(model, seas, labels, *, t, q0, loads, radiation, state_space_options,
         q_rms[i] = np.sqrt(np.sum(0.5 * a2 * np.abs(x) ** 2, axis=0))
     series = None if times is None else (np.array(times),) + _synthesise(comps, xs, times, sys.q0)
     settings = dict(level="spectral", seas=repr(seas), n_frequencies_solved=n_union,
-                    radiation=radiation, convention="exp(-i omega t)", rao_solve_s=solve_s)
+                    radiation=radiation_label(radiation), convention="exp(-i omega t)", rao_solve_s=solve_s)
     return results.spectral(model, sys.loads, sys.q0, q_rms, power, ptos, comps, seas, settings,
                             series, start)

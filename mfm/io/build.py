@@ -111,16 +111,28 @@ def _assemble(path, hydro, body_coupling, raw, options, bodies, content: bytes) 
     model = dataclasses.replace(model, source=options.get("source", str(path)),
                                 source_sha256=hashlib.sha256(content).hexdigest())
     if hydro and "hydro" in options:
-        # a database made from other hulls or BEM settings than the config has now
+        # a database made from other hulls or BEM settings than the config has now (a config
+        # given as a dict or text has no file for `mfm hydro` to remake it from: not checked)
         try:
-            stale, why = database_is_stale(path, parsed=(raw, options, bodies))
+            stale, why = (database_is_stale(path, parsed=(raw, options, bodies))
+                          if not options["source"].startswith("<") else (False, ""))
         except (ConfigError, ValueError, OSError):
             # a config whose [hydro.bem] table cannot make a database has nothing to compare
             stale, why = False, ""
         if stale:
             warnings.warn(why, HydroDatabaseWarning, stacklevel=3)     # the caller of load
-        model = dataclasses.replace(model, hydro=load_hydro_spec(
-            model, bodies, options["hydro"], Path(path).parent, body_coupling))
+        try:
+            spec = load_hydro_spec(model, bodies, options["hydro"], Path(path).parent,
+                                   body_coupling)
+        except FileNotFoundError as e:
+            if not any("geometry" in b for b in raw.get("bodies", [])):
+                raise
+            # the config describes its hulls: the database is made from it
+            raise FileNotFoundError(
+                f"{str(e).rstrip('.')}. This config describes its hulls ([bodies.geometry]): make "
+                f"its database with `mfm hydro {path}` (capytaine: pip install -e \".[bem]\"), "
+                "or point [hydro] database at an existing one") from None
+        model = dataclasses.replace(model, hydro=spec)
     # loads in registry order; each sees the model with the loads before it (a damping ratio is
     # set from the linearisation of the model as built so far)
     for table in TABLES:

@@ -313,9 +313,15 @@ def cmd_optimize(args):
           f"({int(ds.iterations)} iterations, including compilation) -> {out}")
     for k, name in enumerate(ds.parameter.values):
         bound = str(ds.at_bound.values[k])
-        print(f"  {name:>32s}: {float(ds.optimum[k]):.6g} {ds.parameter_unit.values[k]} (model's "
+        value = float(ds.optimum[k])
+        if bound in ("lower", "upper"):
+            # at its bound the optimiser's value is the bound to round-off (1.66533e-15 for 0)
+            value = float(ds[bound][k])
+        off = bound == "lower" and value == 0.0 and "damping" in str(name)
+        print(f"  {name:>32s}: {value:.6g} {ds.parameter_unit.values[k]} (model's "
               f"{float(ds.baseline[k]):.6g}; bounds {float(ds.lower[k]):g}:{float(ds.upper[k]):g}"
-              + (f", at the {bound} bound)" if bound else ")"))
+              + (f", at the {bound} bound" if bound else "")
+              + ("; switched off: the device absorbs more without this damper)" if off else ")"))
     gain = (f"gain {float(ds.gain):+.2%}" if float(ds.objective_baseline) else
             "the model's own values absorb nothing")
     print(f"  mean absorbed power {float(ds.objective):.6g} W (model's "

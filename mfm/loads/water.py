@@ -271,8 +271,12 @@ class Water(Load):
         from hydro.waves import WaveComponents, wavenumber
 
         spec = self.spec
-        rad = strategy(spec, options.get("radiation", "database"), frequency_domain=True,
-                       state_space_options=options.get("state_space_options"))
+        from ..radiation import resolve
+
+        # a strategy object or its alias, resolved here behind every frequency-domain front door
+        name, _, fit_options = resolve(options.get("radiation", "database"), None,
+                                       options.get("state_space_options"), domain="frequency")
+        rad = strategy(spec, name, frequency_domain=True, state_space_options=fit_options)
         om_db = np.asarray(spec.database()["omega"].values)
         om_db = om_db[np.isfinite(om_db)]
         # a frequency within GRID_RTOL beyond an end of the grid is that end (six-decimal grids)
@@ -613,6 +617,16 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
                 f"{dry} are not in the database {str(path)!r} (bodies {available}): a body "
                 "renamed? Bodies are matched by name; give each wet body a [bodies.hydro] table "
                 "with body = \"<database name>\" (with such tables, bodies without one are dry)")
+    named = {db_name for _, db_name, _ in wet}
+    extra = [d for d in available if d not in named]
+    if wet and extra:
+        # solved with the others, so its presence is in their A, B and X; but it does not move
+        # here: a body of the device left out of the config by mistake would run held fixed
+        warnings.warn(f"hydro: database bodies {extra} of {str(path)!r} are named by no config "
+                      "body: they are held fixed in the water (the others' coefficients include "
+                      "their presence, as solved). If they belong to the device, add them to the "
+                      "config (matched by name, or [bodies.hydro] body = \"<database name>\")",
+                      HydroDatabaseWarning, stacklevel=4)
     if not wet:
         raise ValueError(f"hydro: no config body is in the database {str(path)!r} (database bodies "
                          f"{available}, config bodies {[b.name for b in bodies]}); give each wet "

@@ -373,7 +373,10 @@ def optimize(model: Model, seas, parameters: dict, *, objective: Callable | str 
     confirm_out = None
     if confirm is not None:
         confirm_out = _confirm(model, seas, dict(zip(labels, theta)), params, w, r_opt, confirm)
-    settings = dict(level="spectral", seas=repr(seas), radiation=radiation, method="SLSQP",
+    from ..radiation import label as radiation_label
+
+    settings = dict(level="spectral", seas=repr(seas), radiation=radiation_label(radiation),
+                    method="SLSQP",
                     derivatives="forward" if forward else "reverse", max_iter=int(max_iter),
                     tol=float(tol), message=str(res.message), success=bool(res.success),
                     objective=("mean absorbed power" if objective_fn is mean_power

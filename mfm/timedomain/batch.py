@@ -176,6 +176,9 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     Raises :class:`SimulationError` naming the first case that goes non-finite.
     """
     models = [check_model(m_) for m_ in (model if isinstance(model, (list, tuple)) else [model])]
+    from ..radiation import resolve
+
+    radiation, memory, state_space_options = resolve(radiation, memory, state_space_options)
     seas = list(seas) if isinstance(seas, (list, tuple)) else [seas]
     try:
         dts = np.atleast_1d(np.asarray(dt, dtype=float))

@@ -21,9 +21,10 @@ step without the corrector) 2, Newmark average acceleration ∞ (unconditionally
 """
 from __future__ import annotations
 
+import abc
 import dataclasses
 import math
-from typing import Callable, NamedTuple
+from typing import Callable, ClassVar, NamedTuple
 
 import jax
 import jax.numpy as jnp
@@ -57,6 +58,24 @@ def phase_error(integrator, omega_dt: float) -> float:
     return x**2 / 12.0
 
 
+class AbstractIntegrator(abc.ABC):
+    """The base of the integrators (the protocol of the module docstring, declared): a frozen
+    dataclass with ``name``, ``order`` (global error O(dtⁿ)), ``evaluations`` (of f per step),
+    ``stability_limit`` (max ω dt on an undamped oscillator) and ``stage_offsets`` (the fractions
+    of dt at which f is evaluated within a step), and :meth:`init`, :meth:`step`. An integrator
+    of a user's own subclasses it (or follows the protocol: :func:`get` accepts that too, and
+    asks for ``stage_offsets`` only where a load with memory needs them)."""
+    name: ClassVar[str]
+
+    @abc.abstractmethod
+    def init(self, f, t0, q0, qd0, z0) -> State:
+        """The state at t0: the acceleration and the auxiliary rates evaluated there."""
+
+    @abc.abstractmethod
+    def step(self, f, state: State, dt) -> State:
+        """One step of length dt."""
+
+
 def _init(f, t0, q0, qd0, z0):
     t0 = jnp.asarray(t0, jnp.float64)
     a, zd = f(t0, q0, qd0, z0)
@@ -64,7 +83,7 @@ def _init(f, t0, q0, qd0, z0):
 
 
 @dataclasses.dataclass(frozen=True)
-class RK4:
+class RK4(AbstractIntegrator):
     """Classical 4th-order Runge–Kutta on (q, q̇, z). Global error O(dt⁴)."""
     name: str = "rk4"
     order: int = 4
@@ -112,7 +131,7 @@ class RK4:
 
 
 @dataclasses.dataclass(frozen=True)
-class SemiImplicitEuler:
+class SemiImplicitEuler(AbstractIntegrator):
     """Semi-implicit (symplectic) Euler: q̇ₙ₊₁ = q̇ₙ + dt q̈(qₙ, q̇ₙ), qₙ₊₁ = qₙ + dt q̇ₙ₊₁.
 
     Symplectic for separable Hamiltonian systems with a constant mass matrix (bounded energy error
@@ -137,7 +156,7 @@ class SemiImplicitEuler:
 
 
 @dataclasses.dataclass(frozen=True)
-class Verlet:
+class Verlet(AbstractIntegrator):
     """Velocity Verlet with a predicted velocity: one evaluation of f per step, second order.
 
         qₙ₊₁ = qₙ + dt q̇ₙ + dt²/2 q̈ₙ,   q̇* = q̇ₙ + dt q̈ₙ,   z* = zₙ + dt żₙ      (predictor)
@@ -178,7 +197,7 @@ def _rel_change(new, old):
 
 
 @dataclasses.dataclass(frozen=True)
-class Beeman:
+class Beeman(AbstractIntegrator):
     """The scheme of seed 001 eq. 52 (after [29]), a predictor–corrector:
 
         qₙ₊₁ = qₙ + dt (q̇ₙ + q̈ₙ dt/2)                      (52a)
@@ -229,7 +248,7 @@ class Beeman:
 
 
 @dataclasses.dataclass(frozen=True)
-class Newmark:
+class Newmark(AbstractIntegrator):
     """Newmark average acceleration (β = 1/4, γ = 1/2), the trapezoidal rule on (q, q̇, z):
 
         qₙ₊₁ = qₙ + dt q̇ₙ + dt²/4 (q̈ₙ + q̈ₙ₊₁),   q̇ₙ₊₁ = q̇ₙ + dt/2 (q̈ₙ + q̈ₙ₊₁),

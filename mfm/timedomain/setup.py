@@ -10,6 +10,7 @@ from ..loads.assembly import carried_loads
 from ..loads.base import Load
 from ..mechanics.model import Model
 from . import integrators as _integrators
+from ..radiation import resolve as resolve_radiation
 from ..validation import check_model
 
 
@@ -21,6 +22,8 @@ def model_loads(model: Model, sea=None, *, dt, duration, t0=0.0, ramp=0.0,
     prepared for the stage times of ``integrator``), then the config's loads (``model.loads``:
     moorings, PTOs, …): :func:`mfm.loads.assembly.carried_loads` for this integrator."""
     model = check_model(model)
+    radiation, memory, state_space_options = resolve_radiation(radiation, memory,
+                                                               state_space_options)
     stages = stage_offsets(integrator) if model.hydro is not None else ()
     return carried_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                          radiation=radiation, memory=memory,

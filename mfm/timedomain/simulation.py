@@ -24,6 +24,7 @@ from .checks import (nonfinite_message, refuse_impossible, warn_accuracy, warn_s
 from .progress import phase, progress_bar, progress_options
 from .record import OUTPUTS
 from .rollout import prepare_run, rollout, rollout_call, rollout_jit  # noqa: F401
+from ..radiation import resolve as resolve_radiation
 from .setup import (choose_radiation, convolution_or_state_space, judge_radiation,  # noqa: F401
                     judged_choice, model_loads, stage_offsets, state_space_update)
 
@@ -91,6 +92,9 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     if sea is not None and model.hydro is None:
         raise ValueError("sea: this model has no hydrodynamics (no [hydro] table in its config, or "
                          "mfm.load(..., hydro=False)); pass sea=None")
+    # a strategy object or its string alias, with the string API's side options
+    radiation, memory, state_space_options = resolve_radiation(radiation, memory,
+                                                               state_space_options)
     dt = finite_number(dt, "dt", positive=True)
     duration = finite_number(duration, "duration", positive=True)
     t0 = finite_number(t0, "t0")
