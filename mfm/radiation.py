@@ -130,9 +130,10 @@ def as_strategy(radiation) -> AbstractRadiation:
         return radiation
     if isinstance(radiation, str) and radiation in ALIASES:
         return ALIASES[radiation]
-    raise ValueError(f"radiation={radiation!r}; accepted: a strategy of mfm.radiation (Auto(), "
-                     "Convolution(memory_length=...), StateSpace(update='integrated'|'exact'), "
-                     f"NoMemory(), Database()) or one of {list(ALIASES)}")
+    raise ValueError(f"radiation={radiation!r}; accepted: "
+                     + ", ".join(repr(a) for a in ALIASES)
+                     + " or a strategy of mfm.radiation (Auto(), Convolution(memory_length=...), "
+                     "StateSpace(update='integrated'|'exact'), NoMemory(), Database())")
 
 
 def label(radiation) -> str:

@@ -36,7 +36,7 @@ SEA = hydro.Regular(height=1.0, period=8.0)
     ({"ramp": -1.0}, r"ramp: -1\.0 must be ≥ 0"),
     ({"q0": [np.nan, 0, 0, 0]}, r"q0: not finite for \['spar\.surge'\]"),
     ({"q0": {"spar.heave": "up"}}, r"q0\['spar\.heave'\]: 'up' is not a number"),
-    ({"radiation": "ss"}, r"radiation='ss'; accepted: 'convolution', 'state_space', 'state_space_exact', 'none'"),
+    ({"radiation": "ss"}, r"radiation='ss'; accepted: 'auto', 'convolution', 'state_space', 'state_space_exact', 'none', 'database' or a strategy of mfm.radiation"),
     ({"radiation": "state_space", "state_space_options": {"orders": 4}},
      r"unknown option\(s\) \['orders'\]; accepted: \[.*'order'"),
     ({"save_every": 0}, r"save_every: 0 must be a positive divisor"),
