@@ -146,7 +146,36 @@ def test_a_run_that_cannot_fit_is_refused_before_any_work(rm3, monkeypatch):
     assert abs(est / ds.nbytes - 1) < 0.05
     # and the limit is the machine's memory: a machine of 100 kB refuses that run (~0.25 MB) too
     monkeypatch.setattr(checks, "machine_memory", lambda: 100_000)
-    with pytest.raises(ValueError, match="more than this machine's 0.0001 GB"):
+    with pytest.raises(ValueError, match=r"more than the 0.0001 GB this process may use "
+                                         r"\(this machine's memory\)"):
+        mfm.simulate(rm3, SEA, duration=20.0, dt=0.1)
+
+
+def test_the_memory_check_meets_a_container_s_limit(tmp_path, monkeypatch):
+    """Issue 54 item 17: the limit is what the process may use, not the machine's memory: a
+    control group's memory.max less its memory.current (cgroup v2; v1's files likewise), read
+    under a root the test lays out. A 1.5 GB limit with 0.3 GB in use leaves 1.2 GB."""
+    from mfm.timedomain import checks
+
+    cg = tmp_path / "sys/fs/cgroup"
+    cg.mkdir(parents=True)
+    (cg / "memory.max").write_text("1500000000\n")
+    (cg / "memory.current").write_text("300000000\n")
+    have, what = checks.usable_memory(str(tmp_path))
+    assert have == 1_200_000_000 and "control group's limit (1.5 GB" in what, (have, what)
+    (cg / "memory.max").write_text("max\n")             # no limit: the others decide
+    have, what = checks.usable_memory(str(tmp_path))
+    assert "control group" not in what and have > 0
+    v1 = tmp_path / "v1"
+    (v1 / "sys/fs/cgroup/memory").mkdir(parents=True)
+    (v1 / "sys/fs/cgroup/memory/memory.limit_in_bytes").write_text("2000000000")
+    (v1 / "sys/fs/cgroup/memory/memory.usage_in_bytes").write_text("500000000")
+    assert checks.usable_memory(str(v1)) [0] == 1_500_000_000
+    # and the run's refusal names it: a run needing more than the group leaves is refused
+    monkeypatch.setattr(checks, "usable_memory",
+                        lambda root="/": (100_000, "its control group's limit (test)"))
+    rm3 = mfm.load(CONFIGS / "rm3.toml")
+    with pytest.raises(ValueError, match=r"may use \(its control group's limit \(test\)\)"):
         mfm.simulate(rm3, SEA, duration=20.0, dt=0.1)
 
 

@@ -23,6 +23,66 @@ def machine_memory() -> int:
         return 0
 
 
+# where the kernel says how much this process may use (cgroup v2, then v1), under a root a test
+# can move
+CGROUP_FILES = (("sys/fs/cgroup/memory.max", "sys/fs/cgroup/memory.current"),
+                ("sys/fs/cgroup/memory/memory.limit_in_bytes",
+                 "sys/fs/cgroup/memory/memory.usage_in_bytes"))
+
+
+def _read_int(path) -> int | None:
+    try:
+        text = open(path).read().strip()
+    except OSError:
+        return None
+    return int(text) if text.isdigit() else None        # "max": no limit
+
+
+def usable_memory(root: str = "/") -> tuple[int, str]:
+    """(bytes, what): the memory this process may still take, the least of
+    - the machine's physical memory (:func:`machine_memory`),
+    - its control group's limit less what the group uses now (cgroup v2 ``memory.max`` −
+      ``memory.current``, or v1's ``memory.limit_in_bytes`` − ``memory.usage_in_bytes``: a
+      container's limit, which kills the process without a word when passed),
+    - the address-space and data limits of the process (``ulimit -v``, ``-d``),
+    - the memory the kernel says is available (``MemAvailable`` of /proc/meminfo) plus what this
+      process holds already (its resident set),
+    and what that least one is. (0, "") where nothing is known."""
+    import resource
+
+    found = []
+    phys = machine_memory()
+    if phys:
+        found.append((phys, "this machine's memory"))
+    for limit_file, usage_file in CGROUP_FILES:
+        limit = _read_int(os.path.join(root, limit_file))
+        if limit is not None and limit < 2**60:
+            used = _read_int(os.path.join(root, usage_file)) or 0
+            found.append((max(limit - used, 0), f"its control group's limit ({limit / 1e9:.3g} GB "
+                                                f"in /{limit_file}, {used / 1e9:.3g} GB in use)"))
+            break
+    for which, name in ((resource.RLIMIT_AS, "ulimit -v"), (resource.RLIMIT_DATA, "ulimit -d")):
+        try:
+            soft = resource.getrlimit(which)[0]
+        except (ValueError, OSError):
+            continue
+        if soft not in (resource.RLIM_INFINITY, -1) and soft > 0:
+            found.append((int(soft), f"the process's limit ({name})"))
+    try:
+        info = dict(line.split(":", 1) for line in open(os.path.join(root, "proc/meminfo")))
+        avail = int(info["MemAvailable"].split()[0]) * 1024
+        rss = 0
+        try:
+            rss = int(open(os.path.join(root, "proc/self/statm")).read().split()[1]) \
+                * int(os.sysconf("SC_PAGE_SIZE"))
+        except (OSError, ValueError, IndexError):
+            pass
+        found.append((avail + rss, "the memory available now (MemAvailable of /proc/meminfo)"))
+    except (OSError, KeyError, ValueError):
+        pass
+    return min(found) if found else (0, "")
+
+
 def run_bytes(model, loads, n_steps: int, save_every: int, *, cases: int = 1,
               every_output: bool = True, names=()) -> float:
     """An estimate (bytes, float64) of what a run of ``n_steps`` holds before it starts stepping:
@@ -52,15 +112,19 @@ def run_bytes(model, loads, n_steps: int, save_every: int, *, cases: int = 1,
 def refuse_impossible(model, loads, n_steps, save_every, *, cases=1, every_output=True, names=(),
                       what="duration"):
     """Raise a ValueError before any work when the run's memory (:func:`run_bytes`) is more than
-    this machine has: a run that would otherwise allocate until it fails or hangs (a duration of
-    1e15 s). The message gives the estimate and how to proceed."""
-    need, have = run_bytes(model, loads, n_steps, save_every, cases=cases,
-                           every_output=every_output, names=names), machine_memory()
+    this process may use (:func:`usable_memory`: the machine, a container's limit, ulimits, what
+    is free): a run that would otherwise allocate until it fails, hangs or is killed without a
+    word (a duration of 1e15 s; a 2 GB batch in a 1.5 GB container). The message gives the
+    estimate, the limit it meets and how to proceed."""
+    need = run_bytes(model, loads, n_steps, save_every, cases=cases, every_output=every_output,
+                     names=names)
+    have, limit = usable_memory()
     if have and need > have:
         raise ValueError(
             f"{what}: {n_steps:.4g} steps{f' × {cases} cases' if cases > 1 else ''} would hold "
             f"about {need / 1e9:.3g} GB before the first step (the saved samples and the wave "
-            f"tables), more than this machine's {have / 1e9:.3g} GB: shorten the run, keep fewer "
+            f"tables), more than the {have / 1e9:.3g} GB this process may use ({limit}): "
+            f"shorten the run, keep fewer "
             f"samples (save_every=k keeps every k-th), split it into runs from the last state "
             f"(q0=, qd0=, t0=), or record fewer outputs (simulate_batch(outputs=...))")
 
