@@ -29,6 +29,16 @@ def _number(kind, *, minimum=None, strict=True, integer=False):
     return parse
 
 
+# the exit status of every usage, config and input error: argparse's own for a bad option, and
+# the same for what only the command finds (a config that is not there, a sea outside the
+# database's grid, a run too large); mfm.io.cli.EXIT_USAGE is this number
+EXIT_USAGE = 2
+EPILOG = (f"exit status: 0 done; {EXIT_USAGE} a usage, config or input error, or a run that "
+          "cannot be done as asked (a bad option or value, a missing or bad config, a sea outside the database's frequency grid, a run "
+          f"too large for the memory, a run gone non-finite): one line 'mfm COMMAND: error: ...' "
+          "on stderr, naming the option to change; any other status is a fault of mfm (a "
+          "traceback: please report it). Warnings print as one line 'mfm: warning: ...'.")
+
 POSITIVE = _number("a positive number", minimum=0.0)
 NONNEGATIVE = _number("a number ≥ 0", minimum=0.0, strict=False)
 FINITE = _number("a finite number")
@@ -70,10 +80,21 @@ def _version() -> str:
 
 
 
+def _band_options(p):
+    """``--omega-min/--omega-max``: the JONSWAP's discretised band (the Python sea's
+    ``omega_range``), e.g. to keep it inside the hydro database's frequency grid."""
+    p.add_argument("--omega-min", type=POSITIVE, metavar="RAD_S",
+                   help="JONSWAP: lowest frequency of the discretised band, rad/s (default 0.5 × "
+                   "the peak frequency 2π/Tp); keep the band inside the hydro database's grid")
+    p.add_argument("--omega-max", type=POSITIVE, metavar="RAD_S",
+                   help="JONSWAP: highest frequency of the band, rad/s (default 5 × the peak "
+                   "frequency); a band keeping < 90 %% of the spectrum's variance warns")
+
+
 def build_parser():
     ap = argparse.ArgumentParser(prog="mfm", description="Floating multi-body systems by the Moving "
                                  "Frame Method. Units are SI (m, rad, s, kg, N, W); headings in "
-                                 "degrees on the command line.")
+                                 "degrees on the command line.", epilog=EPILOG)
     ap.add_argument("--version", action="version", version=_version())
     sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
     p = sub.add_parser("info", help="print the tree, coordinates, masses and which coordinates "
@@ -103,6 +124,7 @@ def build_parser():
                    help="JONSWAP peak enhancement (default 3.3)")
     p.add_argument("--seed", type=_count(0), default=0, help="random phases seed (default 0)")
     p.add_argument("--components", type=_count(1), help="number of wave components")
+    _band_options(p)
     p.add_argument("--heading", type=FINITE, default=0.0, help="wave heading, degrees (0 = towards +x)")
     p.add_argument("--ramp", type=NONNEGATIVE, default=0.0, help="start-up ramp of the excitation, s")
     p.add_argument("--radiation", default="auto", choices=["auto", "convolution", "state_space", "state_space_exact", "none"])
@@ -141,6 +163,7 @@ def build_parser():
                      ("--components", dict(type=_count(1), help="number of wave components")),
                      ("--heading", dict(type=FINITE, default=0.0, help="wave heading, degrees"))):
         p.add_argument(flag, **kw)
+    _band_options(p)
     p.add_argument("--max-iter", type=_count(1), default=100, help="SLSQP iterations (default 100)")
     p.add_argument("--out", default="out/optimum.nc", help="NetCDF output (default out/optimum.nc)")
     p.set_defaults(func="cmd_optimize")
@@ -177,12 +200,18 @@ def build_parser():
                    "current directory)")
     p.add_argument("--dpi", type=_count(10), default=120)
     p.set_defaults(func="cmd_plot")
+    for p in sub.choices.values():      # `mfm COMMAND --help` says the exit status too
+        p.epilog = EPILOG
     return ap
 
 
 def main(argv=None):
-    """Parse ``argv`` (default: ``sys.argv[1:]``) and run the command; returns the exit code
-    (0, or 2 with one ``mfm COMMAND: error: ...`` line for a config, input or simulation error)."""
+    """Parse ``argv`` (default: ``sys.argv[1:]``) and run the command; returns the exit code: 0,
+    or :data:`EXIT_USAGE` (2) with one ``mfm COMMAND: error: ...`` line for a config, input or
+    simulation error. A usage error raises ``SystemExit`` with that code, as argparse's own: a
+    bad option (argparse) or an option that needs another (:class:`mfm.io.cli.UsageError`, whose
+    ``str()`` is the message). Warnings print as one ``mfm: warning: ...`` line; errors and
+    warnings name the command's options, not the Python arguments behind them."""
     args = build_parser().parse_args(argv)
     if getattr(args, "progress", None) is not None:
         args.progress = progress_option(args.progress)     # simulate's progress= argument
@@ -190,21 +219,38 @@ def main(argv=None):
         # a command without --progress still says what a long load does (its MoorPy tables:
         # seconds where the cache is empty), as --progress auto would
         args.progress = progress_option("auto")
+    import warnings
+
     from mfm.io import cli   # the commands, and with them mfm and jax: only now that there is work
     from mfm import _gc
 
     _gc.freeze_at_exit()     # the command's objects skip the exit's collections (mfm/_gc.py)
 
+    formatwarning = warnings.formatwarning
+    warnings.formatwarning = cli.format_warnings(args)    # one line, no source path
     try:
-        getattr(cli, args.func)(args)
-    except Exception as e:  # config and simulation errors: one clear line, exit code 2
-        from mfm import ConfigError, SimulationError
+        try:
+            getattr(cli, args.func)(args)
+        except cli.UsageError as e:     # exit status EXIT_USAGE, as argparse's
+            cli.say(f"mfm {args.command}: error: {cli.cli_text(e, args)}")
+            raise
+        except SystemExit as e:         # a command's own exit with a message: a usage error too
+            if e.code is None or isinstance(e.code, int):
+                raise
+            text = str(e.code).removeprefix("mfm: ")
+            cli.say(f"mfm {args.command}: error: {cli.cli_text(text, args)}")
+            raise cli.UsageError(text) from None
+        except Exception as e:  # config and simulation errors: one clear line, exit EXIT_USAGE
+            from mfm import ConfigError, SimulationError
 
-        if isinstance(e, (ConfigError, SimulationError, ValueError, KeyError, OSError, ImportError)):
-            msg = e.args[0] if isinstance(e, KeyError) and e.args else e
-            print(f"mfm {args.command}: error: {msg}", file=sys.stderr)
-            return 2
-        raise
+            if isinstance(e, (ConfigError, SimulationError, ValueError, KeyError, OSError,
+                              ImportError)):
+                msg = e.args[0] if isinstance(e, KeyError) and e.args else e
+                cli.say(f"mfm {args.command}: error: {cli.cli_text(msg, args)}")
+                return EXIT_USAGE
+            raise
+    finally:
+        warnings.formatwarning = formatwarning
     return 0
 
 

@@ -7,8 +7,11 @@ itself.
 """
 from __future__ import annotations
 
+import math
+import re
 import sys
 import time
+import warnings
 from pathlib import Path
 
 from .. import results
@@ -20,6 +23,142 @@ from ..timedomain.simulation import simulate
 from .bemgen import generate
 from .build import load
 from .config import load_config
+
+
+# every usage, config and input error of the command line exits with this status: argparse's own
+# (mfm_cli.EXIT_USAGE, the same number; mfm_cli imports nothing of mfm before the arguments parse)
+EXIT_USAGE = 2
+
+
+class UsageError(SystemExit):
+    """A command-line mistake the parser cannot see (an option that needs another, a NAME=VALUE
+    without its '='): exit status :data:`EXIT_USAGE`, argparse's; ``str()`` is the message, which
+    :func:`mfm_cli.main` prints as one ``mfm COMMAND: error: ...`` line."""
+
+    def __init__(self, message: str):
+        super().__init__(message)
+        self.code = EXIT_USAGE
+
+
+def _grid_remedy(lo: str, hi: str, args) -> str:
+    """What a command-line user does about a sea whose frequencies leave the database's grid
+    [lo, hi] rad/s (the numbers as the message printed them)."""
+    wave = getattr(args, "wave", None)
+    extend = ("or extend the database over a wider band ([hydro.bem] omega_min and omega_max in "
+              "the config, then mfm hydro CONFIG)")
+    if wave == "regular":
+        return (f"give a --period whose frequency 2π/T lies in the grid (T from "
+                f"{2 * math.pi / float(hi):.4g} to {2 * math.pi / float(lo):.4g} s), {extend}")
+    flags = [f"--omega-min {lo}", f"--omega-max {hi}"]
+    if wave == "jonswap" and getattr(args, "tp", None):
+        # only the end that leaves the grid (or both, a band wholly outside it)
+        from hydro.waves import DEFAULT_BAND
+
+        wp = 2.0 * math.pi / args.tp
+        b_lo = getattr(args, "omega_min", None) or DEFAULT_BAND[0] * wp
+        b_hi = getattr(args, "omega_max", None) or DEFAULT_BAND[1] * wp
+        if float(lo) <= b_lo < float(hi):
+            flags.remove(f"--omega-min {lo}")
+        if float(lo) < b_hi <= float(hi):
+            flags.remove(f"--omega-max {hi}")
+        flags = flags or [f"--omega-min {lo}", f"--omega-max {hi}"]
+    return (f"give the spectrum a band inside the grid with --omega-min/--omega-max (rad/s), "
+            f"e.g. {' '.join(flags)} (a band that keeps less than 90 % of the spectrum's variance "
+            f"warns), {extend}")
+
+
+_NUM = r"[-+0-9.eE]+"
+# the Python arguments a remedy of mfm or hydro may name, as the command line's options (a name
+# is rewritten only for a command that has the option: args has its dest); NAME= only, so a
+# sea's repr (Jonswap(hs=2.0, ...)) keeps its fields
+_PYTHON_NAMES = (("save_every", "--save-every", "save_every"),
+                 ("n_components", "--components", "components"),
+                 ("qd0", "--initial-velocity", "initial_velocity"),
+                 ("q0", "--initial", "initial"))
+
+
+def cli_text(message, args=None) -> str:
+    """A message of mfm or hydro (an error's or a warning's) as a command-line user reads it: the
+    remedies it names in Python (``omega_range``, ``components.band(...)``, ``save_every=``,
+    ``q0=``) as the command's options (``--omega-min/--omega-max``, ``--save-every``,
+    ``--initial``). The rest of the text is kept as it is."""
+    text = str(message)
+    # a sea outside the database's grid: the time domain (hydro.excitation) and the frequency
+    # domain (mfm.validation.check_sea_in_grid)
+    text = re.sub(rf"lies outside the database's omega grid \[({_NUM}), ({_NUM})\] rad/s: pass "
+                  r"omega_range inside the grid to the sea state, use components\.band\(\.\.\.\), "
+                  r"or extend the database",
+                  lambda m: (f"lies outside the database's omega grid [{m[1]}, {m[2]}] rad/s: "
+                             + _grid_remedy(m[1], m[2], args)), text)
+    text = re.sub(rf"Give the sea omega_range=\(ω_min, ω_max\) inside \[({_NUM}), ({_NUM})\], or "
+                  r"regenerate the database over a wider band",
+                  lambda m: _grid_remedy(m[1], m[2], args)[0].upper()
+                  + _grid_remedy(m[1], m[2], args)[1:], text)
+    # frequencies outside the grid in the frequency domain (mfm.loads.water): a sea's (optimize)
+    # or the RAOs' own (rao: --omega-min/--omega-max)
+    def grid(m):
+        if getattr(args, "wave", None) is not None:
+            return (f"the sea's frequencies [{m[1]}, {m[2]}] rad/s lie outside the database's grid "
+                    f"[{m[3]}, {m[4]}] rad/s: " + _grid_remedy(m[3], m[4], args))
+        if hasattr(args, "omega_min"):
+            return (f"--omega-min {m[1]} to --omega-max {m[2]} rad/s lies outside the database's "
+                    f"grid [{m[3]}, {m[4]}] rad/s: give frequencies inside it, e.g. --omega-min "
+                    f"{m[3]} --omega-max {m[4]}, or extend the database over a wider band "
+                    "([hydro.bem] omega_min and omega_max in the config, then mfm hydro CONFIG)")
+        return m[0]
+    text = re.sub(rf"omega: \[({_NUM}), ({_NUM})\] rad/s lies outside the database's \[({_NUM}), "
+                  rf"({_NUM})\] rad/s; choose frequencies inside it or regenerate the database",
+                  grid, text)
+    # a band that keeps too little of the spectrum (hydro.waves, a SeaStateWarning)
+    text = re.sub(rf"^\w+: omega_range=\(({_NUM}), ({_NUM})\) rad/s keeps",
+                  r"the band --omega-min \1 --omega-max \2 (rad/s) keeps", text)
+    text = text.replace("Widen omega_range to cover the spectrum (the default band does)",
+                        "Widen --omega-min/--omega-max to cover the spectrum (without them the "
+                        "default band, 0.5 to 5 times the peak frequency, does)")
+    # a run too large for the memory (mfm.timedomain.checks.refuse_impossible)
+    if hasattr(args, "duration") and hasattr(args, "dt"):
+        text = re.sub(r"^duration: ", f"--duration {args.duration:g} s at --dt {args.dt:g} s: ", text)
+    text = re.sub(r"keep fewer samples \(save_every=k keeps every k-th\), split it into runs from "
+                  r"the last state \(q0=, qd0=, t0=\), or record fewer outputs "
+                  r"\(simulate_batch\(outputs=\.\.\.\)\)",
+                  "keep fewer samples (--save-every K keeps every K-th), or take a longer time "
+                  "step (--dt)", text)
+    # what is left: a Python argument by its option, where the command has it
+    if args is not None:
+        if hasattr(args, "omega_min"):
+            text = re.sub(r"(?<![\w.])omega_range\b(=\([^)]*\))?", "--omega-min/--omega-max", text)
+        for name, flag, dest in _PYTHON_NAMES:
+            if hasattr(args, dest):
+                text = re.sub(rf"(?<![\w.-]){name}=(['\"]?)([^\s,;)'\"]*)\1",
+                              lambda m, flag=flag: f"{flag} {m[2]}" if m[2] else flag, text)
+    return text
+
+
+def cli_warning(message, args=None) -> str:
+    """A warning as the command line prints it: ``mfm: warning: <message>``, one line (no Python
+    category, source file or line), its Python names as options (:func:`cli_text`)."""
+    return "mfm: warning: " + " ".join(cli_text(message, args).split())
+
+
+def say(line: str):
+    """Print one line on stderr, on a line of its own where a progress bar (tqdm) is drawn there:
+    the bar is cleared, the line written, the bar drawn again below it."""
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        print(line, file=sys.stderr, flush=True)
+    else:
+        tqdm.write(line, file=sys.stderr)
+        sys.stderr.flush()
+
+
+def format_warnings(args):
+    """A ``warnings.formatwarning`` that writes each warning as :func:`cli_warning` (and a
+    newline). Python's own printing writes it; a recorder (``warnings.catch_warnings(record=True)``,
+    ``pytest.warns``) still gets the warning itself."""
+    def fmt(message, category, filename, lineno, line=None):
+        return cli_warning(message, args) + "\n"
+    return fmt
 
 
 LENGTH_SUFFIXES = ("surge", "sway", "heave", "stroke")
@@ -60,12 +199,12 @@ def _pairs(items, what):
     out = {}
     for item in items or []:
         if "=" not in item:
-            raise SystemExit(f"mfm: {what} {item!r}: expected NAME=VALUE, e.g. float3.angle=0.1")
+            raise UsageError(f"{what} {item!r}: expected NAME=VALUE, e.g. float3.angle=0.1")
         k, v = item.split("=", 1)
         try:
             out[k.strip()] = float(v)
         except ValueError:
-            raise SystemExit(f"mfm: {what} {item!r}: {v!r} is not a number") from None
+            raise UsageError(f"{what} {item!r}: {v!r} is not a number") from None
     return out
 
 
@@ -147,21 +286,53 @@ def _sea(args, command="simulate"):
 
     import hydro
 
+    band = [(f"--omega-{e}", getattr(args, f"omega_{e}", None)) for e in ("min", "max")]
+    band_given = [flag for flag, v in band if v is not None]
     if args.wave is None:
         for flag in ("height", "period", "hs", "tp"):
             if getattr(args, flag) is not None:
-                raise SystemExit(f"mfm {command}: --{flag} needs --wave regular or --wave jonswap")
+                raise UsageError(f"--{flag} needs --wave regular or --wave jonswap")
+        if band_given:
+            raise UsageError(f"{band_given[0]} sets the band of --wave jonswap; give the sea")
         return None
-    heading = float(np.deg2rad(args.heading))
+    deg = args.heading
+    if abs(deg) > 360.0:
+        # a heading beyond a turn: the same direction as its remainder; said here in degrees
+        # (hydro's own warning is in radians and names Python's math.radians)
+        deg = math.fmod(deg, 360.0)
+        warnings.warn(f"--heading {args.heading:g}° is beyond ±360°: taken as {deg:g}° (the same "
+                      "direction; --heading is in degrees, 0 = waves travelling towards +x)",
+                      UserWarning, stacklevel=2)
+    heading = float(np.deg2rad(deg))
     if args.wave == "regular":
+        if band_given:
+            raise UsageError(f"{band_given[0]} sets the band of --wave jonswap, not of a regular "
+                             "wave (one frequency: 2π/--period)")
         if args.height is None or args.period is None:
-            raise SystemExit(f"mfm {command}: --wave regular needs --height (m) and --period (s)")
+            raise UsageError("--wave regular needs --height (m) and --period (s)")
         return hydro.Regular(height=args.height, period=args.period, heading=heading)
     if args.hs is None or args.tp is None:
-        raise SystemExit(f"mfm {command}: --wave jonswap needs --hs (m) and --tp (s)")
+        raise UsageError("--wave jonswap needs --hs (m) and --tp (s)")
     kw = {}
     if args.components is not None:
         kw["n_components"] = args.components
+    if band_given:
+        # one end given: the other is the default band's (hydro.waves.DEFAULT_BAND × ωp)
+        from hydro.waves import DEFAULT_BAND
+
+        wp = 2.0 * math.pi / args.tp
+        lo = band[0][1] if band[0][1] is not None else DEFAULT_BAND[0] * wp
+        hi = band[1][1] if band[1][1] is not None else DEFAULT_BAND[1] * wp
+        if not lo < hi:
+            raise UsageError(f"the band --omega-min {lo:.6g} to --omega-max {hi:.6g} rad/s is "
+                             "empty; give --omega-min < --omega-max"
+                             + ("" if len(band_given) == 2 else
+                                f" (without --omega-max the band ends at {DEFAULT_BAND[1]:g} × "
+                                f"the peak frequency, {hi:.4g} rad/s for --tp {args.tp:g} s)"
+                                if band[1][1] is None else
+                                f" (without --omega-min the band starts at {DEFAULT_BAND[0]:g} × "
+                                f"the peak frequency, {lo:.4g} rad/s for --tp {args.tp:g} s)"))
+        kw["omega_range"] = (lo, hi)
     return hydro.Jonswap(hs=args.hs, tp=args.tp, gamma=args.gamma, seed=args.seed, heading=heading,
                          **kw)
 
