@@ -32,7 +32,8 @@ CGROUP_FILES = (("sys/fs/cgroup/memory.max", "sys/fs/cgroup/memory.current"),
 
 def _read_int(path) -> int | None:
     try:
-        text = open(path).read().strip()
+        with open(path) as f:
+            text = f.read().strip()
     except OSError:
         return None
     return int(text) if text.isdigit() else None        # "max": no limit
@@ -69,12 +70,13 @@ def usable_memory(root: str = "/") -> tuple[int, str]:
         if soft not in (resource.RLIM_INFINITY, -1) and soft > 0:
             found.append((int(soft), f"the process's limit ({name})"))
     try:
-        info = dict(line.split(":", 1) for line in open(os.path.join(root, "proc/meminfo")))
+        with open(os.path.join(root, "proc/meminfo")) as f:
+            info = dict(line.split(":", 1) for line in f)
         avail = int(info["MemAvailable"].split()[0]) * 1024
         rss = 0
         try:
-            rss = int(open(os.path.join(root, "proc/self/statm")).read().split()[1]) \
-                * int(os.sysconf("SC_PAGE_SIZE"))
+            with open(os.path.join(root, "proc/self/statm")) as f:
+                rss = int(f.read().split()[1]) * int(os.sysconf("SC_PAGE_SIZE"))
         except (OSError, ValueError, IndexError):
             pass
         found.append((avail + rss, "the memory available now (MemAvailable of /proc/meminfo)"))
