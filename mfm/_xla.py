@@ -226,8 +226,6 @@ def _sealed_cache(base):
     global _sealed_class
     if _sealed_class is not None:
         return _sealed_class
-    import tempfile
-
     from hydro import fitcache
 
     what = "jax compilation cache entry"
@@ -282,17 +280,7 @@ def _sealed_cache(base):
                 self._evict_if_needed(additional_size=len(blob))
                 atime = self.path / f"{key}-atime"
                 atime.write_bytes(time.time_ns().to_bytes(8, "little"))
-                fd, tmp = tempfile.mkstemp(dir=self.path, prefix=".", suffix=".tmp")
-                try:
-                    with os.fdopen(fd, "wb") as f:
-                        f.write(blob)
-                    os.replace(tmp, self._file(key))
-                except BaseException:
-                    try:
-                        os.unlink(tmp)
-                    except OSError:
-                        pass
-                    raise
+                fitcache.write_whole(self._file(key), lambda f: f.write(blob))
 
     _sealed_class = _SealedCache
     return _SealedCache

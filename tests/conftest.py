@@ -69,3 +69,28 @@ def _resident_bytes() -> int:
             return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
     except (OSError, ValueError, IndexError, AttributeError):
         return RSS_LIMIT + 1
+
+
+# ---------------------------------------------------------------------- fixtures shared by files
+import collections  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def sphere_db():
+    """The sphere's database as its loaded model's water sees it (configs/sphere.toml)."""
+    import mfm
+
+    return mfm.load(CONFIGS / "sphere.toml", hydro=True).hydro.database()
+
+
+@pytest.fixture
+def fit_cache(tmp_path, monkeypatch):
+    """An empty fit-cache folder (MFM_FIT_CACHE, not made yet) and empty in-process caches of
+    hydro.fitcache: its fits, its values and the damaged entries it has already reported."""
+    from hydro import fitcache
+
+    monkeypatch.setenv("MFM_FIT_CACHE", str(tmp_path / "fits"))
+    monkeypatch.setattr(fitcache, "_memory", collections.OrderedDict())
+    monkeypatch.setattr(fitcache, "_values", {})
+    monkeypatch.setattr(fitcache, "_discarded", set())
+    return tmp_path / "fits"

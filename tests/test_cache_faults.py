@@ -12,7 +12,6 @@ never overwrites). Independent reference: the same call on a clean cache, compar
 """
 from __future__ import annotations
 
-import collections
 import os
 import pickle
 import subprocess
@@ -55,20 +54,6 @@ def damaged_warnings(record, path) -> list:
             and str(path) in str(w.message)]
 
 
-@pytest.fixture(scope="module")
-def sphere_db():
-    return mfm.load(CONFIGS / "sphere.toml", hydro=True).hydro.database()
-
-
-@pytest.fixture
-def folder(tmp_path, monkeypatch):
-    monkeypatch.setenv("MFM_FIT_CACHE", str(tmp_path / "fits"))
-    monkeypatch.setattr(FC, "_memory", collections.OrderedDict())
-    monkeypatch.setattr(FC, "_values", {})
-    monkeypatch.setattr(FC, "_discarded", set())
-    return tmp_path / "fits"
-
-
 def test_the_seal_finds_every_flipped_bit_and_every_cut():
     payload = bytes(range(256)) * 4
     blob = FC.seal(payload)
@@ -84,9 +69,9 @@ def test_the_seal_finds_every_flipped_bit_and_every_cut():
             FC.unseal(blob[:n])
 
 
-def test_a_flipped_bit_in_a_stored_fit_is_fitted_again_to_the_bit(sphere_db, folder):
+def test_a_flipped_bit_in_a_stored_fit_is_fitted_again_to_the_bit(sphere_db, fit_cache):
     clean = FC.cached_fit(sphere_db)
-    (path,) = folder.glob("*.pkl")
+    (path,) = fit_cache.glob("*.pkl")
     assert sealed(path)
     flip(path)
     FC.clear()
@@ -103,10 +88,10 @@ def test_a_flipped_bit_in_a_stored_fit_is_fitted_again_to_the_bit(sphere_db, fol
     assert FC.cached_fit(sphere_db).report["cache"] == str(path)
 
 
-def test_a_flipped_bit_in_a_stored_value_is_made_again(folder):
+def test_a_flipped_bit_in_a_stored_value_is_made_again(fit_cache):
     spec = mfm.load(CONFIGS / "sphere.toml").hydro
     T_K, A_inf = spec.memory(), np.array(spec.added_mass_inf())
-    files = sorted(folder.glob("*.pkl"))
+    files = sorted(fit_cache.glob("*.pkl"))
     assert len(files) == 2
     for p in files:
         flip(p)
@@ -121,11 +106,11 @@ def test_a_flipped_bit_in_a_stored_value_is_made_again(folder):
         assert sealed(p)
 
 
-def test_an_unsealed_or_torn_entry_is_made_again_never_read(sphere_db, folder):
+def test_an_unsealed_or_torn_entry_is_made_again_never_read(sphere_db, fit_cache):
     # an entry of the format before the seal (a bare pickle), even one that unpickles into a
     # plausible fit, is not trusted: removed and fitted again; a torn one likewise
     clean = FC.cached_fit(sphere_db)
-    (path,) = folder.glob("*.pkl")
+    (path,) = fit_cache.glob("*.pkl")
     path.write_bytes(pickle.dumps(FC._to_plain(clean)))
     FC.clear()
     with pytest.warns(FC.CacheWarning, match="not a sealed"):

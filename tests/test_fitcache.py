@@ -22,20 +22,6 @@ pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWar
 ARRAYS = ("A", "B", "C", "added_mass_inf")
 
 
-@pytest.fixture(scope="module")
-def sphere_db():
-    return mfm.load(CONFIGS / "sphere.toml", hydro=True).hydro.database()
-
-
-@pytest.fixture
-def folder(tmp_path, monkeypatch):
-    """An empty cache folder and an empty in-process cache."""
-    monkeypatch.setenv("MFM_FIT_CACHE", str(tmp_path / "fits"))
-    monkeypatch.setattr(FC, "_memory", collections.OrderedDict())
-    monkeypatch.setattr(FC, "_values", {})
-    return tmp_path / "fits"
-
-
 def _same_fit(a, b):
     for name in ARRAYS:
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
@@ -44,10 +30,10 @@ def _same_fit(a, b):
         np.testing.assert_array_equal(pa, pb)
 
 
-def test_a_fit_read_back_equals_the_fit(sphere_db, folder):
+def test_a_fit_read_back_equals_the_fit(sphere_db, fit_cache):
     ref = S.fit_state_space(sphere_db)
     made = FC.cached_fit(sphere_db)
-    files = list(folder.glob("*.pkl"))
+    files = list(fit_cache.glob("*.pkl"))
     assert len(files) == 1 and made.report["cache"] == ""
     _same_fit(made, ref)
     assert FC.cached_fit(sphere_db) is made              # the process keeps it
@@ -61,7 +47,7 @@ def test_a_fit_read_back_equals_the_fit(sphere_db, folder):
     # through the spec: HydroSpec.state_space uses it
     FC.clear()
     spec_fit = mfm.load(CONFIGS / "sphere.toml").hydro.state_space(omega_fit=(0.3, 3.0))
-    assert len(list(folder.glob("*.pkl"))) == 2 and spec_fit.report["cache"] == ""
+    assert len(list(fit_cache.glob("*.pkl"))) == 2 and spec_fit.report["cache"] == ""
 
 
 def test_the_key_follows_data_options_and_code(sphere_db, monkeypatch):
@@ -103,9 +89,9 @@ def test_a_database_hashed_once_keys_as_hashed_each_time(sphere_db):
     assert FC.fit_key(other, {}) != FC.fit_key(sphere_db, {}, hashed=hashed)
 
 
-def test_a_damaged_file_is_fitted_again(sphere_db, folder):
-    folder.mkdir()
-    path = folder / f"{FC.fit_key(sphere_db, {})}.pkl"
+def test_a_damaged_file_is_fitted_again(sphere_db, fit_cache):
+    fit_cache.mkdir()
+    path = fit_cache / f"{FC.fit_key(sphere_db, {})}.pkl"
     path.write_bytes(b"not a pickle")
     fit = FC.cached_fit(sphere_db)
     assert fit.report["cache"] == ""
@@ -159,7 +145,7 @@ def test_plain_form_round_trips_every_field(sphere_db):
     assert dict(back.report) == dict(fit.report)
 
 
-def test_memory_and_consistent_added_mass_read_back_equal_what_is_made(folder, monkeypatch):
+def test_memory_and_consistent_added_mass_read_back_equal_what_is_made(fit_cache, monkeypatch):
     # HydroSpec.memory() and its consistent A∞ (hydro.fitcache.cached_value): made once, then
     # read from the folder by a later process (a fresh spec, the process's values forgotten)
     # equal to the last bit without being made again; another rtol is another value
@@ -175,7 +161,7 @@ def test_memory_and_consistent_added_mass_read_back_equal_what_is_made(folder, m
     assert T_K == ref_T
     np.testing.assert_array_equal(A_inf, spec._consistent_added_mass_inf())
     assert not A_inf.flags.writeable
-    assert len(list(folder.glob("*.pkl"))) == 2
+    assert len(list(fit_cache.glob("*.pkl"))) == 2
     FC.clear()
 
     def never(*a, **k):

@@ -160,7 +160,7 @@ class _Table:
 
 
 def _database_grid(sys):
-    from ..frequency.rest import water_of
+    from .rest import water_of
 
     water = water_of(sys.loads)
     if water is None:
