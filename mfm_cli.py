@@ -222,9 +222,9 @@ def main(argv=None):
     import warnings
 
     from mfm.io import cli   # the commands, and with them mfm and jax: only now that there is work
-    from mfm import _gc
+    from mfm.runner import collector as _gc
 
-    _gc.freeze_at_exit()     # the command's objects skip the exit's collections (mfm/_gc.py)
+    _gc.freeze_at_exit()     # the command's objects skip the exit's collections (mfm/runner/collector.py)
 
     formatwarning = warnings.formatwarning
     warnings.formatwarning = cli.format_warnings(args)    # one line, no source path

@@ -121,7 +121,7 @@ def main(argv=None):
     if args.study:
         # the time each part's compiled loop and its tables take, from the threads that run them
         # (blocking on each result there, as simulate_batch's threads do anyway)
-        import mfm.timedomain.batch as batch_mod
+        import mfm.runner.batch as batch_mod
 
         spent = {"stepping": [], "tables": []}
 

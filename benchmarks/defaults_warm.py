@@ -14,8 +14,8 @@ at dt = T_p/200 (20,000 steps), ramp 5 T_p. Rows, each compiled once and then ti
 - ``verlet + state_space_exact``: the fast path.
 
 Beside each, the same call with its outputs made after the time loop instead of beside it
-(in one program, as a run shorter than ``mfm.timedomain.progress.PIPELINE_MIN_SAMPLES`` makes them;
-the pipeline: :func:`mfm.timedomain.progress.run_pipelined`), timed in turn with it,
+(in one program, as a run shorter than ``mfm.runner.progress.PIPELINE_MIN_SAMPLES`` makes them;
+the pipeline: :func:`mfm.runner.progress.run_pipelined`), timed in turn with it,
 and the median of the pairs' ratios (this tree's call / that one); and the compiled time loop
 alone (``mfm.rollout`` with the same loads, nothing recorded): what the rest of the call (the
 loads' preparation, recording every output of every step, the checks, the dataset) adds.
@@ -45,9 +45,9 @@ TP, N = 1.2, 20_000
 @contextlib.contextmanager
 def one_program():
     """simulate's outputs made after its time loop in the same program, not beside it (no
-    pipeline: :data:`mfm.timedomain.progress.PIPELINE_MIN_SAMPLES` raised), for the column that
+    pipeline: :data:`mfm.runner.progress.PIPELINE_MIN_SAMPLES` raised), for the column that
     compares the two."""
-    from mfm.timedomain import progress
+    from mfm.runner import progress
 
     kept = progress.PIPELINE_MIN_SAMPLES
     progress.PIPELINE_MIN_SAMPLES = 2**62

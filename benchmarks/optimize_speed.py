@@ -23,7 +23,7 @@ import warnings
 from pathlib import Path
 
 T_START = time.perf_counter()
-os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded (mfm._xla)
+os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded (mfm.runner.xla)
 ROOT = Path(__file__).resolve().parents[1]
 
 

@@ -28,7 +28,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm._xla)
+os.environ.setdefault("MFM_COMPILATION_CACHE", "off")  # compile times measured, not loaded from disk (mfm.runner.xla)
 os.environ.setdefault("MFM_FIT_CACHE", "off")          # fits too (hydro.fitcache)
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -149,7 +149,7 @@ def child_m4(new, repeats, batch):
         seas = [hydro.Jonswap(hs=h, tp=t, gamma=3.3, seed=1, omega_range=(1.0, 25.0))
                 for h in hss for t in tps]
         res["batch"] = []
-        res["threads"] = sys.modules["mfm.timedomain.batch"].default_threads()
+        res["threads"] = sys.modules["mfm.runner.batch"].default_threads()
         for B in (1, 4, 16, 64, 128):
             ss_b = (seas * 2)[:B]
             dts = np.array([s.tp / 200 for s in ss_b])
@@ -282,7 +282,7 @@ def report(new, old, rev):
              f"ramp=6)` with the defaults**, a fresh process (load, fit, compile, run, dataset): "
              f"{d['wall']:.1f} s without caches ({d['filling']:.1f} s filling them); "
              f"{d['cached']:.1f} s in a later fresh process that loads the compiled programs and "
-             f"the radiation fit from them (`mfm._xla`, `hydro.fitcache`); the same call again in "
+             f"the radiation fit from them (`mfm.runner.xla`, `hydro.fitcache`); the same call again in "
              f"one process {d['warm']:.1f} s. Integrator "
              f"{d['integrator']}; {d['choice']}.\n")
     s = m4["simulate rk4/state_space"]
@@ -352,7 +352,7 @@ def main():
     new = {"rm3": run_child(ROOT, "rm3", True, args.repeats, False),
            "m4": run_child(ROOT, "m4", True, args.repeats, not args.skip_batch)}
     # the defaults call in two fresh processes sharing the caches: the second loads what the
-    # first compiled and fitted (mfm._xla, hydro.fitcache)
+    # first compiled and fitted (mfm.runner.xla, hydro.fitcache)
     with tempfile.TemporaryDirectory() as cache:
         walls = [run_child(ROOT, "defaults", True, 0, False, cache=cache)["wall"] for _ in range(2)]
     new["m4"]["defaults"].update(filling=walls[0], cached=walls[1])

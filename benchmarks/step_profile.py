@@ -233,8 +233,8 @@ def main():
           f"{n} kernels per step ({warm / a.steps * 1e6 / n:.2f} µs per kernel on average)")
     whole = "xla_cpu_small_call" in compiled.as_text()
     print("time loop compiled " + ("whole: one native function, the kernels above are its parts "
-                                   "(mfm._xla)" if whole else "kernel by kernel: each kernel "
-                                   "dispatched on its own (mfm._xla says when and why)"))
+                                   "(mfm.runner.xla)" if whole else "kernel by kernel: each kernel "
+                                   "dispatched on its own (mfm.runner.xla says when and why)"))
     print("kinds: " + ", ".join(f"{k} {v}" for k, v in kinds.most_common()))
     by_file = collections.Counter()
     for k, v in where.items():

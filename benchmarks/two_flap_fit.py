@@ -11,7 +11,7 @@ With the public API only:
    state space and convolution against the database, for the config's PTO and a range of PTOs.
 2. ``mfm.frequency_response(model, ω, radiation=r)`` over a window about the flap modes: the hinge
    RAOs' largest difference from the database's, relative to the database's peak, and the peaks.
-3. ``mfm.timedomain.setup.choose_radiation`` (what ``radiation="auto"`` takes, and why) for a
+3. ``mfm.runner.choices.choose_radiation`` (what ``radiation="auto"`` takes, and why) for a
    3-hour sea state at dt 0.1 s and for the decay run below.
 4. A free decay from ``fore.angle`` = 0.1 rad in still water, ``mfm.simulate`` with the defaults
    (radiation="auto"), radiation="convolution" and radiation="state_space": the hinge angles'
@@ -35,7 +35,7 @@ import numpy as np
 
 import hydro
 import mfm
-from mfm.timedomain.setup import choose_radiation
+from mfm.runner.choices import choose_radiation
 
 warnings.simplefilter("ignore", hydro.database.HydroDatabaseWarning)
 ROOT = Path(__file__).resolve().parents[1]

@@ -2,7 +2,7 @@
 bottom of the package: it imports nothing), and ``mfm`` exports them all.
 
 Errors name the argument or config key, the value, what is accepted and, where there is one, the
-fix. :class:`PerformanceWarning` lives in :mod:`mfm._xla`, which must be imported first of all.
+fix. :class:`PerformanceWarning` lives in :mod:`mfm.runner.xla`, which must be imported first of all.
 """
 from __future__ import annotations
 

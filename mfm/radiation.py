@@ -42,7 +42,7 @@ class AbstractRadiation(abc.ABC):
 class Auto(AbstractRadiation):
     """Time domain: the convolution or the state space, whichever costs less for the run, the
     fit's states integrated where the integrator does that as well as exactly, and the fit judged
-    on the model's modes (:func:`mfm.timedomain.setup.choose_radiation`). ``fit_options``: those of
+    on the model's modes (:func:`mfm.runner.choices.choose_radiation`). ``fit_options``: those of
     the fit where one is taken (:func:`hydro.statespace.fit_state_space`)."""
     fit_options: dict | None = None
     name: ClassVar[str] = "auto"

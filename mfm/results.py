@@ -64,7 +64,7 @@ def provenance(model, loads=(), **settings) -> dict:
     settings (database, sea state, ramp, radiation, fit report), the run's settings, versions."""
     import jax
 
-    from . import _xla
+    from . import backend as _xla
 
     out = {"model": model.name, "config": getattr(model, "source", "") or "none",
            "config_sha256": getattr(model, "source_sha256", "") or "none"}
@@ -75,7 +75,7 @@ def provenance(model, loads=(), **settings) -> dict:
     out.update(settings)
     out.update({"mfm_version": version(), "git_commit": git_commit() or "none",
                 "jax_version": jax.__version__, "numpy_version": np.__version__,
-                # whether XLA compiled the time loop as one function (mfm._xla: speed only)
+                # whether XLA compiled the time loop as one function (mfm.runner.xla: speed only)
                 "xla_time_loop": (f"whole (loops reading up to {_xla.LOOP_THRESHOLD} bytes)"
                                   if _xla.LOOPS_COMPILED_WHOLE else "kernel by kernel"),
                 "xarray_version": xr.__version__,
@@ -248,7 +248,7 @@ def time_series(model, loads, integ, dt, t, q, qd, qdd, iters, rec, settings) ->
 
 def linear_time_series(model, loads, t, q, qd, qdd, q0, eta, settings, source=None,
                        dampers=()) -> xr.Dataset:
-    """The dataset of :func:`mfm.frequency.linear.linear_response`: q, q̇, q̈ (time, coordinate), the power
+    """The dataset of :func:`mfm.runner.linear.linear_response`: q, q̇, q̈ (time, coordinate), the power
     of the joint dampers and of the loads' linearised PTOs (``dampers``,
     :func:`mfm.loads.pto.load_dampers`),
     ``eta`` and the ``equilibrium`` it is linearised about."""
@@ -394,7 +394,7 @@ def frequency(model, loads, omega, x, q0, kin0, heading, settings, extra,
 
 def spectral(model, loads, q0, q_rms, power, ptos, comps, seas, settings, series=None,
              start=None) -> xr.Dataset:
-    """The dataset of :func:`mfm.frequency.spectral.spectral_sweep` over ``case``: ``q_rms``,
+    """The dataset of :func:`mfm.runner.spectral.spectral_sweep` over ``case``: ``q_rms``,
     ``pto_power_mean`` of every PTO (``ptos``: :func:`mfm.loads.pto.linear_ptos`),
     ``n_components`` and ``equilibrium``; with ``series`` = (times, q, qd, eta) the synthesised
     time series and their PTO power c (G q̇)²; the seas' labels; provenance with ``settings``

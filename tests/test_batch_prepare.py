@@ -53,7 +53,7 @@ def test_each_case_gets_the_water_build_water_makes_alone(m4, n_steps):
     in another order), the tables to their round-off bound: a value of Re Σ_j c_j e^{−iω_j t}
     (n_c terms, each made of a few roundings) is off by at most ~10 ε Σ_j |c_j| per column,
     whichever order the sums take."""
-    from mfm.timedomain.batch import _tables
+    from mfm.runner.batch import _tables
 
     seas, dts, ramps = _cases()
     offs = stage_offsets("verlet")

@@ -2,8 +2,8 @@
 again, and the answer is a clean cache's to the bit. Every kind of entry mfm keeps:
 
 - the state-space fit cache's fits and values (hydro.fitcache, ``MFM_FIT_CACHE``);
-- the traced programs (mfm._programs, ``<compilation cache>/mfm-programs``);
-- jax's compilation cache in the folder mfm chooses (mfm._xla: the entries jax writes there).
+- the traced programs (mfm.runner.programs, ``<compilation cache>/mfm-programs``);
+- jax's compilation cache in the folder mfm chooses (mfm.runner.xla: the entries jax writes there).
 
 Before: a flipped bit in a fit's pickle changed the answer silently on every later run; in a
 traced program every later run crashed ("Failed to deserialize StableHLO"); a torn compilation
@@ -29,7 +29,7 @@ from conftest import CONFIGS, ROOT
 
 import mfm
 from hydro import fitcache as FC
-from mfm import _programs, _xla
+from mfm.runner import programs as _programs, xla as _xla
 
 pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 
@@ -196,10 +196,12 @@ def test_mfms_compilation_cache_folder_is_the_sealed_one(tmp_path):
     # the folder mfm chooses gets the sealed cache; one named by jax's own setting stays jax's
     code = (
         "import mfm, jax, jax.numpy as jnp\n"
+        "assert mfm.runner.xla.COMPILATION_CACHE is None  # none at import\n"
+        "mfm.runner.xla.compilation_cache()               # the first front door's\n"
         "jax.config.update('jax_persistent_cache_min_compile_time_secs', 0)\n"
         "jax.jit(lambda x: jnp.sin(x) * 2)(jnp.arange(3.0)).block_until_ready()\n"
         "from jax._src import compilation_cache as cc\n"
-        "print(type(cc._cache).__name__, mfm._xla.COMPILATION_CACHE)\n")
+        "print(type(cc._cache).__name__, mfm.runner.xla.COMPILATION_CACHE)\n")
     env = {k: v for k, v in os.environ.items() if k != "JAX_COMPILATION_CACHE_DIR"}
     env.update(PYTHONPATH=str(ROOT), MFM_COMPILATION_CACHE=str(tmp_path / "mine"))
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,

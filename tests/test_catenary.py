@@ -654,36 +654,37 @@ def test_moordyn_slow_limit_is_the_quasi_static_line(lines):
 def test_tables_are_kept_on_disk_and_read_back_bit_for_bit(monkeypatch, tmp_path):
     """A table made once is read back by a later process (here: the process's table forgotten)
     without MoorPy, the same bits; another line, or the cache off, makes its own."""
-    from mfm.loads import catenary_tables as tables
+    from mfm.loads import catenary_tables as maker
+    from mfm.runner import tables
 
     monkeypatch.setenv("MFM_FIT_CACHE", str(tmp_path))
     monkeypatch.setattr(tables, "_TABLE_CACHE", {})
     calls = []
-    real = tables.catenary_forces
-    monkeypatch.setattr(tables, "catenary_forces", lambda *a: calls.append(a) or real(*a))
+    real = maker.catenary_forces
+    monkeypatch.setattr(maker, "catenary_forces", lambda *a: calls.append(a) or real(*a))
     args = (775.5, 75.0, (2.0, 1.0), (1.0, 1.0), 800.0, 1.243e9, 2972.43, 0.0)
-    made = tables.build_table(*args)
+    made = tables.mooring_table(*args)
     n = len(calls)
     assert n == 5 * 4 and len(list((tmp_path / "mooring-tables").glob("*.npz"))) == 1
     monkeypatch.setattr(tables, "_TABLE_CACHE", {})          # as a new process finds it
-    again = tables.build_table(*args)
+    again = tables.mooring_table(*args)
     assert len(calls) == n                                     # MoorPy not called
     for a, b in zip(made, again):
         np.testing.assert_array_equal(a, b)
-    tables.build_table(*args[:4], 801.0, *args[5:])          # another length: its own table
+    tables.mooring_table(*args[:4], 801.0, *args[5:])          # another length: its own table
     assert len(calls) == 2 * n and len(list((tmp_path / "mooring-tables").glob("*.npz"))) == 2
     # a damaged file is made again
     for p in (tmp_path / "mooring-tables").glob("*.npz"):
         p.write_bytes(b"not a table")
     monkeypatch.setattr(tables, "_TABLE_CACHE", {})
-    np.testing.assert_array_equal(tables.build_table(*args)[2], made[2])
+    np.testing.assert_array_equal(tables.mooring_table(*args)[2], made[2])
     assert len(calls) == 3 * n
     monkeypatch.setenv("MFM_FIT_CACHE", "off")
     monkeypatch.setattr(tables, "_TABLE_CACHE", {})
-    tables.build_table(*args)
+    tables.mooring_table(*args)
     assert len(calls) == 4 * n
     # lines of one geometry whose spans differ in the last digits of their positions share it
-    tables.build_table(775.5000009, 75.0000004, *args[2:])
+    tables.mooring_table(775.5000009, 75.0000004, *args[2:])
     assert len(calls) == 4 * n
 
 
@@ -691,7 +692,7 @@ def test_load_says_how_far_its_mooring_table_is(tmp_path, monkeypatch, capsys):
     # mfm.load(progress=...) shows what the load does; a mooring table it must make says its
     # MoorPy solves as they go (Wu & Yuan's 2,511: ~7 s where the cache is empty). A table of
     # 5 spans × 4 heights (table_extent [2, 1] m, table_step [1, 1] m: _axis keeps ≥ 4 nodes)
-    from mfm.loads import catenary_tables as tables
+    from mfm.runner import tables
 
     monkeypatch.setenv("MFM_FIT_CACHE", "off")              # no table from an earlier run
     monkeypatch.setattr(tables, "_TABLE_CACHE", {})

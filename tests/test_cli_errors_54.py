@@ -151,7 +151,7 @@ def test_bad_option_values_exit_with_the_documented_status(argv, says, tmp_path,
 
 def _mfm(*argv, timeout=300):
     # Python's default warning filters, as a user's shell has them (PYTHONWARNINGS=default would
-    # add the ResourceWarnings of mfm.timedomain.checks.usable_memory's unclosed /proc files)
+    # add the ResourceWarnings of mfm.runner.checks.usable_memory's unclosed /proc files)
     env = {k: v for k, v in os.environ.items() if k != "PYTHONWARNINGS"}
     return subprocess.run([sys.executable, "-m", "mfm", *argv], capture_output=True, text=True,
                           cwd=ROOT, env=env, timeout=timeout)

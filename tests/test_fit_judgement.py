@@ -72,10 +72,10 @@ def test_auto_takes_the_convolution_where_the_fit_fails(rm3, monkeypatch):
     radiation="convolution") and says why in radiation_choice and the fit_* attributes; a fit
     that passes keeps the state space. The convolution's work limit is lowered so that this short
     run takes the state space first."""
-    from mfm.timedomain import setup
+    from mfm.runner import choices
 
     model, _ = rm3
-    monkeypatch.setattr(setup, "AUTO_CONVOLUTION_LIMIT", 0.0)
+    monkeypatch.setattr(choices, "AUTO_CONVOLUTION_LIMIT", 0.0)
     run = dict(duration=30.0, dt=0.1, q0={"spar.heave": 0.3}, check_stability=True)
     poor = mfm.simulate(model, state_space_options={"order": 2}, **run)
     assert poor.attrs["radiation_choice"].endswith("the convolution instead"), \
@@ -85,7 +85,7 @@ def test_auto_takes_the_convolution_where_the_fit_fails(rm3, monkeypatch):
     conv = mfm.simulate(model, radiation="convolution", **run)
     np.testing.assert_array_equal(poor.q.values, conv.q.values)
     # the default fit passes: choose_radiation makes the same judgement without running
-    name, why = setup.choose_radiation(model, dt=0.1, n_steps=300)
+    name, why = choices.choose_radiation(model, dt=0.1, n_steps=300)
     assert name == "state_space" and "the fit matches the database" in why, why
 
 

@@ -229,18 +229,19 @@ def test_values_only_stores_no_fit(sphere, fresh):
 def test_a_stored_mooring_table_is_read_without_moorpy(sphere, fresh, monkeypatch, tmp_path):
     """``mfm fits`` stores a config's mooring tables too (a first run then neither imports
     MoorPy nor solves): read back, the same bits; another code's table is dropped."""
-    from mfm.loads import catenary_tables as tables
+    from mfm.loads import catenary_tables as maker
+    from mfm.runner import tables
 
     cfg, db_path = sphere
     monkeypatch.setattr(tables, "_TABLE_CACHE", {})
     args = (775.5, 75.0, (2.0, 1.0), (1.0, 1.0), 800.0, 1.243e9, 2972.43, 0.0)
     with FC.recording() as made:
-        table = tables.build_table(*args, stored=str(db_path))
+        table = tables.mooring_table(*args, stored=str(db_path))
     items = {key: item for (_, key), item in made.items()}
     assert [kind for kind, _ in items.values()] == ["table"]
     with pytest.raises(ValueError, match="sources="):
         FS.store(db_path, items)                 # hydro cannot judge mfm's code
-    FS.store(db_path, items, sources={"table": tables.table_source()})
+    FS.store(db_path, items, sources={"table": maker.table_source()})
     assert list(FS.stored(db_path).values()) == ["table"]
     monkeypatch.setattr(tables, "_TABLE_CACHE", {})
     shutil.rmtree(tmp_path / "empty-fit-cache")  # on another machine
@@ -248,8 +249,8 @@ def test_a_stored_mooring_table_is_read_without_moorpy(sphere, fresh, monkeypatc
     def moorpy(*a, **k):
         raise AssertionError("MoorPy called: the stored table was not read")
 
-    monkeypatch.setattr(tables, "catenary_forces", moorpy)
-    again = tables.build_table(*args, stored=str(db_path))
+    monkeypatch.setattr(maker, "catenary_forces", moorpy)
+    again = tables.mooring_table(*args, stored=str(db_path))
     for a, b in zip(table, again):
         assert a.shape == b.shape and np.array_equal(a.view(np.uint64), b.view(np.uint64))
     FS.store(db_path, {}, sources={"table": "0" * 64})   # made by other code: dropped

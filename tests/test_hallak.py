@@ -19,10 +19,10 @@ import pytest
 import hydro
 import mfm
 from conftest import CONFIGS
-from mfm.frequency import (critical_damping, cubic_natural_frequencies, linear_system,
-                           natural_frequencies)
+from mfm import natural_frequencies
+from mfm.frequency import critical_damping, cubic_natural_frequencies, linear_system
 from mfm.frequency.response import _mass_and_damping_at
-from mfm.timedomain.setup import choose_radiation
+from mfm.runner.choices import choose_radiation
 
 RHO, G = 1000.0, 9.80665
 OMEGA = np.round(0.19 + 0.03 * np.arange(48), 2)      # Table 4 (index 46: 1.54, printed 1.55)

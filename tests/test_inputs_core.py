@@ -129,7 +129,7 @@ def test_a_run_that_cannot_fit_is_refused_before_any_work(rm3, monkeypatch):
     # model and refused at once, with the estimate and the ways out
     import time
 
-    from mfm.timedomain import checks
+    from mfm.runner import checks
 
     start = time.perf_counter()
     with pytest.raises(ValueError, match=r"duration: 1e\+16 steps would hold about .* GB before "
@@ -155,7 +155,7 @@ def test_the_memory_check_meets_a_container_s_limit(tmp_path, monkeypatch):
     """Issue 54 item 17: the limit is what the process may use, not the machine's memory: a
     control group's memory.max less its memory.current (cgroup v2; v1's files likewise), read
     under a root the test lays out. A 1.5 GB limit with 0.3 GB in use leaves 1.2 GB."""
-    from mfm.timedomain import checks
+    from mfm.runner import checks
 
     cg = tmp_path / "sys/fs/cgroup"
     cg.mkdir(parents=True)
@@ -286,7 +286,7 @@ def test_a_sea_outside_the_database_is_refused_naming_the_sea(rm3):
     database's grid (RM3: 0.02–5.2 rad/s) is refused by spectral_response and spectral_sweep,
     naming the sea (not an ``omega`` the caller never passed), the share of its energy outside and
     the fix; the same sea cut to the grid runs."""
-    from mfm.frequency.spectral import spectral_sweep
+    from mfm.runner.spectral import spectral_sweep
 
     wide = hydro.Jonswap(hs=2.0, tp=8.0, omega_range=(0.3, 8.0))
     with pytest.raises(ValueError, match=r"^sea: JONSWAP Hs 2 m, Tp 8 s.* of its 200 wave "

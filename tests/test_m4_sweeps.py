@@ -20,7 +20,7 @@ from hydro import vectorfit as VF
 from hydro.waves import elevation
 from mfm.studies import wec
 from mfm.studies.fidelity import reduce, variant_model
-from mfm.frequency.spectral import spectral_response
+from mfm.runner.spectral import spectral_response
 from hydro.prepare import modal_form
 from mfm.loads.water import build_water
 
@@ -378,7 +378,7 @@ def test_spectral_sweep_errors(m111):
         mfm.sweep(m111, [sea, "jonswap"], level="spectral")
     with pytest.raises(ValueError, match="dt, n_steps"):
         mfm.sweep(m111, [sea])
-    from mfm.frequency.spectral import spectral_sweep
+    from mfm.runner.spectral import spectral_sweep
     with pytest.raises(ValueError, match="t: shape"):
         spectral_sweep(m111, [sea, sea], t=np.zeros((3, 4)))
     with pytest.raises(ValueError, match="empty"):
@@ -477,7 +477,7 @@ def test_linear_level_is_exact_for_a_force_linear_in_time():
     # a mass–spring–damper from rest to round-off (1e-10 of the response), at a step (0.3 s) near
     # the natural period (2 s) that no explicit integrator would take; and of a free mass with a
     # damper (K = 0: its position left out of the modes and integrated exactly from the velocity)
-    from mfm.frequency.linear import lti_response
+    from mfm.runner.linear import lti_response
 
     m, c, k, F, dt = 3.0, 1.2, 3.0 * math.pi**2, 2.0, 0.3
     t = dt * np.arange(201)
@@ -500,7 +500,7 @@ def test_linear_level_harmonic_force_error_is_the_hold():
     # the closed form is (ωh)²/12 of the amplitude: 1.3e-3 at T/50, a quarter of it at T/100
     # (second order, the level's only error); with the transient from rest (the force's start
     # held too), measured 1.5× that
-    from mfm.frequency.linear import lti_response
+    from mfm.runner.linear import lti_response
 
     m, c, k, F = 2.0, 0.8, 50.0, 1.0
     w = 4.0
@@ -524,7 +524,7 @@ def test_linear_level_against_spectral_synthesis(m111):
     # periods) each non-free coordinate equals the spectral synthesis to the hold's (ωh)²/12 of
     # the amplitude (measured 1.3166e-3 against 1.3159e-3 at T/50) and the mean PTO power to twice
     # that; surge (free, no restoring) keeps the start-up's drift and is not compared.
-    from mfm.frequency.linear import linear_response
+    from mfm.runner.linear import linear_response
 
     T, n = 1.6, 50
     sea = hydro.Regular(height=0.04, period=T)
@@ -552,7 +552,7 @@ def test_linear_level_against_spectral_synthesis(m111):
 
 
 def test_linear_level_errors(m111):
-    from mfm.frequency.linear import linear_response
+    from mfm.runner.linear import linear_response
 
     sea = hydro.Regular(height=0.04, period=1.0)
     with pytest.raises(ValueError, match="save_every"):

@@ -318,12 +318,10 @@ def test_help_and_version_import_neither_mfm_nor_jax():
     assert r.returncode == 0, r.stderr
     assert "mfm 0." in r.stdout or "mfm unknown" in r.stdout
     assert "--no-plot" in r.stdout
-    # the old entry point (mfm.cli.main, a moved path that warns once) is the same function
-    import mfm_cli
-
-    with pytest.warns(FutureWarning, match="mfm_cli.main"):
-        from mfm.cli import main as old_main
-    assert old_main is mfm_cli.main
+    # `python -m mfm.cli` is the command too (mfm/cli.py, a real module: runpy finds its spec)
+    r = subprocess.run([sys.executable, "-m", "mfm.cli", "--version"], capture_output=True,
+                       text=True, timeout=120, cwd=ROOT)
+    assert r.returncode == 0 and r.stdout.strip(), r.stderr
 
 
 @pytest.mark.parametrize("argv, match", [
@@ -519,7 +517,7 @@ def _same_numbers(a, b):
 
 
 def test_chunk_plan_one_length_few_blocks_wasted():
-    from mfm.timedomain.progress import chunk_plan
+    from mfm.runner.progress import chunk_plan
 
     assert chunk_plan(7) == (1, 7)
     for n in (21, 100, 211, 2000, 20000, 99991):
@@ -586,7 +584,7 @@ def test_progress_bar_keeps_a_diverging_run_and_a_batch_exact(capsys):
 def test_a_pipelined_run_gives_the_bits_of_one_program(monkeypatch):
     """A run that saves 10,000 samples or more and makes its outputs apart from its steps is made
     in chunks, each chunk's outputs on a second thread as the next chunk steps
-    (mfm.timedomain.progress.run_pipelined): 12,000 RK4 steps in 5 chunks of 2,400 without a bar
+    (mfm.runner.progress.run_pipelined): 12,000 RK4 steps in 5 chunks of 2,400 without a bar
     and 75 of 160 under one, every chunk the same two compiled programs (traced once each: a
     chunk length no other test uses). The chunks are multiples of the outputs' group width (32),
     so that each sample's outputs are made in the place of its group they have in the run made
@@ -595,7 +593,7 @@ def test_a_pipelined_run_gives_the_bits_of_one_program(monkeypatch):
     A diverging run stops in the chunk where it goes non-finite, with the error and partial
     dataset of the run made in one program."""
     import mfm
-    from mfm.timedomain import progress
+    from mfm.runner import progress
     from mfm.timedomain.record import DEFERRED_RECORD_WIDTH as W
     from mfm.timedomain.rollout import TRACES
 
@@ -617,7 +615,7 @@ def test_a_pipelined_run_gives_the_bits_of_one_program(monkeypatch):
     # its lowest level): the same comparison in a process that compiles as users do
     script = (
         "import numpy as np, mfm\n"
-        "from mfm.timedomain import progress\n"
+        "from mfm.runner import progress\n"
         "m = mfm.load(%r)\n"
         "kw = dict(duration=120.0, dt=0.01, q0={'upper.angle': 0.5})\n"
         "a = mfm.simulate(m, **kw)\n"

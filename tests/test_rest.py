@@ -106,35 +106,13 @@ def mfm_root():
     return ROOT
 
 
-def test_old_import_paths_work_and_warn_once_with_the_new_name():
-    from mfm import _compat
-
-    _compat._warned.clear()
-    with pytest.warns(_compat.MovedWarning, match=r"mfm\.simulate\.model_loads has moved to "
-                                                  r"mfm\.timedomain\.setup\.model_loads"):
-        from mfm.simulate import model_loads
-    assert model_loads is mfm.model_loads
-    assert callable(mfm.simulate)                        # the function, not the old module
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")                   # once: the second use is silent
-        from mfm.simulate import model_loads as again    # noqa: F401
-    with pytest.warns(_compat.MovedWarning, match=r"mfm\.stability\.largest_stable_dt"):
-        assert mfm.stability.largest_stable_dt is mfm.studies.stability.largest_stable_dt
-    with pytest.warns(_compat.MovedWarning, match=r"hydro\.prepare\.HydroSpec"):
-        from mfm.water import HydroSpec
-    assert HydroSpec is importlib.import_module("hydro.prepare").HydroSpec
-    with pytest.warns(_compat.MovedWarning, match=r"mfm\.frequency\.rest\.linearise_lines"):
-        from mfm.loads.catenary import linearise_lines
-    assert linearise_lines is rest.linearise_lines
-    # a private helper renamed on the way is found under its new name
-    with pytest.warns(_compat.MovedWarning, match=r"mfm\.timedomain\.rollout\.rollout_jit"):
-        from mfm.simulate import _rollout_jit  # noqa: F401
-    with pytest.raises(AttributeError, match="it moved: look in"):
-        importlib.import_module("mfm.simulate").no_such_name
+def test_old_import_paths_are_gone():
+    """The flat module paths of before the house layout (mfm.water, mfm.stability, ...) were
+    dropped (CHANGELOG.md): the stand-ins that kept them were planted in sys.modules at import.
+    ``mfm.simulate`` is the function; an old module fails to import as any missing module."""
+    assert callable(mfm.simulate)
+    for old in ("mfm.water", "mfm.stability", "mfm.se3", "mfm._compat"):
+        with pytest.raises(ModuleNotFoundError):
+            importlib.import_module(old)
     with pytest.raises(AttributeError, match="no attribute 'no_such_module'"):
         mfm.no_such_module
-    # the front door's names need no warning
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        assert mfm.integrators.get("rk4").name == "rk4"
-        from mfm.integrators import Verlet  # noqa: F401

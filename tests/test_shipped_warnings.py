@@ -21,7 +21,7 @@ import pytest
 
 import mfm
 from hydro.database import HydroDatabaseWarning
-from mfm.timedomain.setup import convolution_or_state_space
+from mfm.runner.choices import convolution_or_state_space
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 WET = sorted(p for p in [*CONFIGS.glob("*.toml"), *CONFIGS.glob("sensitivity/*.toml")]

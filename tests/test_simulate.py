@@ -70,8 +70,8 @@ def test_auto_radiation_takes_the_cheaper_and_says_why():
     # state space's states are integrated by RK4 where its error in the fitted modes is ≤ 1e-3
     # (M4 134 at dt 0.006: poles to |p| dt 0.09, ~2e-5), advanced exactly by Verlet (no
     # amplification factor declared) and by RK4 at a step too coarse for its poles.
-    from mfm.timedomain.setup import (AUTO_CONVOLUTION_LIMIT, STATE_SPACE_TOLERANCE,
-                                      choose_radiation)
+    from mfm.runner.choices import (AUTO_CONVOLUTION_LIMIT, STATE_SPACE_TOLERANCE,
+                                    choose_radiation)
 
     m4 = mfm.load(CONFIGS / "m4_134.toml")
     name, why = choose_radiation(m4, dt=0.006, n_steps=20_000)
@@ -100,7 +100,7 @@ def test_integrated_state_error_bounds_the_modes_response(p):
     R(p dt) and a = e^{p dt}, on a dense grid of ω around the mode: the largest relative
     difference equals the bound to first order in it (within 5 %)."""
     from mfm.timedomain.integrators import RK4
-    from mfm.timedomain.setup import integrated_state_error
+    from mfm.runner.choices import integrated_state_error
 
     dt = 0.15 / abs(p)                           # |p| dt = 0.15: the bound ~1e-4 to 1e-3
     bound = integrated_state_error(RK4.amplification, np.array([p * dt]))
@@ -124,9 +124,9 @@ def test_auto_runs_the_state_space_it_chose(monkeypatch):
     """radiation="auto" takes what choose_radiation says (here the integrated state space, the
     convolution limit set to 0 so that a short RM3 run takes the state space) and runs it: the
     same q to the last bit as radiation="state_space", the choice and why in the result."""
-    from mfm.timedomain import setup
+    from mfm.runner import choices
 
-    monkeypatch.setattr(setup, "AUTO_CONVOLUTION_LIMIT", 0.0)
+    monkeypatch.setattr(choices, "AUTO_CONVOLUTION_LIMIT", 0.0)
     m = mfm.load(CONFIGS / "rm3.toml")
     sea = hydro.Regular(height=1.0, period=8.0)
     kw = dict(duration=4.0, dt=0.1, ramp=2.0)

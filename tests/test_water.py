@@ -10,7 +10,7 @@ from conftest import CONFIGS, ROOT
 import hydro
 from hydro.prepare import HydroSpec
 import mfm
-from mfm.frequency import equilibrium, frequency_response, natural_frequencies
+from mfm import equilibrium, frequency_response, natural_frequencies
 
 # per module, not session-wide: a database warning is expected here (the shipped BEM data)
 pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")

@@ -1,4 +1,4 @@
-"""The time loop compiled as one function (mfm._xla): the option reaches XLA, the rollout's loop
+"""The time loop compiled as one function (mfm.runner.xla): the option reaches XLA, the rollout's loop
 qualifies, and the numbers are those of XLA's kernel-by-kernel runtime."""
 import json
 import os
@@ -13,7 +13,9 @@ import hydro
 import jax
 import mfm
 from hydro import fitcache
-from mfm import _xla, integrators
+from mfm import integrators
+from mfm import backend as _backend
+from mfm.runner import xla as _xla
 from mfm.timedomain.rollout import rollout_jit
 from mfm.timedomain.setup import model_loads
 
@@ -23,15 +25,15 @@ N_STEPS = 300
 
 
 def test_the_option_is_added_to_xla_flags_once():
-    opt = _xla.OPTION
-    assert _xla.with_loop_option("", 5) == f"--xla_backend_extra_options={opt}=5"
-    assert (_xla.with_loop_option("--xla_backend_optimization_level=0", 5)
+    opt = _backend.OPTION
+    assert _backend.with_loop_option("", 5) == f"--xla_backend_extra_options={opt}=5"
+    assert (_backend.with_loop_option("--xla_backend_optimization_level=0", 5)
             == f"--xla_backend_optimization_level=0 --xla_backend_extra_options={opt}=5")
     # XLA keeps one map of extra options: the option joins an existing flag, comma-separated
-    assert (_xla.with_loop_option("--xla_backend_extra_options=a=1 --x=2", 5)
+    assert (_backend.with_loop_option("--xla_backend_extra_options=a=1 --x=2", 5)
             == f"--xla_backend_extra_options=a=1,{opt}=5 --x=2")
     mine = f"--xla_backend_extra_options={opt}=1024"
-    assert _xla.with_loop_option(mine, 5) == mine           # the user's setting wins
+    assert _backend.with_loop_option(mine, 5) == mine           # the user's setting wins
 
 
 def _rm3_rollout_script(n_steps):
@@ -52,7 +54,7 @@ for x in jax.tree_util.tree_leaves((m, loads)):
 q, qd = mfm.rollout(m, q0, q0, dt=0.1, n_steps={n_steps}, integrator="verlet", loads=loads,
                     save_every={n_steps})[1:3]
 print(json.dumps({{"q": [float(x) for x in q.reshape(-1)], "qd": [float(x) for x in qd.reshape(-1)],
-                  "whole": mfm._xla.LOOPS_COMPILED_WHOLE, "inputs": h.hexdigest()}}))
+                  "whole": mfm.backend.LOOPS_COMPILED_WHOLE, "inputs": h.hexdigest()}}))
 """
 
 
@@ -68,7 +70,7 @@ def test_the_rollout_loop_is_compiled_whole(rm3):
     """Guards the speed of the time step: an op the small-loop pass refuses (a scatter, a custom
     call) in a load's time step would silently bring back the kernel-by-kernel loop (2x slower
     for M4 134)."""
-    assert _xla.LOOPS_COMPILED_WHOLE, os.environ.get("XLA_FLAGS")
+    assert _backend.LOOPS_COMPILED_WHOLE, os.environ.get("XLA_FLAGS")
     m, loads = rm3
     q0 = jnp.zeros(m.n_coordinates)
     z0 = jnp.concatenate([ld.initial_state(m) for ld in loads])
@@ -178,8 +180,8 @@ def test_compiled_whole_gives_the_kernel_by_kernel_numbers(rm3, tmp_path, monkey
     here = {}
     exec(_rm3_rollout_script(N_STEPS).replace("print(json.dumps(", "here.update(("), {"here": here})
     assert here["whole"] is True
-    env = dict(os.environ, XLA_FLAGS=_xla.with_loop_option(
-        os.environ.get("XLA_FLAGS", "").replace(f"{_xla.OPTION}={_xla.LOOP_THRESHOLD}", ""), 1024))
+    env = dict(os.environ, XLA_FLAGS=_backend.with_loop_option(
+        os.environ.get("XLA_FLAGS", "").replace(f"{_backend.OPTION}={_backend.LOOP_THRESHOLD}", ""), 1024))
     out = subprocess.run([sys.executable, "-c", _rm3_rollout_script(N_STEPS)], env=env, cwd=ROOT,
                          capture_output=True, text=True, timeout=600)
     assert out.returncode == 0, out.stderr[-2000:]
@@ -202,11 +204,14 @@ hits = []
 jax.monitoring.register_event_listener(
     lambda name, **kw: hits.append(1) if name == "/jax/compilation_cache/cache_hits" else None)
 import mfm
+at_import = jax.config.jax_compilation_cache_dir          # import mfm sets no cache
+mfm.runner.xla.compilation_cache()                        # what the first front door does
 jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)   # RM3 compiles fast
 here = {{"q": None, "qd": None}}
 if RUN:
     exec({_rm3_rollout_script(20)!r}.replace("print(json.dumps(", "here.update(("), {{"here": here}})
 print(json.dumps({{"dir": jax.config.jax_compilation_cache_dir, "hits": len(hits),
+                  "at_import": at_import,
                   "q": here["q"], "qd": here["qd"]}}))
 """
 
@@ -230,6 +235,7 @@ def test_compiled_programs_are_kept_on_disk_and_loaded_by_a_later_process(tmp_pa
     folder = tmp_path / "cache"
     first = _child({_xla.CACHE_ENV: str(folder)}, run=True)
     assert first["dir"] == str(folder) and any(folder.iterdir())
+    assert first["at_import"] is None                   # import mfm turns no cache on
     second = _child({_xla.CACHE_ENV: str(folder)}, run=True)
     assert second["hits"] > first["hits"]
     assert second["q"] == first["q"] and second["qd"] == first["qd"]
@@ -252,7 +258,7 @@ def test_wide_products_are_made_column_by_column_and_keep_the_loop_whole():
 
     if jax.default_backend() != "cpu":
         pytest.skip("the column form is the CPU's (a GPU keeps the multiply–reduce)")
-    assert _xla.LOOPS_COMPILED_WHOLE
+    assert _backend.LOOPS_COMPILED_WHOLE
     rng = np.random.default_rng(7)
     cases = [((75, 75), (75, 18), False, True), ((24, 24), (24, 7), False, False),
              ((32, 32), (32, 8), False, False), ((32, 32), (32, 9), False, True),   # 8,192 | 9,216

@@ -137,7 +137,7 @@ def run_level(model, sea, level, settings, ss_options=None):
 
     def go():
         if red is None:
-            from mfm.frequency.linear import linear_response
+            from mfm.runner.linear import linear_response
             return linear_response(model, sea, duration=duration, dt=dt, ramp=ramp,
                                    state_space_options=ss_options)
         return red.run(model, sea, duration=duration)
@@ -163,7 +163,7 @@ def measure(ds, settings):
 def expected(model, sea, coordinates):
     """The spectral level's expected statistics (no time series): mean power per PTO, std per
     coordinate, in the keys of mfm.studies.fidelity._measures."""
-    from mfm.frequency.spectral import spectral_response
+    from mfm.runner.spectral import spectral_response
 
     ds = spectral_response(model, sea)
     out = {f"pto_power[{p}]": float(ds.pto_power_mean.sel(pto=p)) for p in ds.pto.values}

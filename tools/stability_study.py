@@ -250,7 +250,7 @@ def longrun(which=None):
     out = json.loads(path.read_text()) if path.exists() else {}
     for name, case in _long_cases().items():
         model = mfm.load(ROOT / "configs" / case["config"])
-        free = importlib.import_module("mfm.timedomain.simulation").no_restoring(model)
+        free = importlib.import_module("mfm.frequency.rest").no_restoring(model)
         for setting, options in LONG_SETTINGS.items():
             key = f"{name} {setting}"
             if which and key not in which:

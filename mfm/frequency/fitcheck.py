@@ -2,7 +2,7 @@
 the sea, with the fit's A(ω), B(ω) against the same with the database's.
 
 A state-space fit is judged by how well it matches its database over a band (its ``overall_error``)
-and by how well an integrator advances it (:func:`mfm.timedomain.setup.state_space_update`).
+and by how well an integrator advances it (:func:`mfm.runner.choices.state_space_update`).
 Neither says what it does to *this model*: a fit that is 1 % off on average can still move two
 closely spaced coupled modes of hinged bodies onto one frequency and damp one of them several
 times too much (a three-body flap device: modes at 13.81 and 14.28 s merged at 13.97 s, the

@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import NamedTuple
 
 import numpy as np
 
-from .. import results
 from ..radiation import label as radiation_label
 from ..loads import body_matrix
 from ..loads.base import MODES
@@ -20,8 +20,20 @@ from .rest import linear_system
 from ..validation import check_model
 
 
-def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: int = 30,
-                        loads=None, radiation: str = "database"):
+class NaturalModes(NamedTuple):
+    """The numbers of :func:`natural_modes` (the dataset of :func:`mfm.natural_frequencies`)."""
+    loads: tuple            # the loads of the linearisation
+    eigen: np.ndarray       # (mode,) rad/s
+    modes: np.ndarray       # (coordinate, mode)
+    damping_ratio: np.ndarray
+    radiation_damping_ratio: np.ndarray
+    min_det: np.ndarray     # (root,) rad/s
+    settings: dict
+    min_det_damped: np.ndarray
+
+
+def natural_modes(model: Model, omega_grid=None, *, q0=None, iterations: int = 30,
+                  loads=None, radiation: str = "database") -> NaturalModes:
     """Natural frequencies (rad/s) and damping ratios, two ways.
 
     eigen: the generalised eigenproblem K φ = ω² M(ω) φ, M(ω) = M + Hᵀ(A(ω) − A∞)H, iterated on ω
@@ -41,9 +53,10 @@ def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: i
     damping_ratio: φᵀ C φ / (2 ω φᵀ M(ω) φ) of each mode for the linear damping C (joint dampers,
         hydraulic β, body matrices); radiation_damping_ratio the same with Hᵀ B(ω) H.
 
-    Returns an xarray.Dataset: ``eigen``, ``period``, ``damping_ratio``,
-    ``radiation_damping_ratio``, ``damped`` (mode), ``modes`` (coordinate, mode), ``min_det``
-    (root), ``min_det_damped`` (root_damped); it reads like the former dict (``nat["eigen"]``).
+    Returns :class:`NaturalModes`; :func:`mfm.natural_frequencies` returns them as an
+    xarray.Dataset: ``eigen``, ``period``, ``damping_ratio``, ``radiation_damping_ratio``,
+    ``damped`` (mode), ``modes`` (coordinate, mode), ``min_det`` (root), ``min_det_damped``
+    (root_damped); it reads like the former dict (``nat["eigen"]``).
     """
     model = check_model(model)
     if omega_grid is not None:
@@ -118,9 +131,9 @@ def natural_frequencies(model: Model, omega_grid=None, *, q0=None, iterations: i
             mins.append(grid[i] + (0.5 * h * (y0 - y2) / den if den > 0 else 0.0))
     mins_damped = _damped_minima(model, sys, grid, stiff, free, options)
     modes = np.array(modes).T if modes else np.zeros((model.n_coordinates, 0))
-    return results.natural(model, sys.loads, np.array(freqs), modes, np.array(zeta),
-                           np.array(zeta_rad), np.array(mins), {"radiation": radiation_label(radiation)},
-                           min_det_damped=np.array(mins_damped))
+    return NaturalModes(sys.loads, np.array(freqs), modes, np.array(zeta), np.array(zeta_rad),
+                        np.array(mins), {"radiation": radiation_label(radiation)},
+                        np.array(mins_damped))
 
 
 def _eig_pair(K, M):

@@ -19,12 +19,13 @@ points follow from the same Jacobians. Quadratic drag has zero slope at rest (it
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .. import _programs, results
+from .. import host
 from ..radiation import label as radiation_label
 from ..loads.assembly import applied_loads, compile_view, state_offsets
 from ..loads.base import Context
@@ -95,8 +96,8 @@ def _reaction_derivatives(model, loads, q0):
 def _joint_reactions(model, sys, omega, heading, options, x):
     """(static (n, 6), complex amplitudes (n_ω, n, 6)): see :func:`joint_reactions`."""
     args = (*compile_view(model, sys.loads), jnp.asarray(sys.q0, jnp.float64))
-    # run once per call: compiled for a fast compilation, and kept on disk (mfm._programs)
-    derivatives = _programs.program(_reaction_derivatives, "reaction_derivatives", args, once=True)
+    # run once per call: the host may compile it for a fast compilation and keep it
+    derivatives = host.current().program(_reaction_derivatives, "reaction_derivatives", args, once=True)
     static, (Jq, Jv, Ja) = jax.tree_util.tree_map(np.asarray, derivatives(*args))
     w = omega[:, None, None, None]
     D = Jq[None] - 1j * w * Jv[None] - w**2 * Ja[None]           # (n_ω, n, 6, n_q)
@@ -164,9 +165,22 @@ def joint_reactions(model: Model, omega, x, *, heading: float = 0.0, q0=None, lo
     return _joint_reactions(model, sys, omega, float(heading), options, x)
 
 
-def frequency_response(model: Model, omega, heading: float = 0.0, *, q0=None,
-                       radiation: str = "database", state_space_options: dict | None = None,
-                       loads=None, joint_reactions: bool = True):
+class Raos(NamedTuple):
+    """The numbers of :func:`solve_raos` (the dataset of :func:`mfm.frequency_response`)."""
+    loads: tuple            # the loads of the linearisation
+    omega: np.ndarray       # (n_ω,) rad/s
+    x: np.ndarray           # (n_ω, n_coordinates) complex, per metre of wave amplitude
+    q0: np.ndarray
+    kin0: object            # the kinematics at q0
+    heading: float
+    settings: dict
+    extra: list             # the loads' own outputs
+    reactions: tuple | None
+
+
+def solve_raos(model: Model, omega, heading: float = 0.0, *, q0=None,
+               radiation: str = "database", state_space_options: dict | None = None,
+               loads=None, joint_reactions: bool = True) -> Raos:
     """Complex RAOs (per metre of wave amplitude, x(t) = Re[x̂ e^{−iωt}]) of every coordinate,
     body (CoM displacement and small rotation, inertial axes), hydro dof and PTO, with the absorbed
     power per unit wave amplitude squared, from the model linearised about its equilibrium with
@@ -178,7 +192,8 @@ def frequency_response(model: Model, omega, heading: float = 0.0, *, q0=None,
     models, "convolution" or "state_space" (:mod:`mfm.loads.radiation`); ``state_space_options``
     as given to :func:`mfm.simulate` (the same options give the same fit).
 
-    Returns an xarray.Dataset: ``rao`` (omega, coordinate), ``body_rao`` (omega, body, dof) with
+    Returns :class:`Raos`; :func:`mfm.frequency_response` returns it as an xarray.Dataset:
+    ``rao`` (omega, coordinate), ``body_rao`` (omega, body, dof) with
     dof = x, y, z, rx, ry, rz, ``xi_rao`` (omega, hydro_dof), ``pto_rao`` and ``pto_power``
     (omega, pto) (W/m², mean power ½ c ω² |x̂|²), the loads' own outputs (``hydraulic_pto_power``,
     ``point_rao``, ``hydraulic_pto_force_rao``, …), ``equilibrium`` (coordinate); with
@@ -207,8 +222,8 @@ def frequency_response(model: Model, omega, heading: float = 0.0, *, q0=None,
     settings = {"radiation": radiation_label(radiation)}
     if state_space_options:
         settings["state_space_options"] = repr(state_space_options)
-    return results.frequency(model, sys.loads, omega, x, sys.q0, sys.kin0, heading, settings,
-                             [e for e in extra if e], reactions)
+    return Raos(sys.loads, omega, x, sys.q0, sys.kin0, heading, settings,
+                [e for e in extra if e], reactions)
 
 
 def _frequency_range(loads):

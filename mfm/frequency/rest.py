@@ -30,7 +30,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .. import _programs
+from .. import host
 from ..loads.assembly import (RK4_STAGE_OFFSETS, applied_loads, as_loads, carried_loads,
                               compile_view)
 from ..mechanics.dynamics import gravity_loads, joint_loads, mass_matrix
@@ -120,9 +120,10 @@ def _static_functions(model: Model, loads):
 
 
 def _jet_program(model, static, mems, q):
-    """:func:`_static_jet` for these arguments' structure, from disk where an earlier process
-    traced it (:mod:`mfm._programs`): called from the host, not inside a trace."""
-    return _programs.program(_static_jet, "static_jet", (model, static, mems, q), once=True)
+    """:func:`_static_jet` for these arguments' structure, as the host makes it
+    (:meth:`mfm.host.Host.program`; the runner's: from disk where an earlier process traced it):
+    called from the host, not inside a trace."""
+    return host.current().program(_static_jet, "static_jet", (model, static, mems, q), once=True)
 
 
 def jet(model: Model, q, loads) -> _Jet:

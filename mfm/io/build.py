@@ -68,7 +68,7 @@ def load(path, hydro: bool = True, body_coupling: bool | None = None,
     if body_coupling is not None and not isinstance(body_coupling, bool):
         raise ValueError(f"body_coupling: {body_coupling!r}; accepted: True, False or None (the "
                          "config's hydro.body_coupling)")
-    from ..timedomain.progress import phase, progress_bar, progress_options
+    from ..runner.progress import phase, progress_bar, progress_options
 
     progress = progress_options(progress)
     if isinstance(path, dict) or text:

@@ -16,10 +16,9 @@ from pathlib import Path
 
 from .. import results
 from ..errors import SimulationError
-from ..frequency.modes import natural_frequencies
-from ..frequency.response import frequency_response
+from ..runner.frequency import frequency_response, natural_frequencies
 from ..frequency.rest import no_restoring
-from ..timedomain.simulation import simulate
+from ..runner.simulation import simulate
 from .bemgen import generate
 from .build import load
 from .config import load_config
@@ -115,7 +114,7 @@ def cli_text(message, args=None) -> str:
     text = text.replace("Widen omega_range to cover the spectrum (the default band does)",
                         "Widen --omega-min/--omega-max to cover the spectrum (without them the "
                         "default band, 0.5 to 5 times the peak frequency, does)")
-    # a run too large for the memory (mfm.timedomain.checks.refuse_impossible)
+    # a run too large for the memory (mfm.runner.checks.refuse_impossible)
     if hasattr(args, "duration") and hasattr(args, "dt"):
         text = re.sub(r"^duration: ", f"--duration {args.duration:g} s at --dt {args.dt:g} s: ", text)
     text = re.sub(r"keep fewer samples \(save_every=k keeps every k-th\), split it into runs from "
@@ -627,7 +626,7 @@ def cmd_fits(args):
         if fit is not None:
             # the judgement radiation="auto" makes before a run uses the fit (a decay: every
             # mode; mfm.frequency.fitcheck), said here where the fit is stored
-            from ..timedomain.setup import judge_radiation
+            from ..runner.choices import judge_radiation
 
             verdict = judge_radiation(model)
             this += (f"; {verdict.summary}" + ("" if verdict.ok else

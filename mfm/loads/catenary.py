@@ -32,14 +32,10 @@ the frequency domain take from jax is smooth; the tables themselves are made and
 Yuan line its error is at most 3.2e-4 of the local tension anywhere in it (at the slack corner,
 where H → 0) and 1.8e-5 of the rest tension within ±20 m × ±10 m, and its derivative (the
 stiffness) agrees with a finite difference of MoorPy within 6e-5 there, 4e-6 at rest
-(``tests/test_catenary.py``); refine ``table_step`` for more. Tables are cached by their
-parameters (six lines of one geometry cost one table: ~2,500 MoorPy calls, 3–5 s), in the process
-and on disk beside the radiation fits (:mod:`hydro.fitcache`'s folder, ``mooring-tables``; off
-with ``MFM_FIT_CACHE=off``), named by the sha256 of the parameters, the tables' module's source
-and the MoorPy, numpy and scipy versions: a later process reads Wu & Yuan's tables (11 s of its
-``mfm.load`` on 2 cores) back, the same to the last bit. ``mfm fits`` also stores a config's
-tables in its database file (:func:`~mfm.loads.catenary_tables.build_table`), where a first run
-on a new machine reads them.
+(``tests/test_catenary.py``); refine ``table_step`` for more. Each table is asked of the host
+(:meth:`mfm.host.Host.mooring_table`): lines of one geometry share one table, and the runner's
+host keeps tables in the process, in the config's database file (where ``mfm fits`` stores them)
+and on disk (:mod:`mfm.runner.tables`), the same to the last bit as a table made anew.
 
 Outside the table nothing is clipped or extrapolated: the force is NaN, so a run that takes a
 fairlead out stops as non-finite and :meth:`CatenaryLines.describe_nonfinite` names the line, its
@@ -75,7 +71,8 @@ from ..validation import body_ref, number, tables, unknown, vector
 from ..mechanics.points import BodyPoints
 from ..errors import ConfigError
 from .base import Load, LoadOutput
-from .catenary_tables import build_table, moorpy_version
+from .. import host
+from .catenary_tables import moorpy_version
 
 LINE_KEYS = {"length", "weight", "mass_per_length", "EA", "seabed_friction"}
 KEYS = {"name", "body", "fairlead", "anchor", "line_type", "table_extent", "table_step",
@@ -378,10 +375,10 @@ class CatenaryLines(Load):
             w = t["weight"] if "weight" in t else t["mass_per_length"] * float(model.gravity)
             try:
                 # a table stored in the config's database file (`mfm fits`) is read from there
-                xs, zs, c = build_table(t["x0"], t["z0"], t["table_extent"], t["table_step"],
-                                        t["length"], t["EA"], w, t["seabed_friction"],
-                                        stored=None if model.hydro is None
-                                        else model.hydro.stored_in)
+                xs, zs, c = host.current().mooring_table(
+                    t["x0"], t["z0"], t["table_extent"], t["table_step"], t["length"], t["EA"],
+                    w, t["seabed_friction"],
+                    stored=None if model.hydro is None else model.hydro.stored_in)
             except ValueError as e:
                 raise ConfigError(f"catenary_lines {t['name']!r}: {e}; narrow table_extent") from None
             coef.append(c)

@@ -374,7 +374,7 @@ class ExactStateSpace(StateSpace):
             W = jnp.concatenate([wr.reshape(n_c, -1), wi.reshape(n_c, -1)], axis=1)
             for k, s in enumerate(self.matvec_stages):
                 # a (1, 2 n_x) row times RMᵀ per stage, not the (n_c, 2 n_x) block at once: in a
-                # time loop compiled whole (mfm._xla) XLA runs a product of several rows as one
+                # time loop compiled whole (mfm.runner.xla) XLA runs a product of several rows as one
                 # scalar chain per element, a row as a vectorised matrix–vector product (RK4's two
                 # stages, M4 134's 20,000 steps: the loop 1.33 -> 0.48 s; Verlet's one row, the
                 # same expression, the same bits as before)

@@ -43,7 +43,7 @@ import numpy as np
 from hydro import phases
 from hydro.seabatch import components_many
 
-from .. import _programs
+from .. import host
 from ..mechanics import se3
 from ..mechanics.points import BodyPoints, h_matrix_at
 from .base import FrequencyTerms, Load, LoadOutput
@@ -136,7 +136,7 @@ class Water(Load):
         elif tuple(r_rad) == tuple(rows):
             rad = F_rad
         else:   # placed by a static 0/1 matrix: a scatter would keep XLA from compiling the time
-            # loop whole (mfm._xla)
+            # loop whole (mfm.runner.xla)
             P = (np.asarray(rows)[:, None] == np.asarray(r_rad)[None, :]).astype(float)
             rad = jnp.sum(P * F_rad[None, :], axis=1)
         # quadratic drag on the translational dofs (k = body, a = axis), dense for the same reason
@@ -695,8 +695,8 @@ def moving_dofs(model, body_index, d_ref, n_samples: int = 3, seed: int = 0) -> 
     rng = np.random.default_rng(seed)
     qs = jnp.asarray(rng.uniform(-0.3, 0.3, (n_samples, model.n_coordinates)))
     args = (model.keyed(), geo, qs)
-    # from disk where an earlier process traced it (mfm._programs): its tracing and lowering
-    # were ~0.7 s of every mfm.load of M4 134 with the caches filled; run once per load
-    samples = _programs.program(_h_samples, "h_samples", args, once=True)(*args)
+    # the host's program (the runner's: from disk where an earlier process traced it); run once
+    # per load
+    samples = host.current().program(_h_samples, "h_samples", args, once=True)(*args)
     peak = np.abs(np.asarray(samples)).max(axis=(0, 2))
     return np.flatnonzero(peak > 1e-12 * max(float(np.max(peak)), 1e-300))

@@ -15,7 +15,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from .. import _xla
+from .. import backend as _xla
 from . import se3
 from .kinematics import Kinematics, kinematics
 from .model import Model
@@ -109,7 +109,7 @@ def evaluate(model: Model, q, qd, tau=None, body_loads=None, extra_mass=None,
 
 # up to this size the solve is unrolled elimination (n fused kernels); above it, a Cholesky
 # factorisation and two triangular solves (three library calls of ~1 µs each on XLA CPU whatever
-# n). With the time loop compiled whole (mfm._xla) library calls are not allowed in it at all (they
+# n). With the time loop compiled whole (mfm.runner.xla) library calls are not allowed in it at all (they
 # would send it back to kernel-by-kernel dispatch), so elimination goes further there.
 _UNROLLED_SOLVE = 64 if _xla.LOOPS_COMPILED_WHOLE else 12
 
@@ -117,7 +117,7 @@ _UNROLLED_SOLVE = 64 if _xla.LOOPS_COMPILED_WHOLE else 12
 def spd_solve(A, b):
     """x = A⁻¹ b for a symmetric positive-definite A (n, n), b (n,).
 
-    For n ≤ 12 (n ≤ 64 with the time loop compiled whole, :mod:`mfm._xla`) by Gauss–Jordan elimination without pivoting, unrolled: the k-th step takes row k
+    For n ≤ 12 (n ≤ 64 with the time loop compiled whole, :mod:`mfm.runner.xla`) by Gauss–Jordan elimination without pivoting, unrolled: the k-th step takes row k
     over its pivot and removes column k from the others, [A | b] ← [A | b] − (a_k − e_k) r_k / a_kk
     (a_k the k-th column, r_k the k-th row, so that row k becomes r_k / a_kk). No pivoting is
     needed: every pivot of an SPD matrix is positive (a ratio of leading principal minors) and the

@@ -63,7 +63,7 @@ class BodyPoints(eqx.Module):
         f, m = F[:, :3], F[:, 3:]
         mb = se3.rotate_t(R, m + jnp.cross(rho, f))
         # summed onto the bodies by a static 0/1 matrix rather than a scatter-add: a scatter keeps
-        # XLA from compiling the time loop as one function (mfm._xla)
+        # XLA from compiling the time loop as one function (mfm.runner.xla)
         S = np.zeros((n_bodies, len(idx)))
         S[idx, np.arange(len(idx))] = 1.0
         return jnp.sum(S[:, :, None] * jnp.concatenate([f, mb], axis=1)[None], axis=1)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from .. import _xla
+from .. import backend as _xla
 
 # Below this rotation angle the closed forms of exp/log switch to Taylor series (their relative
 # error there is below 1e-16 in float64).
@@ -39,7 +39,7 @@ def rotate_t(R, v):
 # products X Y (m, k) × (k, p) up to this many multiplications are written as a multiply–reduce,
 # wider ones as a dot: XLA makes a wide multiply–reduce one slow library fusion (Wu & Yuan's BᵀMB,
 # 96 × 18 × 18: 55 µs/step traced, against a dot's few). With the time loop compiled whole
-# (mfm._xla, library fusions off) a multiply–reduce up to _COLUMNS_LIMIT: the inline dot is the
+# (mfm.runner.xla, library fusions off) a multiply–reduce up to _COLUMNS_LIMIT: the inline dot is the
 # slow one there (the same product 28 µs/step)
 _REDUCE_LIMIT = 8192
 # With the time loop compiled whole on a CPU, products of more than this many multiplications are
@@ -71,7 +71,7 @@ def _by_columns(X, Y):
 def matmul_small(X, Y, *, transpose_x=False):
     """X Y for 2-D X (m, k), Y (k, p); with ``transpose_x``, Xᵀ Y for X (..., m), Y (..., p),
     summed over all leading axes. A multiply–reduce while m k p ≤ 8,192 (see :func:`rotate` for
-    why), a dot above. With the time loop compiled whole (:mod:`mfm._xla`) a multiply–reduce up
+    why), a dot above. With the time loop compiled whole (:mod:`mfm.runner.xla`) a multiply–reduce up
     to the same size (XLA's inline dot of Wu & Yuan's BᵀMB cost 28 µs/step there), and on a CPU
     column by column above (:func:`_by_columns`). Xᵀ Y is reduced over X's leading axes
     directly: a transposed or reshaped operand costs XLA extra copy kernels."""

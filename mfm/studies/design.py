@@ -11,7 +11,7 @@ For each sea s with components a_sj at (ω_j, β_j) (the union of every sea's pa
     P_s = Σ_p Σ_j a_sj² ½ c_p ω_j² |G_p x̂_sj|²      (mean power of each PTO p, rate ẇ = G_p q̇)
     σ_{q,s}² = Σ_j ½ a_sj² |x̂_sj|²                  (variance of each coordinate; of a stroke with G)
 
-the frequency domain's equations (:mod:`mfm.frequency.response`, :mod:`mfm.frequency.spectral`),
+the frequency domain's equations (:mod:`mfm.frequency.response`, :mod:`mfm.runner.spectral`),
 written in jax so that θ — joint dampings and stiffnesses, controller stiffnesses about q₀, body masses, hydraulic μ, β, κ, linear
 mooring stiffnesses, named as the config and the coordinates are (:func:`tunable_parameters`) —
 are arguments of one compiled function (their structure, not their values, is its key).

@@ -4,9 +4,9 @@ cheapest level whose answer stays within a tolerance of the full model on the sc
 The levels, cheapest first:
 
 - ``"spectral"``: the linear frequency-domain response summed over the sea's components
-  (:func:`mfm.frequency.spectral.spectral_response`), no time stepping. Linear about the equilibrium: no
+  (:func:`mfm.runner.spectral.spectral_response`), no time stepping. Linear about the equilibrium: no
   drag, no large rotations, no stops.
-- ``"linear"``: the same linear model in the time domain (:func:`mfm.frequency.linear.linear_response`):
+- ``"linear"``: the same linear model in the time domain (:func:`mfm.runner.linear.linear_response`):
   radiation by the state-space fit, the modes stepped exactly; it has the start-up transient and
   ramp that the spectral level's steady state has not.
 - ``"fast"``: the full nonlinear model stepped once per step (``integrator="verlet"``) with the
@@ -36,10 +36,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..frequency.linear import linear_response
-from ..frequency.spectral import spectral_response
+from ..runner.linear import linear_response
+from ..runner.spectral import spectral_response
 from ..mechanics.model import Model
-from ..timedomain.simulation import simulate
+from ..runner.simulation import simulate
 from ..validation import check_model, check_sea, finite_number
 
 LEVELS = ("spectral", "linear", "fast", "full")

@@ -35,7 +35,7 @@ from hydro.seabatch import components_many
 from .. import results
 from ..errors import OptimizeError
 from ..frequency.rest import _equilibrium, _static_functions, system_loads, water_of
-from ..frequency.spectral import component_union
+from ..runner.spectral import component_union
 from ..loads.base import Load
 from ..loads.catenary import CatenaryLines
 from ..loads.hydraulic_pto import HydraulicPTO
@@ -438,8 +438,8 @@ def _confirm(model, seas, values, params, weights, r_opt, options):
     ``options`` say otherwise): every PTO's mean power after ``settle`` against the spectral
     prediction. One :func:`mfm.simulate_batch` call for the seas; a model with hydraulic pistons
     runs :func:`mfm.simulate` per sea (a batch records joint dampers only)."""
-    from ..timedomain.batch import simulate_batch
-    from ..timedomain.simulation import simulate
+    from ..runner.batch import simulate_batch
+    from ..runner.simulation import simulate
 
     options = dict(options)
     if "dt" not in options or "n_steps" not in options:

@@ -66,11 +66,12 @@ from pathlib import Path
 import numpy as np
 
 from .. import results
-from ..frequency import linear as _linear
-from ..frequency.spectral import spectral_response
+from ..runner import linear as _linear
+from ..runner.spectral import spectral_response
 from ..io.build import load
 from ..timedomain.rollout import rollout
-from ..timedomain.setup import choose_radiation, model_loads
+from ..runner.choices import choose_radiation
+from ..timedomain.setup import model_loads
 
 ROOT = Path(__file__).resolve().parents[2]      # the repository (configs/), in a checkout
 

@@ -15,7 +15,7 @@ model is sent to each worker once (``scatter``) and kept there under a hash of i
 so later sweeps of the same model on the same cluster (a resume) do not compile again.
 
 ``level="spectral"`` skips all of that for a model linear over its sea states: the cases are the
-linear frequency-domain response of :func:`mfm.frequency.spectral.spectral_sweep` (one linearisation, one RAO
+linear frequency-domain response of :func:`mfm.runner.spectral.spectral_sweep` (one linearisation, one RAO
 solve on the union of the seas' frequencies), in one call.
 """
 from __future__ import annotations
@@ -32,11 +32,11 @@ import numpy as np
 import xarray as xr
 
 from ..errors import SweepError  # noqa: F401  (exported)
-from ..frequency.spectral import spectral_sweep
+from ..runner.spectral import spectral_sweep
 from ..results import gather_cases, label_cases, sea_labels
 from ..timedomain import integrators as _integrators
-from ..timedomain.batch import simulate_batch
-from ..timedomain.progress import progress_bar, progress_options
+from ..runner.batch import simulate_batch
+from ..runner.progress import progress_bar, progress_options
 from ..timedomain.setup import model_loads
 from ..validation import check_model, finite_number
 
@@ -200,7 +200,7 @@ def sweep(model, seas, *, dt=None, n_steps: int | None = None, chunk_size: int =
         may differ (e.g. smaller for the chunks that went non-finite).
     progress: True (default), False, or a dict of tqdm options: a bar over the chunks.
     level: None (default: the time domain, as ``options`` say) or ``"spectral"``: the linear
-        frequency-domain level of the fidelity ladder (:func:`mfm.frequency.spectral.spectral_sweep`), for a
+        frequency-domain level of the fidelity ladder (:func:`mfm.runner.spectral.spectral_sweep`), for a
         model that is linear over the sea states (:func:`mfm.reduce` measures it): linearised
         once, RAOs solved once on the union of the seas' frequencies, every case's statistics
         ``pto_power_mean`` and ``q_rms`` (case, …) in one call, no time stepping. With ``dt`` and
@@ -319,7 +319,7 @@ SPECTRAL_OPTIONS = {"q0": None, "loads": None, "radiation": "database",
 
 
 def _spectral_sweep(model, seas, level, dt, n_steps, parameters, options, unused):
-    """``sweep(..., level="spectral")``: :func:`mfm.frequency.spectral.spectral_sweep` over the cases, on the
+    """``sweep(..., level="spectral")``: :func:`mfm.runner.spectral.spectral_sweep` over the cases, on the
     time domain's saved grid when dt and n_steps are given, labelled as a sweep."""
     if level != "spectral":
         raise ValueError(f"level: {level!r}; accepted: None (the time domain, as the options "

@@ -46,7 +46,7 @@ import xarray as xr
 
 from hydro.database import HydroDatabaseWarning, read_netcdf
 
-from ..frequency.response import frequency_response
+from ..runner.frequency import frequency_response
 from ..io.build import load
 from ..loads.body_matrix import LinearBodyMatrix
 from . import wu_yuan_layout as layout

@@ -1,2 +1,4 @@
-"""The time domain: integrators (:mod:`.integrators`), the model's loads for a run, the pure
-rollout, the recording of outputs, progress, batches, and the front door :func:`mfm.simulate`."""
+"""The time domain's pure core: integrators (:mod:`.integrators`), the model's loads for a run
+(:mod:`.setup`), the rollout (:mod:`.rollout`) and what it records (:mod:`.record`). The front
+doors that run it (:func:`mfm.simulate`, :func:`mfm.simulate_batch`) are the runner's
+(:mod:`mfm.runner`)."""

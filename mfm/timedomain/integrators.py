@@ -99,7 +99,7 @@ class RK4(AbstractIntegrator):
         """One step on the test equation ẏ = λy, z = λ dt (complex, any shape): y ← R(z) y with
         R(z) = 1 + z + z²/2 + z³/6 + z⁴/24 (Hairer & Wanner, Solving ODEs II, §IV.2). What RK4
         does to a first-order state such as a radiation state-space mode; the exact factor is
-        eᶻ (:func:`mfm.timedomain.setup.choose_radiation` compares the two)."""
+        eᶻ (:func:`mfm.runner.choices.choose_radiation` compares the two)."""
         import numpy as np
 
         z = np.asarray(z, complex)

@@ -2,7 +2,7 @@
 outputs (poses, joint reactions, energies, the loads' diagnostics), every one or those named,
 computed inside the time loop or, for a small load memory, after it in one vmapped pass over the
 saved samples (which :func:`~mfm.simulate` makes chunk by chunk beside the loop:
-:func:`~mfm.timedomain.progress.run_pipelined`)."""
+:mod:`mfm.runner.pipeline`)."""
 from __future__ import annotations
 
 import dataclasses
@@ -133,7 +133,7 @@ def deferred(carry, recording: Recording) -> bool:
 def outputs_after(model, loads, carries, recording: Recording = EVERY):
     """What ``recording`` (:data:`EVERY` or :data:`OUTPUTS`) keeps (:func:`saved`) of stacked
     carries, in groups of a fixed width: every sample is computed by the same vmapped program
-    whatever their number, so a run in chunks (progress bar) gives the same bits."""
+    whatever their number, so a run in chunks (the runner's) gives the same bits."""
     return map_in_groups(lambda sm: saved(model, loads, *sm, recording), carries,
                           DEFERRED_RECORD_WIDTH)
 

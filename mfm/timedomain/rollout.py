@@ -4,15 +4,11 @@ save_every, loads structure); vmap- and grad-friendly."""
 from __future__ import annotations
 
 import collections
-import concurrent.futures
-import time
 from typing import Sequence
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 
-from .. import _programs
 from ..loads.assembly import applied_loads, as_loads, compile_view
 from ..loads.base import Load
 from ..mechanics.dynamics import evaluate
@@ -20,9 +16,7 @@ from ..mechanics.kinematics import kinematics
 from ..mechanics.model import Model
 from ..validation import positive_seconds, whole_number
 from . import integrators as _integrators
-from . import progress
-from .progress import chunk_plan, run_chunked, run_pipelined
-from .record import (DEFERRED_RECORD_WIDTH, EVERY, STATE, Recording, deferred,
+from .record import (EVERY, STATE, Recording, deferred,
                      outputs_after, saved)
 
 
@@ -113,8 +107,8 @@ rollout_jit = jax.jit(rollout_impl,
                        static_argnames=("n_steps", "integrator", "save_every", "record"))
 
 
-# The chunked rollout of a progress bar: the same start and blocks, compiled as two functions
-# (the blocks one once for the chunk length), called from the host between bar updates.
+# The chunked rollout the runner shows as it goes: the same start and blocks, compiled as two
+# functions (the blocks one once for the chunk length), called from the host between chunks.
 def _chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every, recording):
     TRACES["rollout_chunk"] += 1
     return rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, recording)
@@ -135,7 +129,7 @@ def _blocks_with_head(model, loads, carry, dt, n_blocks, integrator, save_every,
 def _headed_chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every,
                        recording: Recording = EVERY):
     """A chunk of a recorded run whose outputs are deferred (:func:`_blocks_with_head`), in one
-    program with its steps (a run too short to pipeline, :data:`~.progress.PIPELINE_MIN_SAMPLES`).
+    program with its steps (a run too short for the runner to pipeline, :mod:`mfm.runner.pipeline`).
     The host keeps the head of the first chunk only (the run's initial sample): the start then
     needs no outputs program of its own, and a first run compiles one copy of the outputs instead
     of two (RM3: the start's 4.7 of 14 s of compilation, cold)."""
@@ -145,7 +139,7 @@ def _headed_chunk_impl(model, loads, carry, dt, n_blocks, integrator, save_every
 
 
 def _steps_impl(model, loads, carry, dt, n_blocks, integrator, save_every):
-    """A chunk of a pipelined run (:func:`~.progress.run_pipelined`): ``n_blocks`` blocks from
+    """A chunk of a pipelined run (:mod:`mfm.runner.pipeline`): ``n_blocks`` blocks from
     ``carry``, the carry after them and each block's saved carry, stacked; no outputs."""
     TRACES["rollout_chunk"] += 1
     return rollout_blocks(model, loads, carry, dt, n_blocks, integrator, save_every, EVERY,
@@ -162,22 +156,22 @@ def _outputs_impl(model, loads, head, carries, recording: Recording = EVERY):
 
 
 # for the memories' shapes only: a jit keeps its trace, so a warm run does not trace them again
-_init_memories_jit = jax.jit(init_memories)
-_start_jit = jax.jit(rollout_start, static_argnames=("integrator", "recording"))
+init_memories_jit = jax.jit(init_memories)
+start_jit = jax.jit(rollout_start, static_argnames=("integrator", "recording"))
 
 
-_chunk_jit = jax.jit(_chunk_impl, static_argnames=("n_blocks", "integrator", "save_every",
+chunk_jit = jax.jit(_chunk_impl, static_argnames=("n_blocks", "integrator", "save_every",
                                                    "recording"))
 
 
-_headed_chunk_jit = jax.jit(_headed_chunk_impl, static_argnames=("n_blocks", "integrator",
+headed_chunk_jit = jax.jit(_headed_chunk_impl, static_argnames=("n_blocks", "integrator",
                                                                  "save_every", "recording"))
 
 
-_steps_jit = jax.jit(_steps_impl, static_argnames=("n_blocks", "integrator", "save_every"))
+steps_jit = jax.jit(_steps_impl, static_argnames=("n_blocks", "integrator", "save_every"))
 
 
-_outputs_jit = jax.jit(_outputs_impl, static_argnames=("recording",))
+outputs_jit = jax.jit(_outputs_impl, static_argnames=("recording",))
 
 
 def rollout(model: Model, q0, qd0, *, dt, n_steps: int, integrator="rk4", loads=None,
@@ -218,121 +212,3 @@ def rollout_call(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, 
             jnp.asarray(dt, jnp.float64))
     return args, dict(n_steps=int(n_steps), integrator=integ, save_every=int(save_every),
                       record=Recording.of(record))
-
-
-def _strong(tree):
-    """``tree``'s arrays, strongly typed (the same dtypes and values)."""
-    def strong(a):
-        if isinstance(a, jax.Array) and not a.weak_type:
-            return a
-        if isinstance(a, jax.Array):
-            # through the host: jnp's conversion of a weakly typed array is a program of its own,
-            # compiled in a first run beside the run's (Wu & Yuan: 1.2 s on 2 busy cores)
-            return jax.device_put(np.asarray(a))
-        return jnp.asarray(a, a.dtype)
-    return jax.tree_util.tree_map(strong, tree)
-
-
-def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0,
-                recording: Recording = EVERY, chunked: bool = False):
-    """Start a recorded run and compile its programs, here and now; returns ``run(bar)``, which
-    makes the run and gives what ``recording`` keeps of each saved step (numpy or jax arrays,
-    the initial state first). Compiling before ``run`` lets :func:`~.simulation.simulate` do it
-    while its checks' linearisation compiles on another thread (XLA compiles without the GIL): a
-    first run waits for the longer of the two, not their sum.
-
-    ``recording``: :data:`~.record.EVERY` (``rollout``'s ``record=True``) or
-    :data:`~.record.OUTPUTS` (``simulate``'s: no loads' states per sample). Where its outputs
-    are made after the time loop (:func:`~.record.deferred`: a small load memory) and the run
-    saves at least :data:`~.progress.PIPELINE_MIN_SAMPLES` samples, it is pipelined
-    (:func:`~.progress.run_pipelined`): chunks of steps on this thread, each chunk's outputs on
-    another as the next one steps; ``chunked`` (a progress bar) in 20 to 100 chunks
-    (:func:`~.progress.chunk_plan`), else in up to 8 (:func:`~.progress.pipeline_plan`).
-    Other runs make their outputs after the loop in the same program (one program to compile
-    instead of two), and a large memory (a convolution's history) makes them inside the loop: the
-    whole run in one program, or with ``chunked`` in chunks of one
-    (:func:`~.progress.run_chunked`). The same numbers every way."""
-    began = time.perf_counter()
-    parts = [ld.initial_state(model) for ld in loads]
-    z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
-    q0, qd0 = jnp.asarray(q0, jnp.float64), jnp.asarray(qd0, jnp.float64)
-    t0, dt = jnp.asarray(t0, jnp.float64), jnp.asarray(dt, jnp.float64)
-    model, loads = compile_view(model, loads)
-    n_blocks = n_steps // save_every
-    memories = _programs.eval_shape(_init_memories_jit, model, loads, t0, q0, qd0, dt)
-    headed = deferred((None, memories), recording)
-    pipelined = headed and n_blocks >= progress.PIPELINE_MIN_SAMPLES
-    start_args = (model, loads, q0, qd0, z0, t0, dt)
-    if not (pipelined or chunked):
-        # the whole run, one program (from disk where an earlier process traced it); its outputs
-        # after the loop (rollout_impl), or inside it for a large memory
-        opts = dict(n_steps=n_steps, integrator=integrator, save_every=save_every,
-                    record=recording)
-        whole = _programs.program(rollout_jit, "rollout", start_args, opts)
-        whole.compile(*start_args)
-        return lambda bar: whole(*start_args)
-    if pipelined:
-        # a multiple of the outputs' group width: each sample in the place of its group it has
-        # in the run made in one program (the same bits; progress.run_pipelined)
-        c, _ = (chunk_plan(n_blocks, multiple=DEFERRED_RECORD_WIDTH) if chunked
-                else progress.pipeline_plan(n_blocks, multiple=DEFERRED_RECORD_WIDTH))
-    else:
-        c, _ = chunk_plan(n_blocks)
-    # the outputs of the initial sample come with the first chunk's (its head) where they are
-    # made after the steps; else the start makes them, in the loop's way
-    start_kw = dict(integrator=integrator, recording=STATE if headed else recording)
-    # the chunk's programs compile on other threads from the start's shapes while this one
-    # compiles and runs the start: XLA compiles without the GIL, so on several cores they
-    # overlap. All come from disk where an earlier process traced them (mfm._programs)
-    start = _programs.program(_start_jit, "rollout_start", start_args, start_kw)
-    # the carry strongly typed, however the start was made (a saved program keeps no weak types),
-    # so that the chunk is one program, one key (the same dtypes: the same numbers)
-    shapes = jax.tree_util.tree_map(lambda a: jax.ShapeDtypeStruct(a.shape, a.dtype),
-                                    start.shapes(*start_args)[0])
-
-    def compiled(fn, name, args, kw):
-        made = _programs.program(fn, name, args, kw)
-        made.compile(*args)
-        return made
-
-    steps_kw = dict(n_blocks=c, integrator=integrator, save_every=save_every)
-    pool = concurrent.futures.ThreadPoolExecutor(2)
-    try:
-        if pipelined:
-            stacked = jax.tree_util.tree_map(
-                lambda a: jax.ShapeDtypeStruct((c,) + a.shape, a.dtype), shapes)
-            ahead = [pool.submit(compiled, _steps_jit, "rollout_steps", (model, loads, shapes, dt),
-                                 steps_kw),
-                     pool.submit(compiled, _outputs_jit, "rollout_outputs",
-                                 (model, loads, shapes, stacked), dict(recording=recording))]
-        else:
-            fn, name = ((_headed_chunk_jit, "rollout_chunk_headed") if headed
-                        else (_chunk_jit, "rollout_chunk"))
-            ahead = [pool.submit(compiled, fn, name, (model, loads, shapes, dt),
-                                 dict(steps_kw, recording=recording))]
-        carry, first = start(*start_args)
-        carry = _strong(carry)
-        # a pipelined run steps once its steps' program is ready: the outputs' program (the
-        # larger: M4 134 3.5 s, Wu & Yuan 4–9 s of compilation on 2 cores) goes on compiling
-        # beside the first chunks, whose outputs wait for it on the outputs' thread
-        made = [ahead[0].result(), ahead[1]] if pipelined else [f.result() for f in ahead]
-    finally:
-        pool.shutdown(wait=False)
-    if pipelined:
-        steps, outputs = made
-        return lambda bar: run_pipelined(
-            carry, lambda cr: steps(model, loads, _strong(cr), dt),
-            # strongly typed as the program was compiled (a step's iteration count comes out
-            # weak): else the call compiles it again (M4 134: 7.5 s of a first run)
-            lambda head, carries: outputs.result()(model, loads, _strong(head),
-                                                   _strong(carries)),
-            c, n_blocks, save_every, bar, began)
-    if headed:
-        first = None
-
-    def chunk(carry, n):
-        assert n == c, (n, c)          # one chunk length: the one compiled
-        return made[0](model, loads, _strong(carry), dt)
-
-    return lambda bar: run_chunked(lambda: (carry, first), chunk, n_blocks, save_every, bar,
-                                   time_axis=0, began=began)

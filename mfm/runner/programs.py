@@ -1,5 +1,5 @@
 """Traced programs kept on disk: a later process skips jax's tracing and lowering of a run's
-programs as :mod:`mfm._xla`'s persistent cache lets it skip XLA's compilation.
+programs as :mod:`mfm.runner.xla`'s persistent cache lets it skip XLA's compilation.
 
 Why. With the compilation cache filled, a first :func:`mfm.simulate` still traces each of its
 programs (Python walking the model, its loads and the integrator: about a second each for RM3's
@@ -44,7 +44,7 @@ import numpy as np
 
 from hydro import fitcache
 
-from . import _xla
+from . import xla as _xla
 
 ENV = "MFM_PROGRAM_CACHE"
 FOLDER_BYTES = 512 * 2**20
@@ -62,11 +62,12 @@ class _Unkeyable(Exception):
 
 def folder() -> Path | None:
     """The programs' folder, or None when either cache is off."""
-    if _xla.COMPILATION_CACHE is None or jax.config.jax_disable_jit:
+    cache = _xla.compilation_cache()
+    if cache is None or jax.config.jax_disable_jit:
         return None
     if _xla.switched_off(os.environ.get(ENV)):
         return None
-    return Path(_xla.COMPILATION_CACHE) / "mfm-programs"
+    return Path(cache) / "mfm-programs"
 
 
 def _type_name(t: type) -> str:
@@ -228,7 +229,7 @@ def program(jitted, name: str, args: tuple, static: dict | None = None, *,
             once: bool = False) -> "Program":
     """The :class:`Program` of ``jitted(*args, **static)``: the one this process made already
     for that key, else one from disk, else one traced now (and saved). ``once``: a program run
-    once per call, compiled with :func:`mfm._xla.once_options` (faster to compile, slower to
+    once per call, compiled with :func:`mfm.runner.xla.once_options` (faster to compile, slower to
     run)."""
     static = dict(static or {})
     options = _xla.once_options() if once else None

@@ -17,12 +17,12 @@ from .. import results
 from ..errors import SimulationError
 from ..loads.assembly import CaseLoads, as_loads, carried_loads_batch, compile_view
 from ..validation import check_model, finite_number, initial_vector, whole_number
-from . import integrators as _integrators
+from ..timedomain import integrators as _integrators
 from .checks import refuse_impossible
 from .progress import progress_bar, progress_options, run_chunked
-from .record import Recording, map_in_groups, output_names
-from .rollout import TRACES, rollout_blocks, rollout_impl, rollout_start
-from .setup import model_loads, stage_offsets
+from ..timedomain.record import Recording, map_in_groups, output_names
+from ..timedomain.rollout import TRACES, rollout_blocks, rollout_impl, rollout_start
+from ..timedomain.setup import model_loads, stage_offsets
 
 
 def _over_cases(f, model, model_axis, batched, lanes):

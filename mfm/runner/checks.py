@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import AccuracyWarning, StabilityWarning
 from ..frequency.rest import shortest_natural_period
-from . import integrators as _integrators
+from ..timedomain import integrators as _integrators
 
 
 def machine_memory() -> int:

@@ -32,8 +32,8 @@ from .. import results
 from ..loads.pto import linear_ptos, mean_absorbed_power
 from ..mechanics.model import Model
 from ..validation import check_model, check_sea, check_sea_in_grid, check_seas
-from .response import _amplitudes
-from .rest import linear_system
+from ..frequency.response import _amplitudes
+from ..frequency.rest import linear_system
 
 def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
                       radiation: str = "database", state_space_options: dict | None = None

@@ -1,7 +1,8 @@
-"""The front door of the time domain: :func:`simulate` checks its inputs, builds the run's
-loads, runs the compiled rollout (:mod:`.rollout`), stops with a clear error if the state went
-non-finite (:mod:`.checks`), and returns an :class:`xarray.Dataset` (:mod:`mfm.results`). The pure
-core is :func:`~.rollout.rollout`; many runs at once are :func:`~.batch.simulate_batch`.
+"""The front door of the time domain: :func:`simulate` checks its inputs, makes the runner's
+choices (:mod:`.choices`), builds the run's loads, compiles and runs the pure rollout
+(:mod:`mfm.timedomain.rollout`, through :mod:`.pipeline`), stops with a clear error if the state
+went non-finite (:mod:`.checks`), and returns an :class:`xarray.Dataset` (:mod:`mfm.results`).
+Many runs at once are :func:`~.batch.simulate_batch`.
 """
 from __future__ import annotations
 
@@ -12,21 +13,20 @@ import xarray as xr
 from hydro import phases
 
 from .. import results
-from ..errors import AccuracyWarning, SimulationError, StabilityWarning  # noqa: F401  (exported)
+from ..errors import SimulationError
 from ..frequency import rest
 from ..loads.assembly import as_loads
 from ..mechanics.model import Model
+from ..radiation import resolve as resolve_radiation
+from ..timedomain import integrators as _integrators
+from ..timedomain.record import OUTPUTS
+from ..timedomain.setup import model_loads, stage_offsets
 from ..validation import check_model, finite_number, initial_vector, whole_number
-from . import integrators as _integrators
-from .batch import simulate_batch  # noqa: F401  (exported)
 from .checks import (nonfinite_message, refuse_impossible, warn_accuracy, warn_stability,
                      warn_verlet_drift)
+from .choices import convolution_or_state_space, judge_radiation, judged_choice, state_space_update
+from .pipeline import prepare_run
 from .progress import phase, progress_bar, progress_options
-from .record import OUTPUTS
-from .rollout import prepare_run, rollout, rollout_call, rollout_jit  # noqa: F401
-from ..radiation import resolve as resolve_radiation
-from .setup import (choose_radiation, convolution_or_state_space, judge_radiation,  # noqa: F401
-                    judged_choice, model_loads, stage_offsets, state_space_update)
 
 
 def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="rk4",

@@ -24,7 +24,7 @@ import atexit
 import gc
 import os
 
-from ._xla import switched_off
+from .xla import switched_off
 
 
 def enabled() -> bool:

@@ -48,7 +48,7 @@ from ..loads.pto import load_dampers
 from ..mechanics.model import Model
 from ..mechanics.points import h_matrix_at
 from ..validation import check_model, check_sea, finite_number
-from .rest import linear_system, water_of
+from ..frequency.rest import linear_system, water_of
 
 # the largest condition number of the mode matrix V accepted: the modes' round-off grows as
 # cond(V)·ε (1e10: 1e-6 relative; in the 1-norm RM3 has 4.6e3, M4 134 2.1e4)
