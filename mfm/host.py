@@ -34,15 +34,14 @@ class Host:
         host may compile such a program with less optimisation)."""
         return _Jitted(jitted, dict(static or {}))
 
-    def mooring_table(self, x0, z0, extent, step, length, EA, weight, seabed_friction,
+    def mooring_table(self, make, x0, z0, extent, step, length, EA, weight, seabed_friction,
                       stored=None):
-        """(xs, zs, coef) of a catenary line's table
-        (:func:`mfm.loads.catenary_tables.make_table`; ``stored``: the database file where
-        ``mfm fits`` may have stored it, which the plain host does not read)."""
-        from .loads.catenary_tables import make_table, table_centre
-
-        x0, z0 = table_centre(x0, z0)
-        return make_table(x0, z0, extent, step, length, EA, weight, seabed_friction)
+        """(xs, zs, coef) of a catenary line's table, ``make(x0, z0, extent, step, length, EA,
+        weight, seabed_friction)`` (the load's maker,
+        :func:`mfm.loads.catenary_tables.make_table`, handed in so that this module imports no
+        load); ``stored``: the database file where ``mfm fits`` may have stored it, which the
+        plain host does not read."""
+        return make(x0, z0, extent, step, length, EA, weight, seabed_friction)
 
 
 class _Jitted:

@@ -83,6 +83,16 @@ def sphere_db():
     return mfm.load(CONFIGS / "sphere.toml", hydro=True).hydro.database()
 
 
+def fresh_programs(monkeypatch, folder):
+    """A traced-program folder of the test's own (mfm.runner.programs) and its empty in-process
+    tables, as a new process finds them."""
+    from mfm.runner import programs
+
+    monkeypatch.setattr(programs, "folder", lambda: folder)
+    monkeypatch.setattr(programs, "_MADE", {})
+    monkeypatch.setattr(programs, "_ORDINARY_ONCE", {})
+
+
 @pytest.fixture
 def fit_cache(tmp_path, monkeypatch):
     """An empty fit-cache folder (MFM_FIT_CACHE, not made yet) and empty in-process caches of

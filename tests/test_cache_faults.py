@@ -25,7 +25,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from conftest import CONFIGS, ROOT
+from conftest import CONFIGS, ROOT, fresh_programs
 
 import mfm
 from hydro import fitcache as FC
@@ -129,9 +129,7 @@ def _affine(p, x):
 
 
 def test_a_flipped_bit_in_a_traced_program_is_made_anew(monkeypatch, tmp_path):
-    monkeypatch.setattr(_programs, "folder", lambda: tmp_path)
-    monkeypatch.setattr(_programs, "_MADE", {})
-    monkeypatch.setattr(_programs, "_ORDINARY_ONCE", {})
+    fresh_programs(monkeypatch, tmp_path)
     monkeypatch.setattr(FC, "_discarded", set())
     p = {"a": jnp.arange(9.0).reshape(3, 3), "b": jnp.ones(3)}
     x = jnp.arange(3.0)

@@ -23,7 +23,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from conftest import CONFIGS, ROOT
+from conftest import CONFIGS, ROOT, fresh_programs
 
 from mfm import host
 from mfm.runner import programs as _programs
@@ -35,15 +35,8 @@ def _affine(p, x):
     return {"y": p["a"] @ x + p["b"], "n": jnp.sum(x)}
 
 
-def _fresh(monkeypatch, tmp_path):
-    """A program folder of this test's own and an empty in-process table."""
-    monkeypatch.setattr(_programs, "folder", lambda: tmp_path)
-    monkeypatch.setattr(_programs, "_MADE", {})
-    monkeypatch.setattr(_programs, "_ORDINARY_ONCE", {})
-
-
 def test_a_saved_program_gives_the_ordinary_bits(monkeypatch, tmp_path):
-    _fresh(monkeypatch, tmp_path)
+    fresh_programs(monkeypatch, tmp_path)
     rng = np.random.default_rng(1)
     p = {"a": jnp.asarray(rng.normal(size=(5, 5))), "b": jnp.asarray(rng.normal(size=5))}
     x = jnp.asarray(rng.normal(size=5))
@@ -68,7 +61,7 @@ def test_a_saved_program_gives_the_ordinary_bits(monkeypatch, tmp_path):
 
 
 def test_a_damaged_file_is_made_anew(monkeypatch, tmp_path):
-    _fresh(monkeypatch, tmp_path)
+    fresh_programs(monkeypatch, tmp_path)
     p = {"a": jnp.eye(3), "b": jnp.ones(3)}
     x = jnp.arange(3.0)
     _programs.program(_affine, "affine", (p, x))
@@ -132,7 +125,7 @@ def test_the_key_changes_with_whatever_changes_the_program(monkeypatch):
 def test_what_the_key_cannot_name_takes_the_ordinary_path(monkeypatch, tmp_path):
     import equinox as eqx
 
-    _fresh(monkeypatch, tmp_path)
+    fresh_programs(monkeypatch, tmp_path)
 
     class WithFunction(eqx.Module):
         scale: jnp.ndarray
@@ -227,7 +220,7 @@ def test_a_compiled_program_is_not_compiled_again_when_called(monkeypatch, tmp_p
     arrays of those shapes (committed to the device, as a program's outputs are) runs that
     executable: XLA compiles once (counted by jax's events, not timed). The call used to lower
     the concrete arrays anew, with other sharding annotations, and compile again."""
-    _fresh(monkeypatch, tmp_path)
+    fresh_programs(monkeypatch, tmp_path)
     if not kept:
         monkeypatch.setattr(_programs, "folder", lambda: None)
     scale = 3.0 if kept else 5.0          # a program of each case's own, compiled nowhere else
@@ -276,7 +269,7 @@ def test_the_moved_dofs_of_a_load_come_from_a_saved_program(monkeypatch, tmp_pat
     import mfm
     from mfm.loads import water
 
-    _fresh(monkeypatch, tmp_path)
+    fresh_programs(monkeypatch, tmp_path)
     m = mfm.load(CONFIGS / "sphere.toml")
     spec = m.hydro
     d_ref = spec.d_ref
@@ -383,7 +376,7 @@ def test_a_warm_run_traces_nothing(monkeypatch, tmp_path, kept):
     import mfm
     from mfm.runner import progress
 
-    _fresh(monkeypatch, tmp_path)
+    fresh_programs(monkeypatch, tmp_path)
     if not kept:
         monkeypatch.setattr(_programs, "folder", lambda: None)
     monkeypatch.setattr(progress, "PIPELINE_MIN_SAMPLES", 16)
@@ -451,7 +444,7 @@ def test_programs_run_once_compile_fast_and_give_the_same_numbers(monkeypatch, t
     reference = plain_compile(rest._static_jet.lower(*args),
                               {"xla_backend_optimization_level": 2})(*args)
     for kept in (True, False):
-        _fresh(monkeypatch, tmp_path / str(kept))
+        fresh_programs(monkeypatch, tmp_path / str(kept))
         if not kept:
             monkeypatch.setattr(_programs, "folder", lambda: None)
         del asked[:]
@@ -483,7 +476,7 @@ def test_a_pipelined_run_steps_before_its_outputs_program_is_ready(monkeypatch, 
     import mfm
     from mfm.runner import progress
 
-    _fresh(monkeypatch, tmp_path)
+    fresh_programs(monkeypatch, tmp_path)
     monkeypatch.setattr(progress, "PIPELINE_MIN_SAMPLES", 16)
     sea = hydro.Regular(height=1.0, period=6.0)
     kw = dict(duration=4.0, dt=0.1, radiation="state_space", check_stability=False)
@@ -491,7 +484,7 @@ def test_a_pipelined_run_steps_before_its_outputs_program_is_ready(monkeypatch, 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         plain = mfm.simulate(model, sea, **kw)
-    _fresh(monkeypatch, tmp_path / "again")
+    fresh_programs(monkeypatch, tmp_path / "again")
     order, stepped = [], threading.Event()
     real = _programs.program
 

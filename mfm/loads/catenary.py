@@ -72,7 +72,7 @@ from ..mechanics.points import BodyPoints
 from ..errors import ConfigError
 from .base import Load, LoadOutput
 from .. import host
-from .catenary_tables import moorpy_version
+from .catenary_tables import make_table, moorpy_version, table_centre
 
 LINE_KEYS = {"length", "weight", "mass_per_length", "EA", "seabed_friction"}
 KEYS = {"name", "body", "fairlead", "anchor", "line_type", "table_extent", "table_step",
@@ -375,8 +375,9 @@ class CatenaryLines(Load):
             w = t["weight"] if "weight" in t else t["mass_per_length"] * float(model.gravity)
             try:
                 # a table stored in the config's database file (`mfm fits`) is read from there
+                x0, z0 = table_centre(t["x0"], t["z0"])
                 xs, zs, c = host.current().mooring_table(
-                    t["x0"], t["z0"], t["table_extent"], t["table_step"], t["length"], t["EA"],
+                    make_table, x0, z0, t["table_extent"], t["table_step"], t["length"], t["EA"],
                     w, t["seabed_friction"],
                     stored=None if model.hydro is None else model.hydro.stored_in)
             except ValueError as e:

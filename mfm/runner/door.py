@@ -19,12 +19,12 @@ class RunnerHost(host.Host):
 
         return programs.program(jitted, name, args, static, once=once)
 
-    def mooring_table(self, x0, z0, extent, step, length, EA, weight, seabed_friction,
+    def mooring_table(self, make, x0, z0, extent, step, length, EA, weight, seabed_friction,
                       stored=None):
         from . import tables
 
         return tables.mooring_table(x0, z0, extent, step, length, EA, weight, seabed_friction,
-                                    stored=stored)
+                                    stored=stored, make=make)
 
 
 RUNNER = RunnerHost()

@@ -21,10 +21,11 @@ from ..loads.catenary_tables import make_table, packed, stored_table_key, table_
 _TABLE_CACHE: dict = {}
 
 
-def mooring_table(x0, z0, extent, step, length, EA, weight, seabed_friction, stored=None):
+def mooring_table(x0, z0, extent, step, length, EA, weight, seabed_friction, stored=None,
+                  make=make_table):
     """(xs, zs, coef): the grid axes and the nodal data (nx, nz, 4, 2) of the tensor-product
     not-a-knot cubic spline of (H, V): [f, hx ∂f/∂x, hz ∂f/∂z, hx hz ∂²f/∂x∂z] per node
-    (:func:`~mfm.loads.catenary_tables.make_table`). The grid is centred on the rest span and
+    (``make``: :func:`~mfm.loads.catenary_tables.make_table`). The grid is centred on the rest span and
     height (:func:`~mfm.loads.catenary_tables.table_centre`), and kept on its arguments: lines of
     one geometry make one table (Wu & Yuan's six lines: one table of 2,511 MoorPy solves, not
     three).
@@ -57,7 +58,7 @@ def mooring_table(x0, z0, extent, step, length, EA, weight, seabed_friction, sto
     table = _read_table(path)
     if table is not None:
         return kept(table)
-    table = make_table(x0, z0, extent, step, length, EA, weight, seabed_friction)
+    table = make(x0, z0, extent, step, length, EA, weight, seabed_friction)
     _write_table(path, table)
     return kept(table)
 
