@@ -19,7 +19,7 @@ radians are meant) is refused by `check_heading`, naming the fix ``math.radians(
 - `Regular(height, period, heading, phase)`: one component, a = H/2.
 - `Jonswap`, `PiersonMoskowitz`, `UserSpectrum`: one-sided spectra S(ω) (m² s/rad) discretised with
   a_j = sqrt(2 S(ω_j) Δω_j) and seeded uniform phases. Frequencies:
-  * with `repeat_period` T_R (seed 003 §5): every multiple of 2π/T_R inside `omega_range`
+  * with `repeat_period` T_R (Stansby & Li 2024 §5): every multiple of 2π/T_R inside `omega_range`
     (Δω_j = 2π/T_R), or, if `n_components` is also given, that many multiples of 2π/T_R spread
     evenly over the range (Δω_j = the spacing between neighbours). The elevation then repeats
     exactly with period T_R.
@@ -29,7 +29,7 @@ radians are meant) is refused by `check_heading`, naming the fix ``math.radians(
 - `MeasuredElevation(t, eta)`: a measured record at the origin decomposed by FFT; it reproduces the
   record (minus its mean) at the sample times and repeats with the record length.
 
-Directional spreading (`Spreading`) uses the random-directional method of seed 003 §5: every
+Directional spreading (`Spreading`) uses the random-directional method of Stansby & Li 2024 §5: every
 frequency component gets one direction drawn from the spreading distribution, so no two components
 share a frequency and the field is ergodic.
 
@@ -324,7 +324,7 @@ def _make_components(omega, amplitude, phase, heading, water_depth, g, repeat_pe
 
 @dataclass(frozen=True)
 class Spreading:
-    """Directional spreading G(β) = α cos^{2s}(β/2) on −π < β ≤ π (seed 003 eq. 34), β relative to
+    """Directional spreading G(β) = α cos^{2s}(β/2) on −π < β ≤ π (Stansby & Li 2024 eq. 34), β relative to
     the mean heading, α = Γ(s+1) / (2 sqrt(π) Γ(s+½)) so that ∫G dβ = 1.
 
     Its first circular moment is E[cos β] = s/(s+1), hence the directional spread
@@ -332,7 +332,7 @@ class Spreading:
 
     method:
     - "cos2s" (default): directions drawn exactly from G: sin²(β/2) ~ Beta(½, s+½) with a random sign.
-    - "normal": seed 003's approximation, β = σ·N(0, 1) with σ² = 2/(1+s), wrapped to (−π, π].
+    - "normal": Stansby & Li's (2024) approximation, β = σ·N(0, 1) with σ² = 2/(1+s), wrapped to (−π, π].
     """
 
     s: float
@@ -344,7 +344,7 @@ class Spreading:
             raise ValueError(f"s (spreading parameter) must be >= 0 (0 = uniform over all directions), got {self.s!r}")
         object.__setattr__(self, "s", s)
         if self.method not in ("cos2s", "normal"):
-            raise ValueError(f"method must be 'cos2s' (exact) or 'normal' (seed 003), got {self.method!r}")
+            raise ValueError(f"method must be 'cos2s' (exact) or 'normal' (Stansby & Li 2024), got {self.method!r}")
 
     @property
     def sigma(self) -> float:

@@ -496,7 +496,7 @@ def natural(model, loads, freqs, modes, zeta, zeta_rad, min_det, settings,
          "modes": (("coordinate", "mode"), np.asarray(modes).reshape(model.n_coordinates, n),
                    {"long_name": "mode shapes (coordinates)"}),
          "min_det": (("root",), np.asarray(min_det), {"long_name": "local minima of |det Λ(ω)| "
-                                                      "(seed 000 §2.10)", "units": "rad/s"}),
+                                                      "(Hallak et al. §2.10)", "units": "rad/s"}),
          "min_det_damped": (("root_damped",), np.asarray(min_det_damped, dtype=float),
                             {"long_name": "local minima of |det(−ω² M(ω) − iω (C + B(ω)) + K)|, "
                              "damping kept: the peaks of the response to a force of constant "

@@ -1,5 +1,5 @@
 """Natural frequencies of the model linearised about its equilibrium: the generalised eigenproblem
-with A(ω) iterated per mode, the minima of |det Λ(ω)| without and with damping (seed 000 §2.10),
+with A(ω) iterated per mode, the minima of |det Λ(ω)| without and with damping (Hallak et al. §2.10),
 the seed's closed form for three coordinates, and the damping that is a ratio of critical for one
 mode of one body (``[[body_matrices]] damping_ratio``)."""
 from __future__ import annotations
@@ -41,8 +41,8 @@ def natural_modes(model: Model, omega_grid=None, *, q0=None, iterations: int = 3
         of their own and move freely with the others (condensed out of the mass:
         M_ss − M_sf M_ff⁻¹ M_fs, the free part of each mode shape −M_ff⁻¹ M_fs φ_s).
     min_det: local minima of |det Λ(ω)|, Λ = −ω² M_eff(ω) + K_ss, over ``omega_grid``
-        (seed 000 §2.10), refined parabolically.
-    min_det_damped: the same with the damping kept (seed 000 eq. 27's remark):
+        (Hallak et al. §2.10), refined parabolically.
+    min_det_damped: the same with the damping kept (Hallak et al. eq. 27's remark):
         |det(−ω² M(ω) − iω (C + B(ω)) + K)|, B(ω) the radiation damping, C the joint, PTO and
         body-matrix damping, free coordinates condensed out dynamically; refined by a bounded
         search (:func:`_damped_minima`). These are the peaks of the response to a force of
@@ -196,7 +196,7 @@ def _damped_minima(model, sys, grid, stiff, free, options):
 
 def cubic_natural_frequencies(M, K):
     """The three natural frequencies (rad/s, ascending) of a 3-dof undamped system with constant
-    mass M and stiffness K (3, 3), from the cubic of seed 000 §2.11 (eqs. 37–44):
+    mass M and stiffness K (3, 3), from the cubic of Hallak et al. §2.11 (eqs. 37–44):
 
         P(λ) = det(K − λM) = â λ³ + b̂ λ² + ĉ λ + d̂,   λ = ω²,
         â = −det M,  b̂ = tr(adj(M) K),  ĉ = −tr(adj(K) M),  d̂ = det K

@@ -119,7 +119,7 @@ def _parse_joint(raw: Any, where: str, is_root: bool) -> JointSpec:
     if locked and kind not in ("revolute", "prismatic"):
         raise ConfigError(f"{where}.locked: only a revolute or prismatic joint can be locked")
     if locked:
-        # a locked hinge (seed 004, severe seas) is rigid at its q = 0 position: no coordinate
+        # a locked hinge (Wu & Yuan 2025, severe seas) is rigid at its q = 0 position: no coordinate
         for key in ("damping", "stiffness", "rest"):
             if key in raw:
                 raise ConfigError(f"{where}.{key}: a locked joint has no coordinate; remove the key")

@@ -5,7 +5,7 @@ model, the time, the state, the kinematics, its own states and memory) and it re
 :class:`LoadOutput`: Cartesian body loads ``body`` (n, 6: force in inertial axes, moment about the
 CoM in body axes), generalised loads ``tau`` (n_q), the derivative ``zd`` of its own first-order
 states, and an acceleration-proportional matrix ``mass`` (n_q, n_q) that the solver moves to the
-left-hand side. Loads enter the equations of motion as ``Bᵀ body + tau`` (seed 001 eq. 46).
+left-hand side. Loads enter the equations of motion as ``Bᵀ body + tau`` (Lande-Sudall et al. eq. 46).
 
 From the same definition the frequency domain takes, about a static equilibrium q₀:
 

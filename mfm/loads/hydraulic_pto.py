@@ -1,4 +1,4 @@
-"""Hydraulic PTO of seed 000 (Hallak et al.), a piston between two body points.
+"""Hydraulic PTO of Hallak et al., a piston between two body points.
 
 Config table ``[[ptos]]``: ``body`` and ``point`` (one end, m at q = 0), ``anchor_body`` (omitted:
 the inertial frame) and ``anchor`` (the other end), ``mu`` kg, ``beta`` N s/m, ``kappa`` N/m,

@@ -18,7 +18,7 @@ Cummins equation for all hydro bodies together:
 
 - A∞ is acceleration-proportional: ``M* += Hᵀ A∞ H`` and its velocity part ``−Hᵀ A∞ Ḣ q̇`` is a
   load (Ḣ q̇ from the tree walk's velocity-product accelerations). ``added_mass="rhs"`` instead
-  puts −A∞ ξ̈ on the right-hand side with the corrector's acceleration iterate (seed 001 §5).
+  puts −A∞ ξ̈ on the right-hand side with the corrector's acceleration iterate (Lande-Sudall et al. §5).
 - Buoyancy is the constant force ρgV ẑ at the centre of buoyancy (a point fixed in the body), plus
   the linear water-plane stiffness C_wp about r_k (the database's ``waterplane_stiffness``: no
   ρgV z_B, no m g z_G, so gravity and buoyancy are not counted twice). Weights act exactly (mfm).
@@ -175,7 +175,7 @@ class Water(Load):
         comps, zd, _, _ = self._forces(ctx.t, ctx.kin, ctx.z, ctx.memory, mv)
         F = sum(comps.values())
         if self.added_mass == "rhs" and ctx.qdd_guess is not None:
-            # seed 001 §5: −A∞ ξ̈ on the right-hand side with the corrector's acceleration iterate.
+            # Lande-Sudall et al. §5: −A∞ ξ̈ on the right-hand side with the corrector's acceleration iterate.
             # Without an iterate (start of a run, linearisation) the iteration's converged value
             # is used instead: A∞ on the left.
             F = F - self.A_inf[mv][:, mv] @ (H @ ctx.qdd_guess)
@@ -246,7 +246,7 @@ class Water(Load):
         r = float(np.abs(np.linalg.eigvals(np.linalg.solve(Ms, H.T @ np.asarray(self.A_inf) @ H))).max())
         if r < 1.0:
             return None
-        return (f"Likely cause: added_mass='rhs' (the seed 001 iteration of A∞ ξ̈ on the right-hand "
+        return (f"Likely cause: added_mass='rhs' (Lande-Sudall et al.'s iteration of A∞ ξ̈ on the right-hand "
                 f"side) diverges here: the spectral radius of M*⁻¹ Hᵀ A∞ H is {r:.3g} ≥ 1 (added "
                 "mass larger than the structural mass). Use added_mass='lhs' (A∞ in M*, no "
                 "iteration).")

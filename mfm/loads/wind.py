@@ -1,4 +1,4 @@
-"""Rotor thrust of a wind turbine on a floating body (seed 003, Stansby & Li, eq. 33).
+"""Rotor thrust of a wind turbine on a floating body (Stansby & Li 2024, eq. 33).
 
 Config table ``[[wind_thrust]]``: ``body``; ``hub`` [x, y, z] m, inertial at q = 0 (the point moves
 with the body); ``rotor_radius`` R m (> 0); ``wind_speed`` U m/s (≥ 0, the mean wind at the hub);
@@ -11,7 +11,7 @@ the direction the wind blows towards in the horizontal plane, degrees from +x to
     H = ½ ρ_air A C_T(U) (U − u_hub) |U − u_hub|,   A = π R²,   F = H d,  d = (cos φ, sin φ, 0),
 
 with u_hub = d · v_hub the hub's inertial velocity along the wind. C_T is taken at the mean wind U,
-not at the relative speed (seed 003), and is a linear interpolation of the table, 0 outside it (a
+not at the relative speed (Stansby & Li 2024), and is a linear interpolation of the table, 0 outside it (a
 U above the turbine's cut-out is allowed, with a warning: no thrust). (U − u)|U − u| keeps the sign
 right if the hub ever overtakes the wind.
 

@@ -1,4 +1,4 @@
-"""MFM equations of motion (seed 001 eq. 46), generalised forces and joint reaction loads.
+"""MFM equations of motion (Lande-Sudall et al. eq. 46), generalised forces and joint reaction loads.
 
     M* q̈ = Bᵀ F + Q − N* q̇,   M* = Bᵀ M B,   N* = Bᵀ (M Ḃ + D M B)
 
@@ -43,7 +43,7 @@ def gyroscopic(model: Model, X) -> jnp.ndarray:
 
 
 def coriolis_matrix(model: Model, q, qd) -> jnp.ndarray:
-    """N*(q, q̇) = Bᵀ (M Ḃ + D M B), shape (n_q, n_q) (seed 001 eq. 46)."""
+    """N*(q, q̇) = Bᵀ (M Ḃ + D M B), shape (n_q, n_q) (Lande-Sudall et al. eq. 46)."""
     q = jnp.asarray(q, jnp.float64)
     qd = jnp.asarray(qd, jnp.float64)
     B, Bdot = jax.jvp(lambda x: kinematics(model, x).B, (q,), (qd,))

@@ -1,14 +1,14 @@
 """Forward kinematics and the B-matrix by walking the tree with frame connections.
 
 Each body c hangs from its parent p by ``E_c = E_p · G_c(q)`` with the joint connection
-``G_c = E_{J/p} · Exp(θ₁ξ̂₁) ⋯ Exp(θ_kξ̂_k) · E_{c/J}`` (seed 001 eqs. 6–7): a constant placement of
+``G_c = E_{J/p} · Exp(θ₁ξ̂₁) ⋯ Exp(θ_kξ̂_k) · E_{c/J}`` (Lande-Sudall et al. eqs. 6–7): a constant placement of
 the joint frame on the parent (parallel to the parent frame, at the joint point), the joint's
 elementary motions (unit twists ξ: a rotation axis or a sliding direction), and the constant
 placement of the child CoM frame on the joint frame.
 
-Velocities follow by the same walk, one factor at a time (seed 001 eqs. 15–27): a rigid placement
+Velocities follow by the same walk, one factor at a time (Lande-Sudall et al. eqs. 15–27): a rigid placement
 by d adds ω × d to the origin velocity, a revolute motion adds θ̇ a to ω (a = the axis in inertial
-axes), a prismatic motion adds θ̇ a to the origin velocity. The B-matrix of seed 001 eq. 28 stacks,
+axes), a prismatic motion adds θ̇ a to the origin velocity. The B-matrix of Lande-Sudall et al. eq. 28 stacks,
 per body, the CoM velocity in inertial axes over the angular velocity in body axes:
 ``X = B(q) q̇`` with X of size 6n. The same walk gives Ḃ q̇ (the velocity-product accelerations,
 from ȧ = ω × a); the jvp of B along q̇ (:func:`b_matrix_dot`) is its independent check.
@@ -158,7 +158,7 @@ def kinematics(model: Model, q, qd=None) -> Kinematics:
 
     The walk composes, for each body, the parent's frame with the joint connection
     ``E_{J/p} · Exp(θ₁ξ̂₁) ⋯ Exp(θ_kξ̂_k) · E_{c/J}`` one factor at a time, carrying the velocity
-    Jacobians along (seed 001 eqs. 15–27: ẋ_c = ẋ_p + ω_p × s + joint terms, ω_c = ω_p + joint
+    Jacobians along (Lande-Sudall et al. eqs. 15–27: ẋ_c = ẋ_p + ω_p × s + joint terms, ω_c = ω_p + joint
     terms); the acceleration terms are their time derivatives. Everything is in inertial axes until
     the end, where ω is turned into body axes (ω_body = Rᵀ ω, ω̇_body = Rᵀ ω̇). The bodies of one
     tree level with the same kinds of motion are walked together (:func:`_groups`).
@@ -233,7 +233,7 @@ def _pose(R, x):
 
 
 def b_matrix(model: Model, q) -> jnp.ndarray:
-    """The B-matrix (6n, n_q) of seed 001 eq. 28: ``X = B(q) q̇`` with X stacking, per body in tree
+    """The B-matrix (6n, n_q) of Lande-Sudall et al. eq. 28: ``X = B(q) q̇`` with X stacking, per body in tree
     order, the CoM velocity (inertial axes, m/s) and the angular velocity (body axes, rad/s)."""
     B = kinematics(model, q).B
     return B.reshape(6 * model.n_bodies, model.n_coordinates)

@@ -1,4 +1,4 @@
-"""SE(3) frame connections as 4×4 matrices (seed 001 eqs. 4–12).
+"""SE(3) frame connections as 4×4 matrices (Lande-Sudall et al. eqs. 4–12).
 
 A frame connection ``E = [[R, x], [0, 1]]`` places a child frame in a parent frame: ``R`` turns
 child axes into parent axes and ``x`` is the child origin in parent axes. Composition is the matrix
@@ -191,7 +191,7 @@ def translation(E):
 
 
 def inverse(E):
-    """Analytic inverse (seed 001 eq. 8): ``[[Rᵀ, −Rᵀx], [0, 1]]``."""
+    """Analytic inverse (Lande-Sudall et al. eq. 8): ``[[Rᵀ, −Rᵀx], [0, 1]]``."""
     R, x = E[:3, :3], E[:3, 3]
     return make(R.T, -R.T @ x)
 

@@ -42,7 +42,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     sea: a sea state from :mod:`hydro.waves` (``Regular``, ``Jonswap``, …), or None (still water,
         or no water at all for a mechanics-only model).
     duration, dt: s. The run has ``round(duration / dt)`` steps.
-    integrator: ``"rk4"`` (default), ``"beeman"`` (seed 001 eq. 52), ``"semi_implicit"``,
+    integrator: ``"rk4"`` (default), ``"beeman"`` (Lande-Sudall et al. eq. 52), ``"semi_implicit"``,
         ``"newmark"``, ``"verlet"`` (one evaluation per step, second order: the fast one, with
         ``radiation="state_space_exact"``), or an instance from :mod:`mfm.integrators`.
     q0, qd0: initial coordinates and rates, arrays (n_q,) or dicts by coordinate name (others 0).
@@ -62,7 +62,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
         ``state_space_options``, its states integrated by the integrator),
         ``"state_space_exact"`` (the same fit, its states advanced exactly over each step: stable
         at any dt, what ``integrator="verlet"`` needs) or ``"none"`` (A∞ only).
-    added_mass: ``"lhs"`` (A∞ in M*, the default) or ``"rhs"``: the scheme of seed 001 §5, A∞ ξ̈
+    added_mass: ``"lhs"`` (A∞ in M*, the default) or ``"rhs"``: the scheme of Lande-Sudall et al. §5, A∞ ξ̈
         on the right-hand side with the acceleration iterated in Beeman's corrector (needs
         ``integrator="beeman"``; converges only where A∞ is smaller than the structural mass; the
         iteration counts are in ``iterations``).
@@ -111,9 +111,9 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     refuse_impossible(model, extra + tuple(model.loads), n_steps, save_every)
     integ = _integrators.get(integrator)
     if added_mass not in ("lhs", "rhs"):
-        raise ValueError(f"added_mass={added_mass!r}; accepted: 'lhs' (A∞ in M*), 'rhs' (seed 001)")
+        raise ValueError(f"added_mass={added_mass!r}; accepted: 'lhs' (A∞ in M*), 'rhs' (Lande-Sudall et al.)")
     if added_mass == "rhs" and integ.name != "beeman":
-        raise ValueError(f"added_mass='rhs' (the seed 001 scheme) iterates the acceleration in "
+        raise ValueError(f"added_mass='rhs' (the scheme of Lande-Sudall et al.) iterates the acceleration in "
                          f"Beeman's corrector; integrator={integ.name!r} has none: use "
                          "integrator='beeman' or added_mass='lhs'")
     choice = "given"

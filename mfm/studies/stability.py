@@ -15,7 +15,7 @@ re-derivation of a scheme on paper:
    a scheme whose q̈ is a function of (q, q̇) the extra eigenvalues are 0.) Two placements of A∞:
 
    - ``added_mass="lhs"`` (mfm's): (M + A∞) q̈ = −C q̇ − K q;
-   - ``added_mass="rhs"`` (seed 001 §5): M q̈ = −C q̇ − K q − A∞ q̈_guess, q̈_guess the corrector's
+   - ``added_mass="rhs"`` (Lande-Sudall et al. §5): M q̈ = −C q̇ − K q − A∞ q̈_guess, q̈_guess the corrector's
      current iterate (:class:`~mfm.integrators.Beeman`; with ``max_iter=0`` no corrector at all:
      the lagged q̈ₙ, the classic added-mass instability).
 
@@ -51,7 +51,7 @@ ADDED_MASS = ("lhs", "rhs")
 def _added_mass(value):
     if value not in ADDED_MASS:
         raise ValueError(f"added_mass={value!r}; accepted: 'lhs' (A∞ in M*, mfm's) or 'rhs' (A∞ q̈ "
-                         "on the right-hand side with the corrector's iterate, seed 001 §5)")
+                         "on the right-hand side with the corrector's iterate, Lande-Sudall et al. §5)")
     return value
 
 

@@ -1,15 +1,15 @@
 """Wave energy measures: incident wave power, capture width ratio, response statistics and RAOs
-from time series (seed 001 §6).
+from time series (Lande-Sudall et al. §6).
 
-Conventions of seed 001 (Lande-Sudall et al.), kept so that its figures can be reproduced:
+Conventions of Lande-Sudall et al., kept so that its figures can be reproduced:
 
 - deep-water wave power per metre of crest, irregular sea  P_w = ρ g² H_s² T_e / (64 π),
   regular wave  P_w = ρ g² H² T / (32 π)  (the group velocity g T / 4π times the energy ρ g H² / 8);
 - the device length  L_e = g T_e² / (2π), the deep-water wavelength at the energy period;
-- T_e = 0.84 T_p for JONSWAP γ = 3.3 and 0.78 T_p for γ = 1 (seed 001 §6.3; the exact ratios
+- T_e = 0.84 T_p for JONSWAP γ = 3.3 and 0.78 T_p for γ = 1 (Lande-Sudall et al. §6.3; the exact ratios
   m₋₁/m₀ of our spectra are :func:`energy_period`);
-- the capture width ratio  CWR = P_av / (P_w L_e)  (seed 001 eq. 53);
-- the RAO from an irregular run  √(S_θθ / S_ηη)  (seed 001 eq. 54).
+- the capture width ratio  CWR = P_av / (P_w L_e)  (Lande-Sudall et al. eq. 53);
+- the RAO from an irregular run  √(S_θθ / S_ηη)  (Lande-Sudall et al. eq. 54).
 
 The deep-water expressions are the seed's choice also where the basin is not deep (1 m water at
 T_p = 1.8 s: k h ≈ 1.3); :func:`wave_power` takes ``water_depth`` for the finite-depth value.
@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-#: T_e / T_p used by seed 001 for its JONSWAP seas, by peak enhancement γ
+#: T_e / T_p used by Lande-Sudall et al. for its JONSWAP seas, by peak enhancement γ
 SEED_TE_OVER_TP = {3.3: 0.84, 1.0: 0.78}
 
 
@@ -54,7 +54,7 @@ def wave_power(height, period, *, regular: bool = False, rho: float = 1000.0, g:
 
 def capture_width_ratio(mean_power, wave_power_per_metre, length):
     """CWR = P_av / (P_w L): mean absorbed power (W) over the wave power per metre (W/m) times a
-    length (m; seed 001: L_e, the deep-water wavelength at T_e)."""
+    length (m; Lande-Sudall et al.: L_e, the deep-water wavelength at T_e)."""
     return np.asarray(mean_power) / (np.asarray(wave_power_per_metre) * np.asarray(length))
 
 
@@ -82,7 +82,7 @@ def harmonic_amplitude(t, y, omega: float, extra_omegas=()):
 
 
 def spectral_rao(t, response, elevation, *, segment: float | None = None):
-    """RAO = √(S_rr / S_ηη) (seed 001 eq. 54) from an irregular run: Welch spectra (Hann windows
+    """RAO = √(S_rr / S_ηη) (Lande-Sudall et al. eq. 54) from an irregular run: Welch spectra (Hann windows
     of ``segment`` seconds, default a quarter of the record, half overlap) of the response and of
     the undisturbed elevation. Returns (ω (rad/s), RAO, S_ηη (m² s/rad))."""
     from scipy.signal import welch

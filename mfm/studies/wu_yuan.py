@@ -1,4 +1,4 @@
-"""Wu & Yuan (seed 004) in the frequency domain: the power of each WEC operating alone, P_s of the
+"""Wu & Yuan (2025) in the frequency domain: the power of each WEC operating alone, P_s of the
 interaction factors (eqs. 31–33: q_s = P_m^i / P_s^i, q_r and q_a their sums over a row or the
 array), from the lone-WEC model configs/wu_yuan_wec.toml; the five spacings at the seed's ten
 periods (H 3.8 m, heading 0) and the severe sea with locked hinges (H 8.1 m, T 11.4 s), from

@@ -1,4 +1,4 @@
-"""The Wu & Yuan semi-sub energy platform with 12 hinged WECs (seed 004; GEOMETRY.md §4): its layout
+"""The Wu & Yuan semi-sub energy platform with 12 hinged WECs (2025; GEOMETRY.md §4): its layout
 and data, and the configs written from them: configs/wu_yuan_m1.toml … wu_yuan_m5.toml at the
 five WEC spacings L = 2D … 3D of the seed's Table 4; configs/wu_yuan_m1_td.toml, model 1 with a
 band database for the time domain (K(t)); and configs/wu_yuan_wec.toml, one WEC alone hinged at
@@ -187,7 +187,7 @@ def lines():
 HEADER = """\
 # Semi-sub energy harvesting platform with 12 hinged point absorbers, model {m} (L = {ld:g} D = {L:g} m):
 # H. Wu, Z. Yuan, "WEC spacing effects on the performance of a floating energy harvesting
-# platform", Ocean Engineering (2025) (docs/references.md, seed 004). Values tagged as in
+# platform", Ocean Engineering (2025) (docs/references.md). Values tagged as in
 # docs/GEOMETRY.md §4:
 #   [S] stated in the seed, [D] derived from stated values, [A] assumed (no source found).
 # MADE BY tools/wu_yuan_configs.py (the five models share everything but the spacing-dependent
@@ -446,8 +446,8 @@ def config_text(m: int, td: bool = False, locked: bool = False) -> str:
 
 WEC_ALONE = """\
 # One WEC of the Wu & Yuan platform operating ALONE: P_s of the interaction factors q_s, q_r, q_a
-# (seed 004 eqs. 31–33: "P_s^i is the captured power of the i-th WEC when it operates alone").
-# H. Wu, Z. Yuan, Ocean Engineering (2025) (docs/references.md, seed 004); values tagged as in
+# (Wu & Yuan 2025 eqs. 31–33: "P_s^i is the captured power of the i-th WEC when it operates alone").
+# H. Wu, Z. Yuan, Ocean Engineering (2025) (docs/references.md); values tagged as in
 # docs/GEOMETRY.md §4 ([S] stated, [D] derived, [A] assumed).
 # MADE BY tools/wu_yuan_configs.py (the WEC's data are those of configs/wu_yuan_m1..m5.toml; edit
 #   the script and rerun it, not this file).
@@ -559,7 +559,7 @@ def main(argv=None, root=ROOT):
     import argparse
 
     ap = argparse.ArgumentParser(description="Write configs/wu_yuan_m1..m5.toml, wu_yuan_m1_td.toml "
-                                             "and wu_yuan_wec.toml (Wu & Yuan, seed 004) from "
+                                             "and wu_yuan_wec.toml (Wu & Yuan 2025) from "
                                              "mfm.studies.wu_yuan_layout")
     ap.add_argument("--check", action="store_true",
                     help="write nothing; exit 1 if a config differs from what would be written")

@@ -16,7 +16,7 @@ assuming them. ``State.qdd`` holds the acceleration at
 step (implicit and predictor–corrector schemes; 0 otherwise).
 
 Stability on an undamped oscillator of natural frequency ω (``stability_limit`` = max ω dt):
-RK4 2√2, Beeman (seed 001 eq. 52 with its corrector) 2, semi-implicit Euler 2, Verlet (Beeman's
+RK4 2√2, Beeman (Lande-Sudall et al. eq. 52 with its corrector) 2, semi-implicit Euler 2, Verlet (Beeman's
 step without the corrector) 2, Newmark average acceleration ∞ (unconditionally stable).
 """
 from __future__ import annotations
@@ -163,7 +163,7 @@ class Verlet(AbstractIntegrator):
         q̈ₙ₊₁, ż* = f(tₙ₊₁, qₙ₊₁, q̇*, z*)
         q̇ₙ₊₁ = q̇ₙ + dt/2 (q̈ₙ + q̈ₙ₊₁),   zₙ₊₁ = zₙ + dt/2 (żₙ + ż*)
 
-    Beeman's step (seed 001 eq. 52) with no corrector iteration. q̈ₙ₊₁ is taken at the predicted
+    Beeman's step (Lande-Sudall et al. eq. 52) with no corrector iteration. q̈ₙ₊₁ is taken at the predicted
     velocity q̇*, which is O(dt²) off q̇ₙ₊₁: with velocity-dependent loads (damping, drag, PTOs) that
     enters q̇ at O(dt³) per step, so the scheme stays second order. On an undamped oscillator it is
     Störmer–Verlet: period error (ω dt)²/24, half the trapezoid's. Stable for ω dt < 2
@@ -198,7 +198,7 @@ def _rel_change(new, old):
 
 @dataclasses.dataclass(frozen=True)
 class Beeman(AbstractIntegrator):
-    """The scheme of seed 001 eq. 52 (after [29]), a predictor–corrector:
+    """The scheme of Lande-Sudall et al. eq. 52 (after [29]), a predictor–corrector:
 
         qₙ₊₁ = qₙ + dt (q̇ₙ + q̈ₙ dt/2)                      (52a)
         q̇ₙ₊₁ = q̇ₙ + dt/2 (q̈ₙ + q̈ₙ₊₁)                      (52b)
