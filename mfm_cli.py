@@ -224,7 +224,10 @@ def main(argv=None):
     from mfm.io import cli   # the commands, and with them mfm and jax: only now that there is work
     from mfm.runner import collector as _gc
 
-    _gc.freeze_at_exit()     # the command's objects skip the exit's collections (mfm/runner/collector.py)
+    # the command owns its process: the libraries' objects out of the collector's walks now, and
+    # the command's at its exit (mfm/runner/collector.py)
+    _gc.freeze()
+    _gc.freeze_at_exit()
 
     formatwarning = warnings.formatwarning
     warnings.formatwarning = cli.format_warnings(args)    # one line, no source path

@@ -4,6 +4,9 @@ import os
 # 2-core CI machine (threaded BLAS measured up to 10× slower on first calls under load).
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("MPLBACKEND", "Agg")
+# the command line freezes the collector's objects (mfm/runner/collector.py: it owns its process);
+# tests call it inside their own process, whose objects must stay collectable
+os.environ.setdefault("MFM_GC_FREEZE", "off")
 # XLA's cheapest optimisation (set before jax starts): compiling is most of most tests' time and
 # their runs are short; the numbers agree to round-off. Measured on tests/test_device_ptos.py, both
 # runs side by side on the same loaded machine: 229 s -> 211 s; the README blocks' subprocess

@@ -338,19 +338,23 @@ def test_importing_mfm_freezes_nothing():
     assert _freeze_count({"MFM_GC_FREEZE": ""}) == 0
 
 
-def test_the_command_line_freezes_at_exit_once(monkeypatch):
+def test_the_command_line_freezes_after_its_imports_and_at_exit_once(monkeypatch):
     import gc
 
     import mfm_cli
     from mfm.runner import collector as _gc
 
-    registered = []
+    registered, frozen = [], []
     monkeypatch.setattr(_gc, "_at_exit", False)
-    # the module's own view of atexit (the other libraries' handlers register as usual)
+    # the module's own view of atexit and gc (the test process's own objects stay collectable)
     monkeypatch.setattr(_gc, "atexit", types.SimpleNamespace(register=registered.append))
+    monkeypatch.setattr(_gc, "gc", types.SimpleNamespace(freeze=lambda: frozen.append(1)))
+    monkeypatch.delenv("MFM_GC_FREEZE", raising=False)
     for _ in range(2):
         assert mfm_cli.main(["info", str(CONFIGS / "double_pendulum.toml")]) == 0
-    assert registered == [_gc.freeze]                   # once, however many commands ran
+    assert frozen == [1, 1]                             # each command, after its imports
+    assert registered == [_gc.freeze]                   # the exit's: once, however many ran
+    monkeypatch.setattr(_gc, "gc", gc)
     # the handler itself moves what exists into the permanent generation (and undoes nothing)
     monkeypatch.setenv("MFM_GC_FREEZE", "off")
     assert _gc.freeze() is False

@@ -7,16 +7,17 @@ spent 0.5 s in its exit, and one that had also run M4 134 1.0–1.3 s, before it
 shell (its last line's time against the shell's clock; 0.1 s with ``os._exit``: the collections
 at exit, not the work of the run). benchmarks/RESULTS.md has the whole processes' figures.
 
-So mfm moves what exists at the end of its import into the collector's permanent generation
-(:func:`gc.freeze`, the standard library's tool for long-lived objects): later collections and
-the exit skip them. Nothing is lost: those objects are the libraries' own and live to the end of
-the process anyway, and everything made afterwards (models, results, the user's objects) is
-collected as before. ``MFM_GC_FREEZE=off`` keeps Python's default.
+The command line (``mfm ...``), which owns its process, moves what exists once it has imported
+mfm into the collector's permanent generation (:func:`freeze`, the standard library's
+:func:`gc.freeze`, its tool for long-lived objects): later collections and the exit skip them.
+Nothing is lost: those objects are the libraries' own and live to the end of the process anyway,
+and everything made afterwards is collected as before. It also freezes at its exit whatever its
+command made (:func:`freeze_at_exit`): it has closed its files by then, and the objects would only
+be collected to be thrown away with the process. ``MFM_GC_FREEZE=off`` keeps Python's default.
 
-The command line (``mfm ...``) also freezes at its exit whatever its command made: it has closed
-its files by then, and the objects would only be collected to be thrown away with the process.
-A library cannot do that for a user's script, whose own objects may rely on being collected at
-exit (a file flushed by a finaliser), so :func:`freeze_at_exit` is the command line's alone.
+``import mfm`` does neither (issue 52: the library changes no global state a user did not ask
+for): a script of the user's, whose own objects may rely on being collected, gets the same
+shorter collections by calling ``gc.freeze()`` itself after its imports (README, Speed).
 """
 from __future__ import annotations
 
