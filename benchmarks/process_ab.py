@@ -7,6 +7,8 @@ README's RM3 case (regular wave H 2.5 m, T 8 s, 200 s at dt 0.1, ramp 40 s) in a
 process with ``PYTHONPATH`` set to one tree, from import to exit:
 
 - ``script``: through the Python API (``mfm.load`` then ``mfm.simulate``), as a user's script;
+- ``script_frozen``: the same script with ``gc.freeze()`` after its imports in this tree (the
+  other tree's is the plain script: before issue 52, ``import mfm`` froze);
 - ``cli``: through the command's entry point (``mfm_cli.main([...])``, no figure).
 
 The two trees run in turn (this, other, this, other, …) after one warm-up of each, which also
@@ -43,7 +45,9 @@ sys.exit(main(["simulate", sys.argv[1] + "/configs/rm3.toml", "--wave", "regular
                "2.5", "--period", "8", "--duration", "200", "--dt", "0.1", "--ramp", "40",
                "--out", sys.argv[2], "--no-plot"]))
 """
-ROWS = {"script": SCRIPT, "cli": CLI}
+# the script as README § Speed advises: the libraries' objects out of the collector's walks
+SCRIPT_FROZEN = SCRIPT.replace("import mfm\n", "import mfm\nimport gc\ngc.freeze()\n", 1)
+ROWS = {"script": SCRIPT, "script_frozen": SCRIPT_FROZEN, "cli": CLI}
 
 
 def run(tree: Path, code: str, out: Path) -> tuple[float, float]:
@@ -70,12 +74,13 @@ def main(argv=None) -> int:
           f"{args.repeats} pairs after one warm-up each")
     for row in args.rows:
         code = ROWS[row]
-        for tree in trees.values():
-            run(tree, code, out)                     # warm-up: fills the caches
+        codes = {"this": code, "other": SCRIPT if row == "script_frozen" else code}
+        for name, tree in trees.items():
+            run(tree, codes[name], out)              # warm-up: fills the caches
         got = {name: [] for name in trees}
         for _ in range(args.repeats):
             for name, tree in trees.items():
-                got[name].append(run(tree, code, out))
+                got[name].append(run(tree, codes[name], out))
         cpu = {n: statistics.median(c for c, _ in v) for n, v in got.items()}
         wall = {n: statistics.median(w for _, w in v) for n, v in got.items()}
         ratio = statistics.median(a[0] / b[0] for a, b in zip(got["this"], got["other"]))
