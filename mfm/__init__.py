@@ -3,7 +3,7 @@
 Importing mfm switches jax to float64 (every physical quantity here is float64) and starts jax's
 backend with the XLA option that compiles mfm's time loops as one function
 (:mod:`mfm.backend`); it changes no environment variable, no garbage-collector setting and no
-cache folder: the first program the runner makes turns jax's compilation cache on
+cache folder: ``mfm.load`` (or the runner's first program) turns jax's compilation cache on
 (:mod:`mfm.runner.door`).
 
 Data flows one way: config (TOML) → float tree → :class:`Model` → :func:`simulate` →

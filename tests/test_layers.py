@@ -84,7 +84,8 @@ def test_import_mfm_changes_no_global_state():
     """In a fresh process with jax, numpy and xarray imported: ``import mfm`` leaves os.environ
     as it was (XLA's option reaches the backend as it starts, then XLA_FLAGS is given back),
     the garbage collector as it was (enabled, nothing frozen), and adds to sys.modules only real
-    modules (no stand-ins without a spec); it makes no cache folder."""
+    modules (no stand-ins without a spec); it makes no cache folder. mfm.load then turns jax's
+    compilation cache on."""
     code = """
 import gc, json, os, sys, tempfile
 os.environ["XDG_CACHE_HOME"] = tempfile.mkdtemp()
@@ -103,13 +104,14 @@ print(json.dumps({
     "cache_dir": jax.config.jax_compilation_cache_dir,
     "folders": os.listdir(os.environ["XDG_CACHE_HOME"]),
     "whole": mfm.backend.LOOPS_COMPILED_WHOLE,
+    "after_load": (mfm.load(sys.argv[1]), jax.config.jax_compilation_cache_dir)[1],
 }))
 """
     env = {k: v for k, v in __import__("os").environ.items()
            if k not in ("XLA_FLAGS", "JAX_COMPILATION_CACHE_DIR", "MFM_COMPILATION_CACHE")}
     env["PYTHONPATH"] = str(ROOT)
-    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
-                         timeout=300, cwd=ROOT)
+    out = subprocess.run([sys.executable, "-c", code, str(CONFIGS / "double_pendulum.toml")],
+                         env=env, capture_output=True, text=True, timeout=300, cwd=ROOT)
     assert out.returncode == 0, out.stderr[-2000:]
     got = json.loads(out.stdout.strip().splitlines()[-1])
     assert got["env"] == {}, got["env"]
@@ -118,6 +120,9 @@ print(json.dumps({
     assert got["stand_ins"] == [] and got["mfm_without_file"] == []
     assert got["cache_dir"] is None and got["folders"] == []
     assert got["whole"] is True            # and XLA's option took effect all the same
+    # a session starts with a model: mfm.load turns the compilation cache on (a model without
+    # water, whose load compiles nothing of the runner's own), under XDG_CACHE_HOME
+    assert got["after_load"] and got["after_load"].endswith("/mfm/jax"), got["after_load"]
 
 
 def test_the_core_under_the_plain_host_gives_the_runners_numbers():

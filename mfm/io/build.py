@@ -23,6 +23,7 @@ from ..loads.registry import TABLES, load_class
 from ..loads.water import load_hydro_spec
 from ..mechanics.compile import compile_tree
 from ..mechanics.model import Model
+from ..runner import xla
 from .bemgen import database_is_stale
 from .config import read_config, read_config_data
 
@@ -52,6 +53,9 @@ def load(path, hydro: bool = True, body_coupling: bool | None = None,
     The model's provenance (``source``, ``source_sha256``) is the file and the sha256 of its bytes,
     or ``<dict>`` / ``<toml text>`` and the sha256 of the text (of the dict as sorted JSON).
     """
+    # jax's compilation cache on before the first compilation of the session (the runner's, at
+    # its first use, not at import: a session starts with a model, whatever it runs next)
+    xla.compilation_cache()
     if isinstance(path, Model):
         raise TypeError(f"path: got a Model ({path.name!r}), already loaded; pass it on as it is, "
                         "or give mfm.load the path of its config TOML file")

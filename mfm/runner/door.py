@@ -1,6 +1,6 @@
 """The runner's host (:class:`RunnerHost`: programs kept on disk, mooring tables kept), the
 default host of the core's calls once ``mfm`` is imported (:func:`install`). jax's persistent
-compilation cache is turned on by the first program the runner makes
+compilation cache is turned on by ``mfm.load`` or the first program the runner makes
 (:func:`mfm.runner.programs.folder` → :func:`mfm.runner.xla.compilation_cache`), not at import.
 """
 from __future__ import annotations

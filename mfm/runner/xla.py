@@ -15,8 +15,8 @@ replaces an entry, so a torn one (a kill, a full disk) was warned about and comp
 every run. Now an entry that fails its check is removed, said once, compiled again and replaced.
 A folder named by jax's own setting is left in jax's format (other programs may share it).
 
-The cache is turned on by the first program the runner makes (:func:`compilation_cache`, from
-:func:`mfm.runner.programs.folder`), not at import: ``import mfm`` makes no folder and changes no jax setting.
+The cache is turned on by ``mfm.load`` or the runner's first program, whichever comes first
+(:func:`compilation_cache`, from :func:`mfm.io.build.load` and :func:`mfm.runner.programs.folder`), not at import: ``import mfm`` makes no folder and changes no jax setting.
 """
 from __future__ import annotations
 
