@@ -153,7 +153,7 @@ def test_drag_linearisation_is_a_fixed_point_of_the_numpy_route():
     import jax.numpy as jnp
 
     from hydro.waves import Jonswap
-    from mfm.frequency.rest import system_loads, water_of
+    from mfm.frequency.rest import linear_hydro, system_loads
     from mfm.loads.body_matrix import LinearBodyMatrix
 
     with warnings.catch_warnings():
@@ -166,7 +166,7 @@ def test_drag_linearisation_is_a_fixed_point_of_the_numpy_route():
     _, _, r = O._run(P, np.array([0.5]), 1.0)
     assert float(r.drag_change) < 1e-10
     c_eq = r.drag_damping[0].reshape(-1, 6)                 # (K, 6): translations only
-    water = water_of(system_loads(m))
+    water = linear_hydro(system_loads(m))
     D = np.asarray(water.drag)
     assert np.all(c_eq[:, 3:] == 0) and np.any(c_eq[:, :3] > 0)
     g = water.geometry

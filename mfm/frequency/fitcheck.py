@@ -160,9 +160,9 @@ class _Table:
 
 
 def _database_grid(sys):
-    from .rest import water_of
+    from .rest import linear_hydro
 
-    water = water_of(sys.loads)
+    water = linear_hydro(sys.loads)
     if water is None:
         return np.zeros(0)
     om = np.asarray(water.spec.database()["omega"].values, float)

@@ -230,16 +230,28 @@ def linearise(model: Model, q0=None, *, loads=None):
     about the equilibrium, and the hydro Jacobian H₀ (6K, n_q) (None without water)."""
     sys = linear_system(model, q0, loads=loads)
     M0 = np.asarray(mass_matrix(model, jnp.asarray(sys.q0)))
-    water = water_of(sys.loads)
+    water = linear_hydro(sys.loads)
     H0 = None if water is None else np.asarray(h_matrix_at(water.geometry, sys.kin0))
     return sys.q0, M0, sys.K, sys.C, H0
 
 
-def water_of(loads):
-    """The water load among ``loads``, or None."""
-    from ..loads.water import Water
+def linear_hydro_index(loads) -> int | None:
+    """Where among ``loads`` the one that carries a linear potential-flow model is
+    (:meth:`~mfm.loads.base.Load.linear_hydro`), or None. Two such loads are refused: the levels
+    built on it read one BEM model."""
+    found = [k for k, ld in enumerate(loads) if ld.linear_hydro() is not None]
+    if len(found) > 1:
+        raise ValueError("loads: " + ", ".join(type(loads[k]).__name__ for k in found)
+                         + " each carry a linear potential-flow model (linear_hydro); the spectral "
+                         "and linear levels read one: give the model one [hydro] table")
+    return found[0] if found else None
 
-    return next((ld for ld in loads if isinstance(ld, Water)), None)
+
+def linear_hydro(loads):
+    """The :class:`~mfm.loads.base.LinearHydro` of ``loads`` (:func:`linear_hydro_index`), or
+    None."""
+    k = linear_hydro_index(loads)
+    return None if k is None else loads[k].linear_hydro()
 
 
 def linearise_lines(model: Model, q0=None) -> Model:

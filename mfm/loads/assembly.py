@@ -17,9 +17,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..validation import check_sea
-from .base import Context, Load
-from .radiation import Convolution, StateSpace
-from .water import Water, build_water, build_water_batch
+from .base import Context, Load, RunGrid
+from .water import build_water, build_water_batch
 
 # the stage offsets of RK4 (fractions of dt at which it evaluates the dynamics): what the loads of
 # a linearisation are built with when no integrator is named (their tables hold no run either way)
@@ -28,19 +27,39 @@ RK4_STAGE_OFFSETS = (0.0, 0.5, 1.0)
 
 def carried_loads(model, sea=None, *, dt, duration, t0=0.0, ramp=0.0, radiation="convolution",
                   memory=None, state_space_options=None, added_mass="lhs",
-                  stage_offsets=RK4_STAGE_OFFSETS) -> tuple[Load, ...]:
-    """The loads a model carries itself: with a [hydro] config its water for this sea and time
-    grid (:func:`mfm.loads.water.build_water`, prepared for an integrator's ``stage_offsets``),
-    then the config's loads (``model.loads``: moorings, PTOs, …). The time domain's
+                  stage_offsets=RK4_STAGE_OFFSETS, extra=()) -> tuple[Load, ...]:
+    """The loads of a run: with a [hydro] config the model's water for this sea and time grid
+    (:func:`mfm.loads.water.build_water`, prepared for an integrator's ``stage_offsets``), then
+    the config's loads (``model.loads``: moorings, PTOs, …) and the ``extra`` loads of a front
+    door, each laid on the run by its :meth:`~mfm.loads.base.Load.for_run`. The time domain's
     :func:`mfm.timedomain.setup.model_loads` names the integrator instead of its offsets."""
     out = []
+    run = run_grid(sea, dt=dt, duration=duration, t0=t0, ramp=ramp, stage_offsets=stage_offsets)
     if model.hydro is not None:
         check_sea(sea)
         out.append(build_water(model, model.hydro, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                                radiation=radiation, memory=memory,
                                state_space_options=state_space_options, added_mass=added_mass,
-                               stage_offsets=tuple(float(o) for o in stage_offsets)))
-    return tuple(out) + tuple(model.loads)
+                               stage_offsets=run.stage_offsets))
+    return tuple(out) + laid_on(model, tuple(model.loads) + tuple(extra), run)
+
+
+def run_grid(sea, *, dt, duration, t0=0.0, ramp=0.0, stage_offsets=RK4_STAGE_OFFSETS) -> RunGrid:
+    """The :class:`~mfm.loads.base.RunGrid` of a run of ``duration`` s in steps of ``dt``."""
+    return RunGrid(sea, float(t0), float(dt), int(round(float(duration) / float(dt))), float(ramp),
+                   tuple(float(o) for o in stage_offsets))
+
+
+def laid_on(model, loads, run: RunGrid) -> tuple[Load, ...]:
+    """``loads`` laid on the run ``run`` (:meth:`~mfm.loads.base.Load.for_run` of each), each
+    checked to be a load still."""
+    out = []
+    for ld in loads:
+        laid = ld.for_run(model, run)
+        if not isinstance(laid, Load):
+            raise TypeError(f"load {type(ld).__name__}: for_run returned {laid!r}, not a Load")
+        out.append(laid)
+    return tuple(out)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -49,32 +68,40 @@ class CaseLoads:
     ``batched`` (a pytree of bools like it) carry a leading case axis of length ``size``, the
     others shared by every case (:func:`carried_loads_batch`). With water, ``waves`` (a
     :class:`~mfm.loads.water.WaveSum` over the cases) makes the water's tables, which ``loads``
-    leaves out (None); :meth:`with_eta` puts the elevation in for the dataset."""
+    leaves out (None), for the load at ``waves_at`` (its ``with_tables(exc, eta)`` puts them in);
+    :meth:`with_eta` puts the elevation in for the dataset."""
     loads: tuple
     batched: tuple
     size: int
     waves: object = None
     polar: tuple = ()
+    waves_at: int = 0
+
+    def with_tables(self, loads: tuple, exc, eta) -> tuple:
+        """``loads`` (one case's, or a group's with the case axis) with the tables of ``waves``
+        put in the load they belong to."""
+        k = self.waves_at
+        return loads[:k] + (loads[k].with_tables(exc, eta),) + loads[k + 1:]
 
     def case(self, i: int) -> tuple:
         """Case i's loads, as :func:`carried_loads` makes them (the water's tables made on the
         host, by build_water's own route, where they are left out)."""
         varying, shared = eqx.partition(self.loads, self.batched)
         loads = eqx.combine(jax.tree_util.tree_map(lambda a: a[i], varying), shared)
-        if self.waves is not None and loads[0].exc_values is None:
+        if self.waves is not None and loads[self.waves_at].exc_values is None:
             exc, eta = jax.tree_util.tree_map(lambda a: a[i], self.waves).tables_numpy(
                 tuple(np.asarray(a) for a in self.polar))
-            loads = (dataclasses.replace(loads[0], exc_values=exc, eta_values=eta),) \
-                + tuple(loads[1:])
+            loads = self.with_tables(loads, exc, eta)
         return loads
 
     def with_eta(self, eta) -> "CaseLoads":
         """These loads with the water's elevation table put in, with its case axis (B, n): what
         the dataset reads of the tables (:meth:`batch_outputs`)."""
-        water = dataclasses.replace(self.loads[0], eta_values=eta)
-        mask = dataclasses.replace(self.batched[0], eta_values=True)
-        return dataclasses.replace(self, loads=(water,) + self.loads[1:],
-                                   batched=(mask,) + self.batched[1:])
+        k = self.waves_at
+        water = dataclasses.replace(self.loads[k], eta_values=eta)
+        mask = dataclasses.replace(self.batched[k], eta_values=True)
+        return dataclasses.replace(self, loads=self.loads[:k] + (water,) + self.loads[k + 1:],
+                                   batched=self.batched[:k] + (mask,) + self.batched[k + 1:])
 
     def __len__(self):
         return self.size
@@ -96,11 +123,12 @@ class CaseLoads:
 
 def carried_loads_batch(model, seas, *, dts, ramps, n_steps: int, t0=0.0, radiation="convolution",
                         memory=None, state_space_options=None, added_mass="lhs",
-                        stage_offsets=RK4_STAGE_OFFSETS) -> CaseLoads:
+                        stage_offsets=RK4_STAGE_OFFSETS, extra=()) -> CaseLoads:
     """:func:`carried_loads` of B cases of one model at once (case b: ``seas[b]``, ``dts[b]``,
     ``ramps[b]``, ``n_steps`` steps): its water by :func:`mfm.loads.water.build_water_batch`
     (what the cases share made once, what differs vectorised, the tables left to the device),
-    its config's loads shared."""
+    its config's loads and the ``extra`` loads each laid on every case's run (:meth:`~mfm.loads.base.Load.for_run`):
+    shared where that is the load itself for every case, stacked on a case axis otherwise."""
     B = len(seas)
     out, batched, waves, polar = [], [], None, ()
     if model.hydro is not None:
@@ -112,31 +140,58 @@ def carried_loads_batch(model, seas, *, dts, ramps, n_steps: int, t0=0.0, radiat
             added_mass=added_mass, stage_offsets=tuple(float(o) for o in stage_offsets))
         out.append(water)
         batched.append(mask)
-    for ld in model.loads:
-        out.append(ld)
-        batched.append(jax.tree_util.tree_map(lambda _: False, ld))
-    return CaseLoads(tuple(out), tuple(batched), B, waves, polar)
+    for ld in tuple(model.loads) + tuple(extra):
+        laid = [laid_on(model, (ld,), RunGrid(sea, float(t0), float(dt), int(n_steps), float(ramp),
+                                              tuple(float(o) for o in stage_offsets)))[0]
+                for sea, dt, ramp in zip(seas, dts, ramps)]
+        ld_out, mask = stack_cases(ld, laid)
+        out.append(ld_out)
+        batched.append(mask)
+    return CaseLoads(tuple(out), tuple(batched), B, waves, polar, waves_at=0)
+
+
+def stack_cases(load: Load, laid: Sequence[Load]) -> tuple[Load, object]:
+    """One load of B cases (``laid``, the cases' :meth:`~mfm.loads.base.Load.for_run` of
+    ``load``) as one: ``load`` itself with a mask of False where every case gave it back, else the
+    cases' leaves stacked on a leading axis where they differ (mask True there). Their structure
+    (static fields included) must be one."""
+    shared = jax.tree_util.tree_map(lambda _: False, load)
+    if all(x is load for x in laid):
+        return load, shared
+    defs = {jax.tree_util.tree_structure(x) for x in laid}
+    if len(defs) > 1:
+        raise ValueError(f"load {type(load).__name__}: its for_run gives the cases loads of "
+                         "different structures; a batch needs one (give the cases one dt, "
+                         "or run them apart)")
+    first = laid[0]
+    leaves = [jax.tree_util.tree_leaves(x) for x in laid]
+
+    def differs(j):
+        a0 = np.asarray(leaves[0][j])
+        if any(np.shape(lv[j]) != a0.shape for lv in leaves[1:]):
+            raise ValueError(f"load {type(load).__name__}: its for_run gives the cases arrays of "
+                             f"different shapes ({sorted({np.shape(lv[j]) for lv in leaves})}); a "
+                             "batch stacks them on one case axis (give the cases one dt and "
+                             "duration, or run them apart)")
+        return any(not np.array_equal(np.asarray(lv[j]), a0) for lv in leaves[1:])
+
+    flags = [differs(j) for j in range(len(leaves[0]))]
+    stacked = [np.stack([np.asarray(lv[j]) for lv in leaves]) if f else leaves[0][j]
+               for j, f in enumerate(flags)]
+    treedef = jax.tree_util.tree_structure(first)
+    return (jax.tree_util.tree_unflatten(treedef, stacked),
+            jax.tree_util.tree_unflatten(treedef, flags))
 
 
 def compile_view(model, loads=()):
     """(model, loads) as the compiled functions are handed them: the fields that only the host
-    reads blanked — the model's name, config path and hash and its HydroSpec, the water's spec
-    (traced code reads only its moved dofs, which the water keeps apart), a state-space fit's
-    report, a convolution's memory length — so that models and loads that differ only in numbers
-    share one compilation (a static field is part of jit's key, compared by value; a HydroSpec by
-    the content of its database). Nothing traced reads them: tests/test_jax_contract.py checks
-    that a reused compilation gives the bits of a fresh one."""
-    def view(ld):
-        if isinstance(ld, Water):
-            rad = ld.rad
-            if isinstance(rad, StateSpace):
-                rad = dataclasses.replace(rad, report=())
-            elif isinstance(rad, Convolution):
-                rad = dataclasses.replace(rad, memory_length=0.0)
-            return dataclasses.replace(ld, spec=None, rad=rad)
-        return ld
-
-    return model.keyed(), tuple(view(ld) for ld in loads)
+    reads blanked — the model's name, config path and hash and its HydroSpec, and each load's own
+    (:meth:`~mfm.loads.base.Load.host_view`: the water's spec, a state-space fit's report, a
+    convolution's memory length) — so that models and loads that differ only in numbers share one
+    compilation (a static field is part of jit's key, compared by value; a HydroSpec by the
+    content of its database). Nothing traced reads them: tests/test_jax_contract.py checks that a
+    reused compilation gives the bits of a fresh one."""
+    return model.keyed(), tuple(ld.host_view() for ld in loads)
 
 
 def as_loads(loads) -> tuple[Load, ...]:

@@ -22,7 +22,7 @@ time domain sees. A load records outputs (:meth:`Load.diagnostics` with their di
 """
 from __future__ import annotations
 
-from typing import Any, NamedTuple
+from typing import Any, ClassVar, NamedTuple
 
 import equinox as eqx
 import jax.numpy as jnp
@@ -81,6 +81,36 @@ class PTORecords(NamedTuple):
     force: Any = None
 
 
+class RunGrid(NamedTuple):
+    """The run a load is laid on (:meth:`Load.for_run`): ``sea`` (a :mod:`hydro` sea state, or
+    None for still water), the start ``t0`` (s), the step ``dt`` (s), ``n_steps``, the wave ramp
+    ``ramp`` (s) and the integrator's ``stage_offsets`` (the fractions of dt at which it evaluates
+    the loads; a table laid on t0 + (j + c) dt for each offset c is read without interpolation
+    error at every stage)."""
+    sea: Any
+    t0: float
+    dt: float
+    n_steps: int
+    ramp: float
+    stage_offsets: tuple
+
+
+class LinearHydro(NamedTuple):
+    """The linear potential-flow model a load carries (:meth:`Load.linear_hydro`), what the levels
+    built on it alone read (the spectral and linear levels, ``optimize``, the radiation fit's
+    check): ``spec`` (the :class:`~hydro.prepare.HydroSpec`: database, water depth, g, ρ),
+    ``geometry`` (the reference points: ξ̇ = H(q) q̇, (6K, n_q)), ``A_inf`` (6K, 6K), ``drag``
+    (K, 3): ½ ρ C_D A per inertial axis on the reference points' velocity (what the spectral
+    levels linearise stochastically), and ``coefficients(kin0, omega, heading, options,
+    excitation=True)`` → (A(ω) − A∞, B(ω), X(ω, β) or None, H₀) of the radiation strategy
+    ``options["radiation"]``."""
+    spec: Any
+    geometry: Any
+    A_inf: Any
+    drag: Any
+    coefficients: Any
+
+
 class Load(eqx.Module):
     """Base class of every load: an immutable pytree (``equinox.Module``).
 
@@ -100,9 +130,21 @@ class Load(eqx.Module):
       :meth:`frequency_outputs`, :meth:`linear_dampers` (a PTO's damping about q₀);
     - words: :meth:`provenance`, :meth:`describe_nonfinite`.
 
+    - a run: :meth:`for_run` (the load laid on a run's sea and time grid: wave tables at the
+      integrator's stages; with :attr:`reads_sea` True where it reads the sea), :meth:`host_view` (the load as compiled programs are handed it);
+    - :meth:`linear_hydro` (the linear potential-flow model a load carries, if it is one).
+
+    No code finds a load by its type or its place in a tuple: a load that is a PTO, carries a
+    sea's tables or a BEM model says so through these methods, the water (:mod:`mfm.loads.water`)
+    as any other.
+
     A load that reads a config table also gives ``parse_table`` and ``from_parsed``
     (:mod:`mfm.loads.registry`).
     """
+
+    # whether the load reads the run's sea (in :meth:`for_run`): a front door refuses a sea that
+    # no load of the run reads (a sea on a model without water would otherwise do nothing)
+    reads_sea: ClassVar[bool] = False
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -158,6 +200,27 @@ class Load(eqx.Module):
         """Outputs a batched run (no per-sample record) can take from the load itself:
         name → (array (n_saved,), attrs)."""
         return {}
+
+    # -- a run
+    def for_run(self, model, run: RunGrid) -> "Load":
+        """This load laid on a run (:class:`RunGrid`): what depends on the sea, the start, the step
+        or the integrator's stages made here, on the host, once per run (wave kinematics at the
+        load's points on the stage times, say). Default: the load itself (nothing depends on the
+        run). Called on every load of the model and every extra load of a front door, in the
+        time domain only (a linearisation takes :meth:`static_load`)."""
+        return self
+
+    def host_view(self) -> "Load":
+        """The load as compiled programs are handed it: fields that only the host reads (names,
+        reports, provenance) blanked, so that loads that differ only in them share one
+        compilation (their static fields are part of jit's key). Nothing traced may read what is
+        blanked. Default: the load itself."""
+        return self
+
+    def linear_hydro(self) -> "LinearHydro | None":
+        """The linear potential-flow model this load carries (:class:`LinearHydro`), or None
+        (default): the spectral and linear levels and ``optimize`` are built on it."""
+        return None
 
     # -- linearisation
     def static_load(self) -> "Load | None":
@@ -215,4 +278,5 @@ REQUIRED = ("evaluate",)
 OPTIONAL = ("n_states", "initial_state", "init_memory", "update_memory", "reaction_loads",
             "diagnostics", "outputs", "batch_outputs", "pto_records", "static_load",
             "frequency_terms", "frequency_body_loads", "frequency_range", "frequency_outputs",
-            "linear_dampers", "provenance", "describe_nonfinite")
+            "linear_dampers", "provenance", "describe_nonfinite", "for_run", "host_view",
+            "linear_hydro")

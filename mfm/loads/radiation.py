@@ -19,6 +19,7 @@ have zero velocity and their loads do no work.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from fractions import Fraction
 from typing import ClassVar
@@ -88,6 +89,11 @@ class NoRadiation(eqx.Module):
 
     def provenance(self):
         return {"radiation": self.name}
+
+    def host_view(self):
+        """The strategy as compiled programs are handed it (:meth:`mfm.loads.base.Load.host_view`):
+        host-only static fields blanked. Default: itself."""
+        return self
 
 
 class DatabaseRadiation(NoRadiation):
@@ -172,6 +178,10 @@ class Convolution(NoRadiation):
         return {"radiation": self.name, "memory_length_s": self.memory_length,
                 "convolution_lags": self.n_lags}
 
+    def host_view(self):
+        # the memory length is provenance: the lags' count (static) and weights hold the run's
+        return dataclasses.replace(self, memory_length=0.0)
+
     @classmethod
     def build(cls, spec, dt, memory, stage_offsets):
         W_current, W_lag = spec.kernel(dt, memory, offsets=stage_offsets)
@@ -225,6 +235,10 @@ class StateSpace(NoRadiation):
     def provenance(self):
         return {"radiation": self.name, "state_space_options": repr(dict(self.options)),
                 "state_space_states": self.n_states, **{f"fit_{k}": v for k, v in self.report}}
+
+    def host_view(self):
+        # the fit's report is provenance only
+        return dataclasses.replace(self, report=())
 
     @classmethod
     def build(cls, spec, options):

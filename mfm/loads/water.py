@@ -32,9 +32,11 @@ force Hᵀ X(ω, β).
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 import warnings
 from pathlib import Path
+from typing import ClassVar
 
 import equinox as eqx
 import jax
@@ -46,7 +48,7 @@ from hydro.seabatch import components_many
 from .. import host
 from ..mechanics import se3
 from ..mechanics.points import BodyPoints, h_matrix_at
-from .base import FrequencyTerms, Load, LoadOutput
+from .base import FrequencyTerms, LinearHydro, Load, LoadOutput
 from .radiation import NoRadiation, grid_subdivisions, strategy, strategy_many
 
 MODES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
@@ -82,6 +84,7 @@ class Water(Load):
     # the moved hydro dofs (spec.moving): what traced code needs of the spec, kept apart so that
     # the compiled functions can be handed the water without its spec (loads.assembly.compile_view)
     moving: tuple | None = eqx.field(static=True, default=None)
+    reads_sea: ClassVar[bool] = True
 
     # the older names, kept for code that reads them
     @property
@@ -226,6 +229,18 @@ class Water(Load):
         # (n_saved,), or (B, n_saved) for the water of many cases (build_water_batch)
         eta = np.asarray(self.eta_values)[..., ::self.grid_m * save_every][..., :n_saved]
         return {"eta": (eta, {"long_name": "wave elevation at the origin", "units": "m"})}
+
+    def host_view(self):
+        # traced code reads the moved dofs (kept apart in ``moving``), never the spec
+        return dataclasses.replace(self, spec=None, rad=self.rad.host_view())
+
+    def linear_hydro(self):
+        return LinearHydro(self.spec, self.geometry, self.A_inf, self.drag, self._frequency_coefficients)
+
+    def with_tables(self, exc_values, eta_values):
+        """This water with its excitation (n, 6K or the moved columns) and elevation (n,) tables
+        replaced: a batch's tables made on the device (:class:`WaveSum`)."""
+        return dataclasses.replace(self, exc_values=exc_values, eta_values=eta_values)
 
     def provenance(self):
         out = {"added_mass": self.added_mass, **self.rad.provenance()}

@@ -18,11 +18,11 @@ from ..errors import SimulationError
 from ..loads.assembly import CaseLoads, as_loads, carried_loads_batch, compile_view
 from ..validation import check_model, finite_number, initial_vector, whole_number
 from ..timedomain import integrators as _integrators
-from .checks import refuse_impossible
+from .checks import check_sea_read, refuse_impossible
 from .progress import progress_bar, progress_options, run_chunked
 from ..timedomain.record import Recording, map_in_groups, output_names
 from ..timedomain.rollout import TRACES, rollout_blocks, rollout_impl, rollout_start
-from ..timedomain.setup import model_loads, stage_offsets
+from ..timedomain.setup import declared_stage_offsets, model_loads, stage_offsets
 
 
 def _over_cases(f, model, model_axis, batched, lanes):
@@ -223,6 +223,7 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     integ = _integrators.get(integrator)
     outputs = output_names(outputs)
     extra = as_loads(loads)
+    check_sea_read(models[0], extra, seas)
     refuse_impossible(models[0], extra + tuple(models[0].loads), int(n_steps), int(save_every),
                       cases=B, every_output=False, names=outputs, what="n_steps")
     m0 = models[0]
@@ -235,10 +236,7 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
                                     t0=t0, radiation=radiation, memory=memory,
                                     state_space_options=state_space_options,
                                     stage_offsets=stage_offsets(integ) if m0.hydro is not None
-                                    else ())
-        cases = CaseLoads(cases.loads + extra, cases.batched + tuple(
-            jax.tree_util.tree_map(lambda _: False, ld) for ld in extra), B, cases.waves,
-                          cases.polar)
+                                    else declared_stage_offsets(integ), extra=extra)
         model_view, loads_view = compile_view(m0, cases.loads)
         # the view blanks static fields only: its leaves are the loads' own, in the same order
         mask = jax.tree_util.tree_unflatten(jax.tree_util.tree_structure(loads_view),
@@ -247,7 +245,7 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
         waves = cases.waves
         if waves is not None and not outputs:
             # nothing recorded of the water: the time step reads the moved dofs' excitation alone
-            moving = cases.loads[0].moving
+            moving = cases.loads[cases.waves_at].moving
             waves = waves if moving is None else dataclasses.replace(
                 waves, columns=tuple(int(k) for k in moving))
 
@@ -256,8 +254,7 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
             if waves is None:
                 return part, None
             exc, eta = _tables(waves, cases.polar, g)
-            return (dataclasses.replace(part[0], exc_values=exc, eta_values=eta),) \
-                + tuple(part[1:]), eta
+            return cases.with_tables(tuple(part), exc, eta), eta
 
         model_of = lambda g: model_view  # noqa: E731
         model_axis = None
@@ -266,7 +263,8 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
         loads = [model_loads(pick(models, i), pick(seas, i), dt=float(pick(dts, i)),
                              duration=n_steps * float(pick(dts, i)), t0=t0,
                              ramp=float(pick(ramps, i)), radiation=radiation, memory=memory,
-                             state_space_options=state_space_options, integrator=integ) + extra
+                             state_space_options=state_space_options, integrator=integ,
+                             extra=extra)
                  for i in range(B)]
         if vary_loads is not None:
             if not callable(vary_loads):

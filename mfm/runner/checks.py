@@ -85,6 +85,19 @@ def usable_memory(root: str = "/") -> tuple[int, str]:
     return min(found) if found else (0, "")
 
 
+def check_sea_read(model, loads, seas) -> None:
+    """Refuse a sea (``seas``: the run's sea states, None for still water) that no load of the run
+    reads: the model's water, or a load of ``model.loads`` or ``loads`` with ``reads_sea``
+    (:meth:`mfm.loads.base.Load.for_run`). Without one the sea would change nothing."""
+    if all(s is None for s in seas) or model.hydro is not None:
+        return
+    if any(ld.reads_sea for ld in tuple(model.loads) + tuple(loads)):
+        return
+    raise ValueError("sea: this model has no hydrodynamics (no [hydro] table in its config, or "
+                     "mfm.load(..., hydro=False)) and none of its loads reads a sea (a load's "
+                     "reads_sea); pass sea=None")
+
+
 def run_bytes(model, loads, n_steps: int, save_every: int, *, cases: int = 1,
               every_output: bool = True, names=()) -> float:
     """An estimate (bytes, float64) of what a run of ``n_steps`` holds before it starts stepping:
@@ -166,7 +179,9 @@ def warn_accuracy(model, sea, dt, integ, tol=0.01):
     """Warn when the shortest wave period with energy (amplitude ≥ 5 % of the largest component)
     is resolved with a period error above ``tol`` by the integrator (its leading error term,
     :func:`mfm.integrators.phase_error`)."""
-    comps = sea.components(water_depth=model.hydro.water_depth, g=model.hydro.g)
+    # a sea read by a model's own load where it has no water: deep water and standard g
+    comps = sea.components() if model.hydro is None else \
+        sea.components(water_depth=model.hydro.water_depth, g=model.hydro.g)
     amp = np.abs(np.asarray(comps.amplitude, dtype=float))
     if not amp.size or amp.max() <= 0:
         return

@@ -48,7 +48,7 @@ from ..loads.pto import load_dampers
 from ..mechanics.model import Model
 from ..mechanics.points import h_matrix_at
 from ..validation import check_model, check_sea, finite_number
-from ..frequency.rest import linear_system, water_of
+from ..frequency.rest import linear_hydro, linear_system
 
 # the largest condition number of the mode matrix V accepted: the modes' round-off grows as
 # cond(V)·ε (1e10: 1e-6 relative; in the 1-norm RM3 has 4.6e3, M4 134 2.1e4)
@@ -246,7 +246,6 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
 
     from ..loads.base import Load
     from ..loads.radiation import StateSpace
-    from ..loads.water import Water
 
     if model.hydro is None:
         raise ValueError(f"model {model.name!r} has no hydrodynamics: linear_response needs a "
@@ -264,12 +263,12 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
                          "steps")
     start = _time.perf_counter()
     sys = linear_system(model, q0, loads=loads)
-    other = [type(ld).__name__ for ld in sys.loads if not isinstance(ld, Water)
+    other = [type(ld).__name__ for ld in sys.loads if ld.linear_hydro() is None
              and type(ld).frequency_terms is not Load.frequency_terms]
     if other:
         raise NotImplementedError(f"loads {other} add frequency-dependent terms that have no "
                                   "time-domain realisation in the linear level; use mfm.simulate")
-    water = water_of(sys.loads)
+    water = linear_hydro(sys.loads)
     spec = model.hydro
     rad = StateSpace.build(spec, state_space_options)
     H0 = np.asarray(h_matrix_at(water.geometry, sys.kin0))

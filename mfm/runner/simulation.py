@@ -22,7 +22,7 @@ from ..timedomain import integrators as _integrators
 from ..timedomain.record import OUTPUTS
 from ..timedomain.setup import model_loads, stage_offsets
 from ..validation import check_model, finite_number, initial_vector, whole_number
-from .checks import (nonfinite_message, refuse_impossible, warn_accuracy, warn_stability,
+from .checks import (check_sea_read, nonfinite_message, refuse_impossible, warn_accuracy, warn_stability,
                      warn_verlet_drift)
 from .choices import convolution_or_state_space, judge_radiation, judged_choice, state_space_update
 from .pipeline import prepare_run
@@ -89,9 +89,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     up to the last finite sample.
     """
     model = check_model(model)
-    if sea is not None and model.hydro is None:
-        raise ValueError("sea: this model has no hydrodynamics (no [hydro] table in its config, or "
-                         "mfm.load(..., hydro=False)); pass sea=None")
+    check_sea_read(model, as_loads(loads), [sea])
     # a strategy object or its string alias, with the string API's side options
     radiation, memory, state_space_options = resolve_radiation(radiation, memory,
                                                                state_space_options)
@@ -157,7 +155,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
             loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                                 radiation=radiation, memory=memory,
                                 state_space_options=state_space_options, added_mass=added_mass,
-                                integrator=integ) + extra
+                                integrator=integ, extra=extra)
         # the recorded run (its programs: the whole run, or its start and chunks), compiled here:
         # beside the jet's compilation where the water builds faster than that (no fit), and
         # before the checks' warnings
@@ -187,7 +185,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                 phase(bar, "preparing the loads (the convolution)")
                 loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                                     radiation=radiation, memory=memory, added_mass=added_mass,
-                                    integrator=integ) + extra
+                                    integrator=integ, extra=extra)
                 phase(bar, "compiling")
                 run = prepare_run(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ,
                                   loads=loads, save_every=save_every, t0=t0, recording=OUTPUTS,

@@ -361,7 +361,7 @@ def responses(pb: Problem, values) -> Response:
     # the controller −k_c (q − q₀) adds k_c on K's diagonal and nothing to Q(q₀)
     k_c = _control(pb, values) if pb.control is not None else 0.0
     M, K, C = jet.M, -jet.dQ_dq + jnp.diag(k_c * jnp.ones(model.n_coordinates)), -jet.dQ_dqd
-    H = static[pb.water].geometry.h_matrix(jet.kin)[0]                     # (6K, n)
+    H = static[pb.water].linear_hydro().geometry.h_matrix(jet.kin)[0]                     # (6K, n)
     w = pb.omega[:, None, None]
     Z = (-w**2 * M[None] - 1j * w * C[None] + K[None]
          + jnp.einsum("ai,uab,bj->uij", H, pb.Zb, H))                      # (U, n, n)

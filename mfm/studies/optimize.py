@@ -34,12 +34,12 @@ from hydro.seabatch import components_many
 
 from .. import results
 from ..errors import OptimizeError
-from ..frequency.rest import _equilibrium, _static_functions, system_loads, water_of
+from ..frequency.rest import (_equilibrium, _static_functions, linear_hydro, linear_hydro_index,
+                              system_loads)
 from ..runner.spectral import component_union
 from ..loads.base import Load
 from ..loads.catenary import CatenaryLines
 from ..loads.hydraulic_pto import HydraulicPTO
-from ..loads.water import Water
 from ..mechanics.kinematics import kinematics
 from ..mechanics.model import Model
 from ..validation import check_model, check_seas
@@ -111,7 +111,7 @@ def _sea_union(model, seas, lds, radiation, state_space_options):
     a2 = np.zeros((len(seas), len(union)))
     for s, c in enumerate(comps):
         np.add.at(a2[s], inverse[bounds[s]:bounds[s + 1]], c.amplitude ** 2)
-    water = water_of(lds)
+    water = linear_hydro(lds)
     kin = kinematics(model, jnp.zeros(model.n_coordinates), jnp.zeros(model.n_coordinates))
     options = {"radiation": radiation, "state_space_options": state_space_options}
     nd = 6 * len(water.geometry.body_index)
@@ -120,7 +120,7 @@ def _sea_union(model, seas, lds, radiation, state_space_options):
     for beta in np.unique(union[:, 0]):
         sel = union[:, 0] == beta
         om = union[sel, 1]
-        A_rel, B, Xb, _ = water._frequency_coefficients(kin, om, float(beta), options)
+        A_rel, B, Xb, _ = water.coefficients(kin, om, float(beta), options)
         Zb[sel] = -om[:, None, None] ** 2 * A_rel - 1j * om[:, None, None] * B
         X[sel] = Xb
     return union[:, 1].copy(), a2, Zb, X, water
@@ -163,7 +163,7 @@ def _setup(model, seas, parameters, objective, constraints, weights, loads, radi
     if others:
         raise NotImplementedError(f"optimize: loads {others} add PTOs the spectral objective does "
                                   "not know yet")
-    water_index = next(i for i, ld in enumerate(static) if isinstance(ld, Water))
+    water_index = linear_hydro_index(static)
     # the joint PTOs: the coordinates damped now, and those whose damping is tuned
     tuned = {t.index for _, grp, *_ in params for t in grp if t.where == "model" and t.field == "damping"}
     joint = tuple(sorted({int(k) for k in np.flatnonzero(np.asarray(model.damping) > 0)} | tuned))

@@ -35,6 +35,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..frequency.rest import linear_hydro_index
 from ..io.build import load
 from ..timedomain import integrators as _integrators
 from ..timedomain.rollout import rollout
@@ -260,10 +261,10 @@ def heave_loads(model, mass_ratio, *, dt, n_steps, added_mass="lhs", integrator=
         raise ValueError(f"mass_ratio: {mass_ratio!r}; give A∞/m ≥ 0")
     loads = model_loads(model, None, dt=dt, duration=n_steps * dt, radiation="none",
                         added_mass=_added_mass(added_mass), integrator=integrator)
-    w = loads[0]
+    k = linear_hydro_index(loads)
     m = float(np.asarray(model.mass)[0])
-    A = jnp.zeros_like(w.A_inf).at[2, 2].set(mass_ratio * m)
-    return (eqx.tree_at(lambda x: x.A_inf, w, A),) + tuple(loads[1:])
+    A = jnp.zeros_like(loads[k].linear_hydro().A_inf).at[2, 2].set(mass_ratio * m)
+    return loads[:k] + (eqx.tree_at(lambda x: x.A_inf, loads[k], A),) + loads[k + 1:]
 
 
 def run_grows(model, mass_ratio, dt, *, integrator, added_mass="lhs", n_steps=2000,

@@ -13,19 +13,29 @@ from ..validation import check_model
 
 def model_loads(model: Model, sea=None, *, dt, duration, t0=0.0, ramp=0.0,
                 radiation="convolution", memory=None, state_space_options=None,
-                added_mass="lhs", integrator="rk4") -> tuple[Load, ...]:
-    """The loads a model carries itself, ready for :func:`~mfm.timedomain.rollout.rollout`: with a
-    [hydro] config its water for this sea and time grid (:func:`mfm.loads.water.build_water`,
+                added_mass="lhs", integrator="rk4", extra=()) -> tuple[Load, ...]:
+    """The loads of a run, ready for :func:`~mfm.timedomain.rollout.rollout`: with a [hydro]
+    config the model's water for this sea and time grid (:func:`mfm.loads.water.build_water`,
     prepared for the stage times of ``integrator``), then the config's loads (``model.loads``:
-    moorings, PTOs, …): :func:`mfm.loads.assembly.carried_loads` for this integrator."""
+    moorings, PTOs, …) and the ``extra`` loads of a front door, each laid on the run
+    (:meth:`~mfm.loads.base.Load.for_run`): :func:`mfm.loads.assembly.carried_loads` for this
+    integrator."""
     model = check_model(model)
     radiation, memory, state_space_options = resolve_radiation(radiation, memory,
                                                                state_space_options)
-    stages = stage_offsets(integrator) if model.hydro is not None else ()
+    stages = stage_offsets(integrator) if model.hydro is not None \
+        else declared_stage_offsets(integrator)
     return carried_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                          radiation=radiation, memory=memory,
                          state_space_options=state_space_options, added_mass=added_mass,
-                         stage_offsets=stages)
+                         stage_offsets=stages, extra=extra)
+
+
+def declared_stage_offsets(integrator) -> tuple:
+    """The integrator's ``stage_offsets``, or () where it declares none (a user's integrator that
+    follows the protocol without them: only a load laid on the stage times needs them)."""
+    offs = getattr(_integrators.get(integrator), "stage_offsets", None)
+    return () if offs is None else tuple(float(o) for o in offs)
 
 
 def stage_offsets(integrator):
