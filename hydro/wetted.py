@@ -140,10 +140,14 @@ def pressure(wave: WaveField, points, t, *, rho: float, g: float):
     """p (Pa) of the undisturbed flow at ``points`` (..., 3), inertial axes (z up, 0 at the mean
     level): −ρ g z + ρ g Σ a f(z_s) cos(…), the decay f at the Wheeler-stretched z_s (module
     docstring)."""
+    return -rho * g * points[..., 2] + wave_pressure(wave, points, t, rho=rho, g=g)
+
+
+def wave_pressure(wave: WaveField, points, t, *, rho: float, g: float):
+    """The incident wave's dynamic pressure ρ g Σ a f(z_s) cos(…) (Pa) at ``points`` (..., 3)."""
     x, y, z = points[..., 0], points[..., 1], points[..., 2]
-    p = -rho * g * z
     if wave.amplitude.shape[0] == 0:
-        return p
+        return jnp.zeros_like(z)
     th = _phase(wave, x, y, t)
     eta = jnp.sum(wave.amplitude * jnp.cos(th), axis=-1)
     h = wave.water_depth
@@ -156,7 +160,7 @@ def pressure(wave: WaveField, points, t, *, rho: float, g: float):
         # cosh k(z_s + h)/cosh k h without overflow: e^{k z_s} (1 + e^{−2k(z_s+h)})/(1 + e^{−2kh})
         zc = jnp.clip(zs, -h, 0.0)
         decay = jnp.exp(k * zc) * (1 + jnp.exp(-2 * k * (zc + h))) / (1 + jnp.exp(-2 * k * h))
-    return p + rho * g * jnp.sum(wave.amplitude * decay * jnp.cos(th), axis=-1)
+    return rho * g * jnp.sum(wave.amplitude * decay * jnp.cos(th), axis=-1)
 
 
 # ------------------------------------------------------------------------------------- the cut
@@ -197,31 +201,77 @@ def _cut(P, s):
     return jnp.stack([first, second], axis=1), w
 
 
-def pressure_loads(tri_body, rotation, origin, ref, wave: WaveField, t, *, rho: float, g: float):
+def pressure_loads(tri_body, rotation, origin, ref, wave: WaveField, t, *, rho: float, g: float,
+                   parts: bool = False):
     """Force (3,) and moment about ``ref`` (3,) of the flow's pressure on the wetted part of a
     hull, inertial axes (module docstring).
 
     tri_body: (n, 3, 3) the closed hull's triangles in body axes about the body's origin, ordered
     for outward normals (:func:`triangles`, :func:`check_hull`); rotation (3, 3) and origin (3,):
     the pose, x = origin + rotation @ x_b; ref (3,): the moment's point; wave: the incident wave
-    (:func:`still_water` for hydrostatics alone); t: s.
+    (:func:`still_water` for hydrostatics alone); t: s. ``parts``: return the hydrostatic
+    pressure's (−ρ g z) and the wave's (nonlinear Froude–Krylov) loads apart, each (6,), on the
+    same cut: (hydrostatic, froude_krylov).
     """
     P = origin + jnp.einsum("ij,ntj->nti", rotation, tri_body)            # (n, 3, 3)
     area_n = 0.5 * jnp.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])        # (n, 3): A n̂
-    A = jnp.linalg.norm(area_n, axis=1, keepdims=True)
-    n_hat = area_n / A
+    n_hat = area_n / _norm(area_n)[:, None]
     s = P[..., 2] - elevation(wave, P[..., 0], P[..., 1], t)
     pieces, w = _cut(P, s)                                                # (n, 2, 3, 3), (n, 2)
     a, b, c = pieces[..., 0, :], pieces[..., 1, :], pieces[..., 2, :]
-    area = 0.5 * _norm(jnp.cross(b - a, c - a)) * w    # (n, 2)
+    area = 0.5 * _norm(jnp.cross(b - a, c - a)) * w                       # (n, 2)
     mids = jnp.stack([(a + b) / 2, (b + c) / 2, (c + a) / 2], axis=-2)    # (n, 2, 3, 3)
-    p = pressure(wave, mids, t, rho=rho, g=g)                              # (n, 2, 3)
-    # ∫ p dA and ∫ (x − r) p dA over each piece by the edge-midpoint rule
-    Ip = jnp.sum(area * p.mean(axis=-1), axis=1)                           # (n,)
-    Ixp = jnp.sum(area[..., None] * jnp.mean(p[..., None] * (mids - ref), axis=-2), axis=1)
-    force = -jnp.sum(Ip[:, None] * n_hat, axis=0)
-    moment = -jnp.sum(jnp.cross(Ixp, n_hat), axis=0)
-    return force, moment
+
+    def loads(p):
+        # ∫ p dA and ∫ (x − r) p dA over each piece by the edge-midpoint rule
+        Ip = jnp.sum(area * p.mean(axis=-1), axis=1)                       # (n,)
+        Ixp = jnp.sum(area[..., None] * jnp.mean(p[..., None] * (mids - ref), axis=-2), axis=1)
+        return -jnp.sum(Ip[:, None] * n_hat, axis=0), -jnp.sum(jnp.cross(Ixp, n_hat), axis=0)
+
+    p_wave = wave_pressure(wave, mids, t, rho=rho, g=g)                    # (n, 2, 3)
+    if not parts:
+        return loads(-rho * g * mids[..., 2] + p_wave)
+    return (jnp.concatenate(loads(-rho * g * mids[..., 2])),
+            jnp.concatenate(loads(p_wave)))
+
+
+def froude_krylov_linear(tri, ref, wavenumber, heading, *, water_depth: float, rho: float,
+                         g: float) -> np.ndarray:
+    """The linear Froude–Krylov force and moment about ``ref`` per metre of wave amplitude,
+    (J, 6) complex, hydro's convention (x(t) = Re[x̂ e^{−iωt}], η = Re[e^{ik(x cos β + y sin β)}
+    e^{−iωt}]): the dynamic pressure of a unit wave integrated over the hull at rest cut at z = 0,
+
+        X_FK = −∫_{S₀} ρ g f(z) e^{ik(x cos β + y sin β)} (n, (x − r) × n) dA.
+
+    tri: (n, 3, 3) the closed hull at rest, inertial axes. Numpy (made once per run on the
+    host): what the nonlinear level takes out of the database's excitation, leaving the
+    diffraction, so that in small waves its total is the database's."""
+    T = np.asarray(tri, float)
+    P, s = jnp.asarray(T), jnp.asarray(T[..., 2])
+    pieces, w = _cut(P, s)
+    pieces, w = np.asarray(pieces), np.asarray(w)
+    a, b, c = pieces[..., 0, :], pieces[..., 1, :], pieces[..., 2, :]
+    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=-1) * w          # (n, 2)
+    area_n = 0.5 * np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0])
+    n_hat = area_n / np.linalg.norm(area_n, axis=1, keepdims=True)
+    mids = np.stack([(a + b) / 2, (b + c) / 2, (c + a) / 2], axis=-2)        # (n, 2, 3, 3)
+    keep = area > 0
+    m, A = mids[keep], area[keep]                                             # (p, 3, 3), (p,)
+    nh = np.broadcast_to(n_hat[:, None], area.shape + (3,))[keep]             # (p, 3)
+    k = np.asarray(wavenumber, float)[:, None, None]
+    beta = np.asarray(heading, float)[:, None, None]
+    z = np.minimum(m[None, ..., 2], 0.0)
+    if math.isinf(water_depth):
+        decay = np.exp(k * z)
+    else:
+        h = float(water_depth)
+        decay = np.exp(k * z) * (1 + np.exp(-2 * k * (z + h))) / (1 + np.exp(-2 * k * h))
+    p = rho * g * decay * np.exp(1j * k * (m[None, ..., 0] * np.cos(beta) + m[None, ..., 1] * np.sin(beta)))
+    Ip = np.einsum("p,jpq->jp", A, p) / 3.0                                   # (J, p)
+    Ixp = np.einsum("p,jpq,pqi->jpi", A, p, m - np.asarray(ref, float)) / 3.0
+    F = -np.einsum("jp,pi->ji", Ip, nh)
+    M = -np.cross(Ixp, nh[None]).sum(axis=1)
+    return np.concatenate([F, M], axis=1)
 
 
 def submerged_volume(tri_body, rotation, origin):
