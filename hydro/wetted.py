@@ -35,8 +35,7 @@ vertex crosses the surface: there the loads are continuous, their derivative jum
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
-
+import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
@@ -45,16 +44,23 @@ import numpy as np
 _TINY = 1e-300
 
 
-class WaveField(NamedTuple):
+class WaveField(eqx.Module):
     """Linear incident wave components, arrays (J,) float64: ``amplitude`` (m, ramp included),
     ``omega`` (rad/s), ``wavenumber`` (rad/m), ``heading`` (rad, 0 = towards +x), ``phase`` (rad);
-    ``water_depth`` (m; inf for deep water). η = Σ a cos(k(x cos β + y sin β) − ω t + φ)."""
+    ``water_depth`` (m; inf for deep water; static). η = Σ a cos(k(x cos β + y sin β) − ω t + φ)."""
     amplitude: jnp.ndarray
     omega: jnp.ndarray
     wavenumber: jnp.ndarray
     heading: jnp.ndarray
     phase: jnp.ndarray
-    water_depth: float = math.inf
+    water_depth: float = eqx.field(static=True, default=math.inf)
+
+    @classmethod
+    def of(cls, components) -> "WaveField":
+        """The field of :class:`hydro.waves.WaveComponents` (no ramp)."""
+        f = lambda a: jnp.asarray(np.asarray(a, dtype=float))  # noqa: E731
+        return cls(f(components.amplitude), f(components.omega), f(components.wavenumber),
+                   f(components.heading), f(components.phase), float(components.water_depth))
 
 
 def still_water() -> WaveField:
@@ -339,3 +345,176 @@ def revolved_hull(profile, n_azimuth: int):
             F += [[a, b, c], [a, c, d]]
         F.append([k * m + m - 1, keel, k1 * m + m - 1])
     return V, np.asarray(F)
+
+
+def _face_grid(corner, u, v, nu: int, nv: int):
+    """A planar rectangle corner + [0, 1]u + [0, 1]v in nu × nv quads (vertices, faces; normal
+    along u × v)."""
+    s, t = np.meshgrid(np.linspace(0, 1, nu + 1), np.linspace(0, 1, nv + 1), indexing="ij")
+    V = corner + s[..., None] * u + t[..., None] * v                  # (nu+1, nv+1, 3)
+    idx = np.arange((nu + 1) * (nv + 1)).reshape(nu + 1, nv + 1)
+    F = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], axis=-1).reshape(-1, 4)
+    return V.reshape(-1, 3), F
+
+
+HULL_SHAPES = {"sphere": ("radius",), "cylinder": ("radius", "bottom", "top"),
+               "box": ("length", "beam", "bottom", "top"), "revolution": ("profile",),
+               "geometry": ("top",)}
+HULL_KEYS = {"shape", "center", "panel_size", "notes"} | {k for v in HULL_SHAPES.values() for k in v}
+
+
+def hull_mesh(spec: dict, *, where: str = "hull", geometry: dict | None = None
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """A closed hull (vertices (V, 3) m, faces (F, 4) or (F, 3), outward) from a plain dict, the
+    ``[bodies.hull]`` table of a config, in the config's axes at rest:
+
+    - ``shape = "sphere"``: ``radius``; ``center`` its centre.
+    - ``shape = "cylinder"``: a vertical cylinder, ``radius``, ``bottom`` and ``top`` (z of its
+      ends from ``center``'s z, bottom < top).
+    - ``shape = "box"``: ``length`` along x, ``beam`` along y, ``bottom``, ``top`` (z from
+      ``center``'s z); ``center`` the middle of its footprint.
+    - ``shape = "revolution"``: ``profile`` [[r, z], …] from the top on the axis (r = 0) down to
+      the keel on the axis, z from ``center``'s z: any body of revolution about the vertical
+      through ``center``.
+    - ``shape = "geometry"``: the body's BEM hull (``geometry``, its :mod:`hydro.geometry` spec:
+      cylinder, hemisphere, sphere or revolution) closed above the water line by a vertical wall
+      up to a deck at ``top`` (m above still water): the wetted hull the database was made from,
+      with a freeboard. ``center`` is the spec's origin.
+
+    ``center`` [x, y, z] m (default the origin); ``panel_size`` m (default a sixteenth of the hull's
+    smallest dimension): panels no larger, so that the wave pressure's quadrature and a curved
+    hull's facets converge (volumes as O(panel_size²)). ``where`` names the table in errors."""
+    if not isinstance(spec, dict):
+        raise ValueError(f"{where}: expected a table such as {{ shape = \"cylinder\", radius = 3.0, "
+                         "bottom = -5.0, top = 2.0 }}")
+    bad = sorted(set(spec) - HULL_KEYS)
+    if bad:
+        raise ValueError(f"{where}: unknown key(s) {bad}; accepted keys: {sorted(HULL_KEYS)}")
+    shape = spec.get("shape")
+    if shape not in HULL_SHAPES:
+        raise ValueError(f"{where}.shape: {shape!r}; accepted: {sorted(HULL_SHAPES)}")
+    missing = [k for k in HULL_SHAPES[shape] if k not in spec]
+    if missing:
+        raise ValueError(f"{where}: shape {shape!r} needs {missing}")
+
+    def number(key, positive=False):
+        v = spec[key]
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) \
+                or (positive and v <= 0):
+            raise ValueError(f"{where}.{key}: {v!r}; give a {'positive ' if positive else ''}"
+                             "finite length in m")
+        return float(v)
+
+    c = spec.get("center", [0.0, 0.0, 0.0])
+    try:
+        center = np.asarray(c, dtype=float).reshape(3)
+    except (TypeError, ValueError):
+        raise ValueError(f"{where}.center: {c!r}; give [x, y, z] in m") from None
+    if not np.all(np.isfinite(center)):
+        raise ValueError(f"{where}.center: {c!r}; give finite [x, y, z] in m")
+    if shape == "geometry":
+        return _hull_of_geometry(spec, geometry, where, number("top", True),
+                                 number("panel_size", True) if "panel_size" in spec else None)
+    if shape in ("cylinder", "box"):
+        bottom, top = number("bottom"), number("top")
+        if not bottom < top:
+            raise ValueError(f"{where}: bottom {bottom:g} m must lie below top {top:g} m")
+    if shape == "sphere":
+        R = number("radius", True)
+        size = 2 * R
+    elif shape == "cylinder":
+        R = number("radius", True)
+        size = min(2 * R, top - bottom)
+    elif shape == "box":
+        L, B = number("length", True), number("beam", True)
+        size = min(L, B, top - bottom)
+    else:
+        prof = spec["profile"]
+        try:
+            prof = np.asarray(prof, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"{where}.profile: not a list of [r, z] points") from None
+        if prof.ndim != 2 or prof.shape[1] != 2 or len(prof) < 3 or not np.all(np.isfinite(prof)):
+            raise ValueError(f"{where}.profile: shape {prof.shape}; give ≥ 3 finite [r, z] points")
+        if prof[0, 0] != 0 or prof[-1, 0] != 0 or np.any(prof[1:-1, 0] <= 0):
+            raise ValueError(f"{where}.profile: start at the top on the axis (r = 0), end at the "
+                             "keel on the axis, r > 0 between")
+        size = min(2 * float(prof[:, 0].max()), float(np.ptp(prof[:, 1])))
+    dx = number("panel_size", True) if "panel_size" in spec else size / 16
+    if shape == "box":
+        n = [max(1, math.ceil(x / dx)) for x in (L, B, top - bottom)]
+        x0, y0 = -L / 2, -B / 2
+        ex, ey, ez = np.eye(3)
+        faces_def = [  # corner, u, v, nu, nv: u × v outward
+            ((x0, y0, bottom), B * ey, L * ex, n[1], n[0]),          # bottom (−z)
+            ((x0, y0, top), L * ex, B * ey, n[0], n[1]),             # top (+z)
+            ((x0, y0, bottom), L * ex, (top - bottom) * ez, n[0], n[2]),    # −y
+            ((-x0, -y0, bottom), -L * ex, (top - bottom) * ez, n[0], n[2]),  # +y
+            ((x0, -y0, bottom), -B * ey, (top - bottom) * ez, n[1], n[2]),   # −x
+            ((-x0, y0, bottom), B * ey, (top - bottom) * ez, n[1], n[2]),    # +x
+        ]
+        Vs, Fs, off = [], [], 0
+        for corner, u, v, nu, nv in faces_def:
+            V, F = _face_grid(np.asarray(corner, float), u, v, nu, nv)
+            Vs.append(V)
+            Fs.append(F + off)
+            off += len(V)
+        return np.concatenate(Vs) + center, np.concatenate(Fs)
+    if shape == "sphere":
+        m = max(4, math.ceil(math.pi * R / dx))
+        a = np.linspace(math.pi / 2, -math.pi / 2, m + 1)
+        prof = np.stack([R * np.cos(a), R * np.sin(a)], axis=1)
+        prof[0, 0] = prof[-1, 0] = 0.0
+    elif shape == "cylinder":
+        def seg(p, q):
+            k = max(1, math.ceil(math.dist(p, q) / dx))
+            return np.linspace(p, q, k + 1)[1:]
+        corners = [(0.0, top), (R, top), (R, bottom), (0.0, bottom)]
+        prof = np.concatenate([[corners[0]]] + [seg(p, q) for p, q in zip(corners[:-1], corners[1:])])
+    else:
+        pts = [prof[0]]
+        for p, q in zip(prof[:-1], prof[1:]):
+            k = max(1, math.ceil(math.dist(p, q) / dx))
+            pts.extend(np.linspace(p, q, k + 1)[1:])
+        prof = np.asarray(pts)
+    rmax = float(prof[:, 0].max())
+    n_az = max(12, 4 * math.ceil(2 * math.pi * rmax / dx / 4))
+    V, F = revolved_hull(prof, n_az)
+    return V + center, F
+
+
+def _hull_of_geometry(spec, geometry, where, top, dx):
+    """:func:`hull_mesh` of ``shape = "geometry"``: the body's hydro.geometry meridian (from its
+    water line down to its keel) under a wall and a deck at ``top``."""
+    from .geometry import meridian, normalize_spec
+
+    if geometry is None:
+        raise ValueError(f"{where}: shape 'geometry' takes the body's [bodies.geometry] table, and "
+                         "this body has none; give the hull's own shape (sphere, cylinder, box, "
+                         "revolution)")
+    if "center" in spec:
+        raise ValueError(f"{where}.center: shape 'geometry' is placed at its geometry's origin; "
+                         "leave center out")
+    try:
+        g = normalize_spec({"name": "hull", **geometry})
+    except (ValueError, TypeError) as e:
+        raise ValueError(f"{where}: its body's geometry: {e}") from None
+    if g["shape"] == "mesh":
+        raise ValueError(f"{where}: shape 'geometry' revolves a body of revolution, and this "
+                         "body's geometry is a mesh file; give the hull's own shape")
+    prof0 = meridian(g, 1e9)     # the spec's corners; refined below
+    size = min(2 * float(prof0[:, 0].max()), float(np.ptp(prof0[:, 1])) + top)
+    dx = size / 16 if dx is None else dx
+    prof = np.array(meridian(g, dx), dtype=float)
+    prof[np.abs(prof[:, 0]) < 1e-12 * size, 0] = 0.0     # the keel on the axis (an arc's cos π/2)
+    if prof[0, 0] <= 0 or abs(prof[0, 1]) > 1e-12:
+        raise ValueError(f"{where}: the body's geometry does not pierce the water line (fully "
+                         "submerged); give the hull's own shape")
+    r0 = float(prof[0, 0])
+    wall = [[r0, z] for z in np.linspace(top, 0.0, max(1, math.ceil(top / dx)) + 1)[:-1]]
+    deck = [[r, top] for r in np.linspace(0.0, r0, max(1, math.ceil(r0 / dx)) + 1)[1:-1]]
+    full = np.asarray([[0.0, top]] + deck + wall + prof.tolist())
+    n_az = max(12, 4 * math.ceil(2 * math.pi * float(full[:, 0].max()) / dx / 4))
+    V, F = revolved_hull(full, n_az)
+    o = np.asarray(g["origin"], float)
+    return V + np.array([o[0], o[1], 0.0]), F

@@ -50,11 +50,13 @@ from ..mechanics.tree import (JOINT_KINDS, PLANAR_DOFS, ROOT_DOFS, BodySpec, Joi
 
 # the tables of loads (moorings, ptos, ...) come from the load registry (mfm.loads.registry)
 TOP_KEYS = {"model", "bodies", "hydro"} | set(LOAD_TABLES)
-HYDRO_KEYS = {"database", "names", "body_coupling", "added_mass_inf", "rho", "g", "bem", "notes"}
+HYDRO_KEYS = {"database", "names", "body_coupling", "added_mass_inf", "rho", "g", "bem", "notes",
+              "hydrostatics"}
+HYDROSTATICS = ("linear", "nonlinear")
 BODY_HYDRO_KEYS = {"body", "drag_coefficient", "drag_area", "notes"}
 MODEL_KEYS = {"name", "gravity", "description"}
 BODY_KEYS = {"name", "mass", "com", "inertia", "principal_inertia", "radii_of_gyration", "parent",
-             "joint", "hydro", "geometry", "notes"}
+             "joint", "hydro", "geometry", "hull", "notes"}
 JOINT_KEYS = {"type", "axis", "point", "dofs", "damping", "stiffness", "rest", "locked", "notes"}
 
 
@@ -184,7 +186,12 @@ def _parse_hydro(raw, source):
     out = {"database": raw["database"], "names": raw.get("names"),
            "body_coupling": raw.get("body_coupling", True),
            "added_mass_inf": raw.get("added_mass_inf", "consistent"),
-           "rho": raw.get("rho"), "g": raw.get("g"), "bem": raw.get("bem")}
+           "rho": raw.get("rho"), "g": raw.get("g"), "bem": raw.get("bem"),
+           "hydrostatics": raw.get("hydrostatics", "linear")}
+    if out["hydrostatics"] not in HYDROSTATICS:
+        raise ConfigError(f"hydro.hydrostatics: {out['hydrostatics']!r}; accepted: "
+                          f"{list(HYDROSTATICS)} (nonlinear: hydrostatics and Froude–Krylov on the "
+                          "instantaneous wetted hull of each body's [bodies.hull])")
     for key, unit, typical in (("rho", "kg/m³", "1025 for sea water, 1000 for fresh water"),
                                ("g", "m/s²", "9.81")):
         v = out[key]
@@ -268,6 +275,21 @@ def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodyS
         joint = _parse_joint(raw["joint"], f"{where}.joint", parent is None)
         # geometry (hull shape for `mfm hydro`) is checked by hydro.geometry when a BEM runs
         extra = {k: raw[k] for k in ("notes", "geometry") if k in raw}
+        if "hull" in raw:
+            # the closed hull of the nonlinear level (hydro.wetted.hull_mesh), checked here
+            from hydro.wetted import hull_mesh
+
+            # a hull of shape "geometry" is placed as `mfm hydro` places the geometry (mfm.bemgen:
+            # the axis under the CoM unless its origin says otherwise)
+            geometry = raw.get("geometry")
+            if isinstance(geometry, dict):
+                geometry = {"origin": [float(com[0]), float(com[1]), 0.0], **geometry}
+            try:
+                hull_mesh(raw["hull"], where=f"{where}.hull", geometry=geometry)
+            except ValueError as e:
+                raise ConfigError(str(e)) from None
+            extra["hull"] = dict(raw["hull"])
+            extra["hull_geometry"] = geometry
         if "hydro" in raw:
             extra["hydro"] = _parse_body_hydro(raw["hydro"], f"{where}.hydro", name)
         bodies.append(BodySpec(name=name, mass=mass, com=com, inertia=inertia, parent=parent,

@@ -55,6 +55,51 @@ MODES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
 HYDRO_COMPONENTS = ("excitation", "radiation", "added_mass", "hydrostatic", "buoyancy", "drag")
 
 
+class Hulls(eqx.Module):
+    """The nonlinear level's hulls (``[hydro] hydrostatics = "nonlinear"``): the pressure of the
+    undisturbed flow, hydrostatic and the incident wave's, on each hydro body's instantaneous
+    wetted hull (:func:`hydro.wetted.pressure_loads`), in place of the constant buoyancy, the
+    linear water-plane stiffness and the Froude–Krylov part of the excitation.
+
+    ``tri``: per hydro body, its closed hull's triangles (n_k, 3, 3) in body axes about its CoM;
+    ``wave``: the run's incident components (:class:`hydro.wetted.WaveField`, no ramp);
+    ``ramp``: s, the excitation's start-up ramp, applied to the amplitudes; ``rho``, ``g``."""
+    tri: tuple
+    wave: object
+    ramp: jnp.ndarray
+    rho: float = eqx.field(static=True, default=1025.0)
+    g: float = eqx.field(static=True, default=9.81)
+
+    def loads(self, geometry, kin, t):
+        """(hydrostatic, Froude–Krylov), each (6K,): force and moment about each reference point
+        r_k (inertial axes) of the two pressures on the wetted hull cut at the instantaneous
+        surface."""
+        from hydro.wetted import WaveField, pressure_loads
+
+        T = self.ramp
+        r = jnp.where(T > 0, 0.5 * (1 - jnp.cos(jnp.pi * jnp.clip(t, 0.0, T) / jnp.where(T > 0, T, 1.0))),
+                      1.0)
+        w = self.wave
+        wave = WaveField(w.amplitude * r, w.omega, w.wavenumber, w.heading, w.phase, w.water_depth)
+        idx = np.asarray(geometry.body_index)
+        ref = geometry.positions(kin)
+        hs, fk = [], []
+        for k, tri in enumerate(self.tri):
+            E = kin.E[idx[k]]
+            h, f = pressure_loads(tri, E[:3, :3], E[:3, 3], ref[k], wave, t, rho=self.rho,
+                                  g=self.g, parts=True)
+            hs.append(h)
+            fk.append(f)
+        return jnp.concatenate(hs), jnp.concatenate(fk)
+
+    def still(self) -> "Hulls":
+        """These hulls in still water (the linearisation's static load)."""
+        z = lambda a: jnp.zeros((0,), a.dtype)  # noqa: E731
+        w = self.wave
+        return dataclasses.replace(self, wave=type(w)(z(w.amplitude), z(w.omega), z(w.wavenumber),
+                                                      z(w.heading), z(w.phase), w.water_depth))
+
+
 class Water(Load):
     """The hydrodynamic load of a model. Build with :func:`build_water`.
 
@@ -84,6 +129,8 @@ class Water(Load):
     # the moved hydro dofs (spec.moving): what traced code needs of the spec, kept apart so that
     # the compiled functions can be handed the water without its spec (loads.assembly.compile_view)
     moving: tuple | None = eqx.field(static=True, default=None)
+    # the nonlinear level's hulls (Hulls), or None: the linear hydrostatics and excitation
+    hulls: object = None
     reads_sea: ClassVar[bool] = True
 
     # the older names, kept for code that reads them
@@ -145,9 +192,16 @@ class Water(Load):
         # quadratic drag on the translational dofs (k = body, a = axis), dense for the same reason
         k, a = rows // 6, rows % 6
         vr = v[rows]
-        f, lever = self._buoyancy(kin)
-        buoy = jnp.concatenate([f, jnp.cross(lever - g._frames(kin)[2], f)], axis=1).reshape(-1)
-        return dict(excitation=self._series(self.exc_values, t)[rows], radiation=rad,
+        exc = self._series(self.exc_values, t)
+        if self.hulls is None:
+            f, lever = self._buoyancy(kin)
+            buoy = jnp.concatenate([f, jnp.cross(lever - g._frames(kin)[2], f)], axis=1).reshape(-1)
+        else:
+            # the pressure on the wetted hull: its hydrostatic part is the buoyancy and the
+            # restoring (C_wp is 0 here), its wave part adds to the tables' diffraction
+            buoy, fk = self.hulls.loads(g, kin, t)
+            exc = exc + fk
+        return dict(excitation=exc[rows], radiation=rad,
                     hydrostatic=-(self.C_wp[rows] @ xi),
                     drag=-(self.drag[k, np.minimum(a, 2)] * (a < 3)) * jnp.abs(vr) * vr,
                     added_mass_bias=-(self.A_inf[rows][:, mv] @ hbias[mv]),
@@ -243,7 +297,10 @@ class Water(Load):
         return dataclasses.replace(self, exc_values=exc_values, eta_values=eta_values)
 
     def provenance(self):
-        out = {"added_mass": self.added_mass, **self.rad.provenance()}
+        out = {"added_mass": self.added_mass, **self.rad.provenance(),
+               "hydrostatics": "linear" if self.hulls is None else "nonlinear"}
+        if self.hulls is not None:
+            out["hull_panels"] = ", ".join(str(int(t.shape[0])) for t in self.hulls.tri)
         if self.spec is not None:
             out.update(self.spec.provenance())
         return out
@@ -276,8 +333,11 @@ class Water(Load):
         def zeros(a):
             return jnp.zeros((2,) + a.shape[1:], a.dtype)
 
-        return eqx.tree_at(lambda w: (w.exc_values, w.eta_values, w.rad),
-                           self, (zeros(self.exc_values), zeros(self.eta_values), NoRadiation()))
+        still = eqx.tree_at(lambda w: (w.exc_values, w.eta_values, w.rad),
+                            self, (zeros(self.exc_values), zeros(self.eta_values), NoRadiation()))
+        if self.hulls is None:
+            return still
+        return dataclasses.replace(still, hulls=self.hulls.still())
 
     def _frequency_coefficients(self, kin0, omega, heading, options, excitation=True):
         """(A(ω) − A∞, B(ω), X(ω, β) or None, H₀) of ``options["radiation"]``: (n_ω, 6K, 6K),
@@ -387,11 +447,52 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
     geometry = BodyPoints(body_index=spec.body_index, d_ref=jnp.asarray(spec.d_ref),
                           ref0=jnp.asarray(spec.ref0))
     f64 = lambda a: jnp.asarray(a, dtype=jnp.float64)  # noqa: E731
-    return Water(geometry=geometry, A_inf=f64(rad.added_mass_inf(spec)), C_wp=f64(spec.C_wp),
-                 buoyancy=f64(spec.rho * spec.g * spec.volume), d_cob=f64(spec.d_cob),
+    C_wp, buoyancy, hulls = spec.C_wp, spec.rho * spec.g * spec.volume, None
+    if nonlinear(spec):
+        comps = None if sea is None else sea.components(water_depth=spec.water_depth, g=spec.g)
+        exc = exc - froude_krylov_series(spec, comps, t_grid, ramp)
+        C_wp, buoyancy = np.zeros_like(C_wp), np.zeros_like(buoyancy)
+        hulls = make_hulls(spec, comps, ramp)
+    return Water(geometry=geometry, A_inf=f64(rad.added_mass_inf(spec)), C_wp=f64(C_wp),
+                 buoyancy=f64(buoyancy), d_cob=f64(spec.d_cob),
                  drag=f64(spec.drag), exc_t0=f64(t0), exc_step=f64(step), exc_values=f64(exc),
                  eta_values=f64(eta), rad=rad, dofs=spec.dofs, added_mass=added_mass, spec=spec,
-                 grid_m=int(m), moving=spec.moving)
+                 grid_m=int(m), moving=spec.moving, hulls=hulls)
+
+
+def nonlinear(spec) -> bool:
+    """Whether the spec's water takes the nonlinear level (``[hydro] hydrostatics``)."""
+    return getattr(spec, "hydrostatics", "linear") == "nonlinear"
+
+
+def make_hulls(spec, comps, ramp: float) -> Hulls:
+    """The :class:`Hulls` of the spec's hull meshes (at rest, inertial axes: ``spec.hulls``) in
+    body axes about each body's CoM, with the run's wave components (None: still water)."""
+    from hydro.wetted import WaveField, still_water
+
+    com0 = np.asarray(spec.ref0) - np.asarray(spec.d_ref)
+    tri = tuple(jnp.asarray(np.asarray(T) - com0[k]) for k, T in enumerate(spec.hulls))
+    wave = still_water() if comps is None else WaveField.of(comps)
+    return Hulls(tri=tri, wave=wave, ramp=jnp.asarray(float(ramp)), rho=float(spec.rho),
+                 g=float(spec.g))
+
+
+def froude_krylov_series(spec, comps, t, ramp: float) -> np.ndarray:
+    """The linear Froude–Krylov force of the hulls at rest, (len(t), 6K): what the nonlinear
+    level takes out of the database's excitation (its tables keep the diffraction), so that in
+    small waves the two add up to the database's (:func:`hydro.wetted.froude_krylov_linear` at
+    each component's k and heading: no interpolation)."""
+    from hydro.waves import _harmonic_sum, ramp as ramp_of
+    from hydro.wetted import froude_krylov_linear
+
+    t = np.asarray(t, float)
+    if comps is None or len(comps.omega) == 0:
+        return np.zeros((len(t), 6 * len(spec.hulls)))
+    X = np.concatenate([froude_krylov_linear(T, spec.ref0[k], comps.wavenumber, comps.heading,
+                                             water_depth=spec.water_depth, rho=spec.rho, g=spec.g)
+                        for k, T in enumerate(spec.hulls)], axis=1)          # (J, 6K)
+    out = _harmonic_sum(np.asarray(comps.omega, float), comps.complex_amplitude[:, None] * X, t)
+    return out * ramp_of(t, ramp)[:, None] if ramp else out
 
 
 def excitation_table(spec):
@@ -507,7 +608,8 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
                       state_space_options: dict | None = None, added_mass: str = "lhs",
                       stage_offsets=(0.0, 0.5, 1.0)):
     """The :class:`Water` of B cases at once (a batch's seas, time steps and ramps, each run
-    ``n_steps`` steps): ``(water, batched, waves, polar)``. ``water`` is one Water whose fields that
+    ``n_steps`` steps): ``(water, batched, waves, polar)``. The linear level only (the nonlinear
+    level's hulls: :func:`mfm.simulate` case by case). ``water`` is one Water whose fields that
     differ between the cases carry a leading case axis (``batched``: a pytree of bools like it,
     True on those fields), its tables left out (None): ``waves``, a :class:`WaveSum` with a
     leading case axis, makes them (:meth:`WaveSum.tables`, on the device) with the excitation
@@ -523,6 +625,11 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
     Cases with fewer wave components than the most are padded with zero coefficients (a term
     0 · cos = 0 exactly). Raises ValueError when the cases' radiation differs in structure (a
     convolution's number of lags follows dt)."""
+    if nonlinear(spec):
+        raise NotImplementedError(
+            "simulate_batch: the nonlinear level ([hydro] hydrostatics = \"nonlinear\") is not "
+            "batched yet; run its cases with mfm.simulate, or load the model with the linear "
+            "level for the batch")
     B = len(seas)
     dts = np.broadcast_to(np.asarray(dts, dtype=float), (B,))
     ramps = np.broadcast_to(np.asarray(ramps, dtype=float), (B,))
@@ -674,9 +781,65 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
                          "hydro.body_coupling)")
     phases.say("the hydro dofs the joints move (H(q), compiled once per model structure)")
     moving = moving_dofs(model, idx, np.asarray(db["reference_point"].values) - com0)
-    return HydroSpec(db, idx, [name for name, _, _ in wet], com0, np.stack([d for _, _, d in wet]),
+    spec = HydroSpec(db, idx, [name for name, _, _ in wet], com0, np.stack([d for _, _, d in wet]),
                      body_coupling=coupling, added_mass_inf=options.get("added_mass_inf", "consistent"),
                      source=str(path), moving=moving)
+    if options.get("hydrostatics", "linear") == "nonlinear":
+        attach_hulls(spec, [by_name[name] for name, _, _ in wet])
+    return spec
+
+
+# the nonlinear level's hull against its database body: a hull whose volume or centre of buoyancy
+# at rest is this far from the database's is another hull (or another draft, or misplaced). 3 %:
+# the default panels' facets cost 0.6 % of a sphere's volume, and two meshes of one hull agree
+# far better than that; a hull of the wrong size or place is off by much more
+HULL_VOLUME_RTOL = 0.03
+HULL_COB_RTOL = 0.03
+
+
+def attach_hulls(spec, bodies) -> None:
+    """Give ``spec`` (its bodies ``bodies``, config BodySpecs in the spec's order) the nonlinear
+    level: each body's closed hull (``[bodies.hull]``, :func:`hydro.wetted.hull_mesh`), checked
+    closed and outward, its still-water volume and centre of buoyancy against the database's
+    (:data:`HULL_VOLUME_RTOL`, :data:`HULL_COB_RTOL` of V^{1/3}): ``spec.hulls`` (triangles at
+    rest, inertial axes) and ``spec.hydrostatics = "nonlinear"``."""
+    from hydro.wetted import check_hull, hull_mesh, submerged_volume, triangles
+
+    from ..errors import ConfigError
+
+    hulls = []
+    cob_db = np.asarray(spec.db["center_of_buoyancy"].values, dtype=float)
+    for k, b in enumerate(bodies):
+        where = f"bodies ({b.name!r}).hull"
+        if "hull" not in b.extra:
+            raise ConfigError(
+                f"{where}: missing; hydro.hydrostatics = \"nonlinear\" integrates the pressure over "
+                "each wet body's instantaneous wetted hull, so each needs its closed hull, above "
+                "the water line too: a [bodies.hull] table such as { shape = \"cylinder\", "
+                "radius = 3.0, bottom = -5.0, top = 2.0 } (shapes: sphere, cylinder, box, "
+                "revolution)")
+        V, F = hull_mesh(b.extra["hull"], where=where, geometry=b.extra.get("hull_geometry"))
+        T = triangles(V, F)
+        try:
+            check_hull(T, what=where)
+        except ValueError as e:
+            raise ConfigError(str(e)) from None
+        vol, cob = submerged_volume(jnp.asarray(T), jnp.eye(3), jnp.zeros(3))
+        vol, cob = float(vol), np.asarray(cob)
+        v_db = float(spec.volume[k])
+        size = abs(v_db) ** (1 / 3)
+        if abs(vol / v_db - 1) > HULL_VOLUME_RTOL or \
+                np.linalg.norm(cob - cob_db[k]) > HULL_COB_RTOL * size:
+            raise ConfigError(
+                f"{where}: at rest it displaces {vol:.6g} m³ with its centre of buoyancy at "
+                f"({cob[0]:.4g}, {cob[1]:.4g}, {cob[2]:.4g}) m, the database body "
+                f"{spec.db_names[k]!r} {v_db:.6g} m³ at ({cob_db[k][0]:.4g}, {cob_db[k][1]:.4g}, "
+                f"{cob_db[k][2]:.4g}) m (tolerances {HULL_VOLUME_RTOL:.0%} of the volume, "
+                f"{HULL_COB_RTOL:.0%} of V^(1/3) = {size:.3g} m): not the same hull at the same "
+                "place; give the hull's dimensions and center in the config's axes at rest")
+        hulls.append(T)
+    spec.hulls = tuple(hulls)
+    spec.hydrostatics = "nonlinear"
 
 
 @jax.jit
