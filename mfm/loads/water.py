@@ -61,7 +61,8 @@ class Hulls(eqx.Module):
     wetted hull (:func:`hydro.wetted.pressure_loads`), in place of the constant buoyancy, the
     linear water-plane stiffness and the Froude–Krylov part of the excitation.
 
-    ``tri``: per hydro body, its closed hull's triangles (n_k, 3, 3) in body axes about its CoM;
+    ``tri``: per hydro body, its closed hull's triangles in body axes about its CoM, as rows
+    (3, 3, n_k): vertex, axis, triangle (:func:`hydro.wetted.soa`);
     ``wave``: the run's incident components (:class:`hydro.wetted.WaveField`, no ramp);
     ``ramp``: s, the excitation's start-up ramp, applied to the amplitudes; ``rho``, ``g``."""
     tri: tuple
@@ -74,7 +75,7 @@ class Hulls(eqx.Module):
         """(hydrostatic, Froude–Krylov), each (6K,): force and moment about each reference point
         r_k (inertial axes) of the two pressures on the wetted hull cut at the instantaneous
         surface."""
-        from hydro.wetted import WaveField, pressure_loads
+        from hydro.wetted import WaveField, pressure_loads_rows
 
         T = self.ramp
         r = jnp.where(T > 0, 0.5 * (1 - jnp.cos(jnp.pi * jnp.clip(t, 0.0, T) / jnp.where(T > 0, T, 1.0))),
@@ -86,8 +87,8 @@ class Hulls(eqx.Module):
         hs, fk = [], []
         for k, tri in enumerate(self.tri):
             E = kin.E[idx[k]]
-            h, f = pressure_loads(tri, E[:3, :3], E[:3, 3], ref[k], wave, t, rho=self.rho,
-                                  g=self.g, parts=True)
+            h, f = pressure_loads_rows(tri, E[:3, :3], E[:3, 3], ref[k], wave, t, rho=self.rho,
+                                       g=self.g)
             hs.append(h)
             fk.append(f)
         return jnp.concatenate(hs), jnp.concatenate(fk)
@@ -300,7 +301,7 @@ class Water(Load):
         out = {"added_mass": self.added_mass, **self.rad.provenance(),
                "hydrostatics": "linear" if self.hulls is None else "nonlinear"}
         if self.hulls is not None:
-            out["hull_panels"] = ", ".join(str(int(t.shape[0])) for t in self.hulls.tri)
+            out["hull_panels"] = ", ".join(str(int(t.shape[-1])) for t in self.hulls.tri)
         if self.spec is not None:
             out.update(self.spec.provenance())
         return out
@@ -468,10 +469,10 @@ def nonlinear(spec) -> bool:
 def make_hulls(spec, comps, ramp: float) -> Hulls:
     """The :class:`Hulls` of the spec's hull meshes (at rest, inertial axes: ``spec.hulls``) in
     body axes about each body's CoM, with the run's wave components (None: still water)."""
-    from hydro.wetted import WaveField, still_water
+    from hydro.wetted import WaveField, soa, still_water
 
     com0 = np.asarray(spec.ref0) - np.asarray(spec.d_ref)
-    tri = tuple(jnp.asarray(np.asarray(T) - com0[k]) for k, T in enumerate(spec.hulls))
+    tri = tuple(soa(np.asarray(T) - com0[k]) for k, T in enumerate(spec.hulls))
     wave = still_water() if comps is None else WaveField.of(comps)
     return Hulls(tri=tri, wave=wave, ramp=jnp.asarray(float(ramp)), rho=float(spec.rho),
                  g=float(spec.g))
