@@ -169,6 +169,38 @@ def wave_pressure(wave: WaveField, points, t, *, rho: float, g: float):
     return rho * g * jnp.sum(wave.amplitude * decay * jnp.cos(th), axis=-1)
 
 
+def particle_velocity(wave: WaveField, points, t):
+    """The undisturbed flow's velocity (m/s) at ``points`` (..., 3), inertial axes: linear wave
+    kinematics, each component's
+
+        u_h = a ω f_h(z_s) cos θ (cos β, sin β),   u_z = a ω f_v(z_s) sin θ,
+        θ = k (x cos β + y sin β) − ω t + φ,
+
+    f_h = cosh k(z_s + h)/sinh k h, f_v = sinh k(z_s + h)/sinh k h (e^{k z_s} both in deep water),
+    at the Wheeler-stretched z_s of :func:`pressure` (the surface's velocity at the surface and
+    above it: a point model's reference point in a crest keeps the flow it had)."""
+    x, y, z = points[..., 0], points[..., 1], points[..., 2]
+    if wave.amplitude.shape[0] == 0:
+        return jnp.zeros(jnp.shape(points))
+    th = _phase(wave, x, y, t)
+    eta = jnp.sum(wave.amplitude * jnp.cos(th), axis=-1)
+    h, k = wave.water_depth, wave.wavenumber
+    if math.isinf(h):
+        zs = jnp.minimum(z - eta, 0.0)[..., None]
+        fh = fv = jnp.exp(k * zs)
+    else:
+        zs = jnp.clip(h * (z - eta) / (h + eta), -h, 0.0)[..., None]
+        # cosh, sinh k(z_s + h)/sinh k h without overflow: e^{k z_s} (1 ± e^{−2k(z_s+h)})/(1 − e^{−2kh})
+        e, d = jnp.exp(k * zs), 1 - jnp.exp(-2 * k * h)
+        fh = e * (1 + jnp.exp(-2 * k * (zs + h))) / d
+        fv = e * (1 - jnp.exp(-2 * k * (zs + h))) / d
+    aw = wave.amplitude * wave.omega
+    uh = jnp.sum(aw * fh * jnp.cos(th) * jnp.cos(wave.heading), axis=-1), \
+        jnp.sum(aw * fh * jnp.cos(th) * jnp.sin(wave.heading), axis=-1)
+    uz = jnp.sum(aw * fv * jnp.sin(th), axis=-1)
+    return jnp.stack([uh[0], uh[1], uz], axis=-1)
+
+
 # ------------------------------------------------------------------------------------- the cut
 def _norm(v):
     """|v| over the last axis with a derivative at v = 0 (0 there, not 0/0: an absent piece of

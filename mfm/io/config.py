@@ -51,7 +51,7 @@ from ..mechanics.tree import (JOINT_KINDS, PLANAR_DOFS, ROOT_DOFS, BodySpec, Joi
 # the tables of loads (moorings, ptos, ...) come from the load registry (mfm.loads.registry)
 TOP_KEYS = {"model", "bodies", "hydro"} | set(LOAD_TABLES)
 HYDRO_KEYS = {"database", "names", "body_coupling", "added_mass_inf", "rho", "g", "bem", "notes",
-              "hydrostatics"}
+              "hydrostatics", "drag_flow"}
 HYDROSTATICS = ("linear", "nonlinear")
 BODY_HYDRO_KEYS = {"body", "drag_coefficient", "drag_area", "notes"}
 MODEL_KEYS = {"name", "gravity", "description"}
@@ -187,7 +187,12 @@ def _parse_hydro(raw, source):
            "body_coupling": raw.get("body_coupling", True),
            "added_mass_inf": raw.get("added_mass_inf", "consistent"),
            "rho": raw.get("rho"), "g": raw.get("g"), "bem": raw.get("bem"),
-           "hydrostatics": raw.get("hydrostatics", "linear")}
+           "hydrostatics": raw.get("hydrostatics", "linear"),
+           "drag_flow": raw.get("drag_flow", "body")}
+    if out["drag_flow"] not in ("body", "relative"):
+        raise ConfigError(f"hydro.drag_flow: {out['drag_flow']!r}; accepted: 'body' (quadratic "
+                          "drag on each reference point's velocity) or 'relative' (on its "
+                          "velocity relative to the incident wave's flow there)")
     if out["hydrostatics"] not in HYDROSTATICS:
         raise ConfigError(f"hydro.hydrostatics: {out['hydrostatics']!r}; accepted: "
                           f"{list(HYDROSTATICS)} (nonlinear: hydrostatics and Froude–Krylov on the "

@@ -23,8 +23,10 @@ Cummins equation for all hydro bodies together:
   the linear water-plane stiffness C_wp about r_k (the database's ``waterplane_stiffness``: no
   ρgV z_B, no m g z_G, so gravity and buoyancy are not counted twice). Weights act exactly (mfm).
 - Radiation memory by a strategy (:mod:`mfm.loads.radiation`): convolution, state space or none.
-- Quadratic drag −½ ρ C_D A |u| u per inertial axis on the velocity of r_k (no current, no wave
-  velocity); it is not linearised in the frequency domain (zero slope at rest).
+- Quadratic drag −½ ρ C_D A |u| u per inertial axis on the velocity u of r_k, or with
+  ``[hydro] drag_flow = "relative"`` on its velocity relative to the incident wave's flow there
+  (:func:`hydro.wetted.particle_velocity`; no current); it is not linearised in the frequency
+  domain (zero slope at rest).
 
 In the frequency domain the same load gives, about q₀, the impedance −ω² Hᵀ(A(ω) − A∞)H
 − iω HᵀB(ω)H of its radiation strategy (A∞ H itself is in the mass, from ``mass``) and the wave
@@ -101,6 +103,30 @@ class Hulls(eqx.Module):
                                                       z(w.heading), z(w.phase), w.water_depth))
 
 
+class Flow(eqx.Module):
+    """The incident wave's flow for drag on the relative velocity (``[hydro] drag_flow =
+    "relative"``): ``wave`` (:class:`hydro.wetted.WaveField`, no ramp), ``ramp`` (s)."""
+    wave: object
+    ramp: jnp.ndarray
+
+    def velocity(self, points, t):
+        """The flow's velocity (K, 3) at ``points`` (K, 3), ramped as the excitation is."""
+        from hydro.wetted import WaveField, particle_velocity
+
+        T = self.ramp
+        r = jnp.where(T > 0, 0.5 * (1 - jnp.cos(jnp.pi * jnp.clip(t, 0.0, T) / jnp.where(T > 0, T, 1.0))),
+                      1.0)
+        w = self.wave
+        return particle_velocity(WaveField(w.amplitude * r, w.omega, w.wavenumber, w.heading,
+                                           w.phase, w.water_depth), points, t)
+
+    def still(self) -> "Flow":
+        z = lambda a: jnp.zeros((0,), a.dtype)  # noqa: E731
+        w = self.wave
+        return dataclasses.replace(self, wave=type(w)(z(w.amplitude), z(w.omega), z(w.wavenumber),
+                                                      z(w.heading), z(w.phase), w.water_depth))
+
+
 class Water(Load):
     """The hydrodynamic load of a model. Build with :func:`build_water`.
 
@@ -132,6 +158,8 @@ class Water(Load):
     moving: tuple | None = eqx.field(static=True, default=None)
     # the nonlinear level's hulls (Hulls), or None: the linear hydrostatics and excitation
     hulls: object = None
+    # the incident flow of drag on the relative velocity (Flow), or None: drag on ξ̇ alone
+    flow: object = None
     reads_sea: ClassVar[bool] = True
 
     # the older names, kept for code that reads them
@@ -193,6 +221,10 @@ class Water(Load):
         # quadratic drag on the translational dofs (k = body, a = axis), dense for the same reason
         k, a = rows // 6, rows % 6
         vr = v[rows]
+        if self.flow is not None:
+            # drag on the velocity relative to the undisturbed flow at each reference point
+            u = self.flow.velocity(g.positions(kin), t)                       # (K, 3)
+            vr = vr - jnp.concatenate([u, jnp.zeros_like(u)], axis=1).reshape(-1)[rows]
         exc = self._series(self.exc_values, t)
         if self.hulls is None:
             f, lever = self._buoyancy(kin)
@@ -299,7 +331,8 @@ class Water(Load):
 
     def provenance(self):
         out = {"added_mass": self.added_mass, **self.rad.provenance(),
-               "hydrostatics": "linear" if self.hulls is None else "nonlinear"}
+               "hydrostatics": "linear" if self.hulls is None else "nonlinear",
+               "drag_flow": "body" if self.flow is None else "relative"}
         if self.hulls is not None:
             out["hull_panels"] = ", ".join(str(int(t.shape[-1])) for t in self.hulls.tri)
         if self.spec is not None:
@@ -336,9 +369,11 @@ class Water(Load):
 
         still = eqx.tree_at(lambda w: (w.exc_values, w.eta_values, w.rad),
                             self, (zeros(self.exc_values), zeros(self.eta_values), NoRadiation()))
-        if self.hulls is None:
-            return still
-        return dataclasses.replace(still, hulls=self.hulls.still())
+        if self.hulls is not None:
+            still = dataclasses.replace(still, hulls=self.hulls.still())
+        if self.flow is not None:
+            still = dataclasses.replace(still, flow=self.flow.still())
+        return still
 
     def _frequency_coefficients(self, kin0, omega, heading, options, excitation=True):
         """(A(ω) − A∞, B(ω), X(ω, β) or None, H₀) of ``options["radiation"]``: (n_ω, 6K, 6K),
@@ -448,17 +483,27 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
     geometry = BodyPoints(body_index=spec.body_index, d_ref=jnp.asarray(spec.d_ref),
                           ref0=jnp.asarray(spec.ref0))
     f64 = lambda a: jnp.asarray(a, dtype=jnp.float64)  # noqa: E731
-    C_wp, buoyancy, hulls = spec.C_wp, spec.rho * spec.g * spec.volume, None
+    C_wp, buoyancy, hulls, flow = spec.C_wp, spec.rho * spec.g * spec.volume, None, None
+    comps = None if sea is None else sea.components(water_depth=spec.water_depth, g=spec.g)
     if nonlinear(spec):
-        comps = None if sea is None else sea.components(water_depth=spec.water_depth, g=spec.g)
         exc = exc - froude_krylov_series(spec, comps, t_grid, ramp)
         C_wp, buoyancy = np.zeros_like(C_wp), np.zeros_like(buoyancy)
         hulls = make_hulls(spec, comps, ramp)
+    if relative_drag(spec):
+        from hydro.wetted import WaveField, still_water
+
+        flow = Flow(wave=still_water() if comps is None else WaveField.of(comps),
+                    ramp=jnp.asarray(float(ramp)))
     return Water(geometry=geometry, A_inf=f64(rad.added_mass_inf(spec)), C_wp=f64(C_wp),
                  buoyancy=f64(buoyancy), d_cob=f64(spec.d_cob),
                  drag=f64(spec.drag), exc_t0=f64(t0), exc_step=f64(step), exc_values=f64(exc),
                  eta_values=f64(eta), rad=rad, dofs=spec.dofs, added_mass=added_mass, spec=spec,
-                 grid_m=int(m), moving=spec.moving, hulls=hulls)
+                 grid_m=int(m), moving=spec.moving, hulls=hulls, flow=flow)
+
+
+def relative_drag(spec) -> bool:
+    """Whether the spec's drag acts on the velocity relative to the flow (``[hydro] drag_flow``)."""
+    return getattr(spec, "drag_flow", "body") == "relative"
 
 
 def nonlinear(spec) -> bool:
@@ -626,11 +671,11 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
     Cases with fewer wave components than the most are padded with zero coefficients (a term
     0 · cos = 0 exactly). Raises ValueError when the cases' radiation differs in structure (a
     convolution's number of lags follows dt)."""
-    if nonlinear(spec):
+    if nonlinear(spec) or relative_drag(spec):
         raise NotImplementedError(
-            "simulate_batch: the nonlinear level ([hydro] hydrostatics = \"nonlinear\") is not "
-            "batched yet; run its cases with mfm.simulate, or load the model with the linear "
-            "level for the batch")
+            "simulate_batch: the nonlinear level ([hydro] hydrostatics = \"nonlinear\") and drag "
+            "on the relative flow ([hydro] drag_flow = \"relative\") are not batched yet; run "
+            "their cases with mfm.simulate, or load the model without them for the batch")
     B = len(seas)
     dts = np.broadcast_to(np.asarray(dts, dtype=float), (B,))
     ramps = np.broadcast_to(np.asarray(ramps, dtype=float), (B,))
@@ -787,6 +832,9 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
                      source=str(path), moving=moving)
     if options.get("hydrostatics", "linear") == "nonlinear":
         attach_hulls(spec, [by_name[name] for name, _, _ in wet])
+    if options.get("drag_flow", "body") == "relative":
+        # set only when asked: every other spec keeps its content key (fingerprint) as before
+        spec.drag_flow = "relative"
     return spec
 
 
