@@ -177,8 +177,10 @@ def particle_velocity(wave: WaveField, points, t):
         θ = k (x cos β + y sin β) − ω t + φ,
 
     f_h = cosh k(z_s + h)/sinh k h, f_v = sinh k(z_s + h)/sinh k h (e^{k z_s} both in deep water),
-    at the Wheeler-stretched z_s of :func:`pressure` (the surface's velocity at the surface and
-    above it: a point model's reference point in a crest keeps the flow it had)."""
+    at the Wheeler-stretched z_s of :func:`pressure`; 0 at a point above the instantaneous surface
+    (in air: a reference point on the mean level has flow under a crest, none under a trough,
+    so its mean drag follows the wave, as the flow's mean above the troughs does; the surface's
+    flow carried up to it would push it back under every trough)."""
     x, y, z = points[..., 0], points[..., 1], points[..., 2]
     if wave.amplitude.shape[0] == 0:
         return jnp.zeros(jnp.shape(points))
@@ -198,7 +200,7 @@ def particle_velocity(wave: WaveField, points, t):
     uh = jnp.sum(aw * fh * jnp.cos(th) * jnp.cos(wave.heading), axis=-1), \
         jnp.sum(aw * fh * jnp.cos(th) * jnp.sin(wave.heading), axis=-1)
     uz = jnp.sum(aw * fv * jnp.sin(th), axis=-1)
-    return jnp.stack([uh[0], uh[1], uz], axis=-1)
+    return jnp.where((z <= eta)[..., None], jnp.stack([uh[0], uh[1], uz], axis=-1), 0.0)
 
 
 # ------------------------------------------------------------------------------------- the cut

@@ -143,8 +143,9 @@ def test_its_config_is_checked():
 def test_drag_on_the_relative_flow():
     """[hydro] drag_flow = "relative": a sphere at rest in a regular wave feels the drag of the
     flow past it, +½ ρ C_D A |u| u per axis with u = a ω e^{k z_s} (cos θ, 0, sin θ) at its
-    reference point, the decay at the Wheeler-stretched z_r − η (deep water, heading 0: Morison's
-    drag term at a point), to round-off; in
+    reference point, the decay at the Wheeler-stretched z_r − η and none where the point is out of
+    the water (deep water, heading 0: Morison's drag term at a point), to round-off, at times
+    under a crest and under a trough; in
     still water the relative drag is the body drag to the bit."""
     import jax.numpy as jnp
 
@@ -163,12 +164,14 @@ def test_drag_on_the_relative_flow():
     a, w, k, ph = (float(x[0]) for x in (c.amplitude, c.omega, c.wavenumber, c.phase))
     r = np.asarray(m.hydro.ref0[0])
     D = np.asarray(m.hydro.drag[0])
-    for t in (0.7, 2.9, 4.1):
+    for t in (0.7, 2.9, 4.1, 1.9):
         comps, *_ = water._forces(jnp.asarray(t), kin, jnp.zeros(water.n_states),
                                   water.init_memory(m, t, q, q, 0.05), np.arange(6))
         th = k * r[0] - w * t + ph
-        # Wheeler-stretched: the decay at z − η (the reference point is on the mean surface)
-        decay = math.exp(k * min(r[2] - a * math.cos(th), 0.0))
+        # Wheeler-stretched: the decay at z − η (the reference point is on the mean surface),
+        # and no flow where the point is above the surface (under a trough)
+        eta = a * math.cos(th)
+        decay = math.exp(k * (r[2] - eta)) if r[2] <= eta else 0.0
         u = a * w * decay * np.array([math.cos(th), 0.0, math.sin(th)])
         np.testing.assert_allclose(np.asarray(comps["drag"])[:3], D * np.abs(u) * u,
                                    rtol=1e-10, atol=1e-12 * float(np.abs(D * u * u).max()))
