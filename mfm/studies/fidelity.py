@@ -12,7 +12,13 @@ The levels, cheapest first:
 - ``"fast"``: the full nonlinear model stepped once per step (``integrator="verlet"``) with the
   radiation states advanced exactly (``radiation="state_space_exact"``): second order in dt.
 - ``"full"``: the full nonlinear model with RK4 and the engine's default radiation
-  (``radiation="auto"``), the reference.
+  (``radiation="auto"``), linear potential flow: the reference of a model given with it.
+- ``"nonlinear"``: above linear potential flow, for a model loaded with ``[hydro] hydrostatics =
+  "nonlinear"`` (its hulls) and/or ``drag_flow = "relative"`` (docs/nonlinear.md): "full" with the
+  pressure on the instantaneous wetted hull and drag on the relative flow. Given such a model,
+  :func:`reduce` takes it as the reference and runs the levels below on the same model with the
+  linear water (the database's buoyancy, C_wp and excitation, drag on the body's velocity):
+  whether linear potential flow is enough for the scene is measured, not assumed.
 
 Within a level, ``options`` of :func:`reduce` pilots run-time simplifications of the model the
 same way (:data:`OPTIONS`): ``"body_coupling"``, the model without the hydrodynamic interaction
@@ -42,18 +48,52 @@ from ..mechanics.model import Model
 from ..runner.simulation import simulate
 from ..validation import check_model, check_sea, finite_number
 
-LEVELS = ("spectral", "linear", "fast", "full")
+LEVELS = ("spectral", "linear", "fast", "full", "nonlinear")
 # the run options each time-domain level gives mfm.simulate
 LEVEL_OPTIONS = {"fast": {"integrator": "verlet", "radiation": "state_space_exact"},
-                 "full": {"integrator": "rk4", "radiation": "auto"}}
+                 "full": {"integrator": "rk4", "radiation": "auto"},
+                 "nonlinear": {"integrator": "rk4", "radiation": "auto"}}
+# the levels of linear potential flow: run on the model's linear water (linear_water)
+LINEAR_LEVELS = ("spectral", "linear", "fast", "full")
+
+
+def above_linear(model: Model) -> bool:
+    """Whether ``model``'s water is above linear potential flow (nonlinear hydrostatics and
+    Froude–Krylov, or drag on the relative flow)."""
+    from ..loads.water import nonlinear, relative_drag
+
+    return model.hydro is not None and (nonlinear(model.hydro) or relative_drag(model.hydro))
+
+
+def linear_water(model: Model) -> Model:
+    """``model`` with the linear water: its spec without the nonlinear level's hulls and with
+    drag on the body's velocity (the same database, bodies and options; the radiation's fits and
+    kernels shared, as they do not depend on either)."""
+    import copy
+    import dataclasses
+
+    if not above_linear(model):
+        return model
+    spec = copy.copy(model.hydro)
+    for name in ("hulls", "hydrostatics", "drag_flow"):
+        spec.__dict__.pop(name, None)
+    # its own cache, holding what the given spec has made (fits, kernels: the radiation's, the
+    # same for both) but not its replaced copies (those carry the hulls)
+    spec._cache = {k: v for k, v in model.hydro._cache.items()
+                   if not (isinstance(k, tuple) and k and k[0] == "replace")}
+    return dataclasses.replace(model, hydro=spec)
 # the within-level options reduce can pilot: name -> the HydroSpec options of the variant
 OPTIONS = {"body_coupling": {"body_coupling": False}}
 
 
 def variant_model(model: Model, variant: dict) -> Model:
     """``model`` with the hydro options of ``variant`` (values of :data:`OPTIONS`, merged; e.g.
-    ``{"body_coupling": False}``) by :meth:`hydro.prepare.HydroSpec.replace`; the model itself
-    when ``variant`` is empty."""
+    ``{"body_coupling": False}``) by :meth:`hydro.prepare.HydroSpec.replace`, and with
+    ``"linear_water": True`` its linear water (:func:`linear_water`); the model itself when
+    ``variant`` is empty."""
+    variant = dict(variant)
+    if variant.pop("linear_water", False):
+        model = linear_water(model)
     if not variant:
         return model
     import dataclasses
@@ -78,10 +118,11 @@ class Reduction:
 
     level: the chosen level (one of :data:`LEVELS`). options: what :func:`mfm.simulate` is given
     for it (empty for "spectral" and "linear"). errors: {level: {output: relative error against
-    "full"}} on the pilot. wall_s: {level: s} the warm wall time of each level on the pilot.
+    the reference ("full", or "nonlinear" for a model given above linear)}} on the pilot. wall_s: {level: s} the warm wall time of each level on the pilot.
     reason: why this level, in words. tolerance, dt, pilot: the settings of the measurement.
     variant: the hydro options of the within-level variant taken (``{"body_coupling": False}``;
-    empty when none was asked for or none held); :meth:`run` applies it (:func:`variant_model`).
+    empty when none was asked for or none held; ``{"linear_water": True}`` where a linear level
+    was chosen for a model given above linear); :meth:`run` applies it (:func:`variant_model`).
     variant_errors, variant_wall_s: {option: {output: error}} and {option: s} of each option
     piloted at the chosen level, against the same full model.
     """
@@ -149,7 +190,8 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
     period: s, the scene's period (default the sea's ``tp`` or ``period``); the pilot runs
     ``pilot_periods`` periods at dt = period / ``steps_per_period`` with a ramp of 5 periods, and
     compares the part after ``settle_periods`` periods.
-    levels: the levels to consider ("full" is always run: it is the reference).
+    levels: the levels to consider (the reference is always run: "nonlinear" for a model given
+    above linear potential flow, whose other levels run on its linear water; else "full").
     timing: run each level a second time for its warm wall time (compiled, fitted: what a long
     run or a sweep pays per run), reported in ``wall_s`` and the reason; False runs each once and
     reports no times.
@@ -174,6 +216,11 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
     bad = [lv for lv in levels if lv not in LEVELS]
     if bad or not levels:
         raise ValueError(f"levels: {levels!r}; accepted: a non-empty subset of {LEVELS}")
+    # the reference: the model as given, "nonlinear" when its water is above linear potential
+    # flow (the levels below then run on its linear water), else "full"
+    top = "nonlinear" if above_linear(model) else "full"
+    if top == "full":
+        levels = tuple(lv for lv in levels if lv != "nonlinear")
     names = list(model.coordinates)
     bad = [c for c in coordinates if c not in names]
     if bad:
@@ -203,10 +250,17 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
     duration, ramp = pilot_periods * T, 5.0 * T
     window = slice(settle_periods * T, None)
 
+    def with_water(level, variant=None):
+        # the linear levels of a model given above linear run on its linear water
+        out = dict(variant or {})
+        if top == "nonlinear" and level in LINEAR_LEVELS:
+            out["linear_water"] = True
+        return out
+
     def timed(level, variant=None):
         fn = lambda: Reduction(level, LEVEL_OPTIONS.get(level, {}), {}, {}, "", tolerance, dt,  # noqa: E731
-                               (duration, ramp), dict(variant or {})).run(model, sea,
-                                                                          duration=duration)
+                               (duration, ramp), with_water(level, variant)).run(
+                                   model, sea, duration=duration)
         ds = fn()
         if not timing:
             return ds, None
@@ -214,23 +268,25 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
         fn()
         return ds, _time.perf_counter() - start
 
-    ref, wall_full = timed("full")
+    ref, wall_full = timed(top)
     reference = _measures(ref, window, coordinates)
-    errors, wall = {"full": {k: 0.0 for k in reference}}, {"full": wall_full}
-    for level in [lv for lv in LEVELS if lv in levels and lv != "full"]:
+    errors, wall = {top: {k: 0.0 for k in reference}}, {top: wall_full}
+    for level in [lv for lv in LEVELS if lv in levels and lv != top]:
         ds, wall[level] = timed(level)
         errors[level] = _errors(_measures(ds, window, coordinates), reference)
     within = [lv for lv in LEVELS if lv in errors and max(errors[lv].values(), default=0.0) <= tolerance]
     level = within[0]
     worst = {lv: max(errors[lv].values(), default=0.0) for lv in errors}
-    if level == "full":
+    if level == top:
         reason = ("no cheaper level within the tolerance: " + ", ".join(
-            f"{lv} {worst[lv]:.3g}" for lv in errors if lv != "full") + f" > {tolerance:g}")
+            f"{lv} {worst[lv]:.3g}" for lv in errors if lv != top) + f" > {tolerance:g}")
+        if top == "nonlinear":
+            reason += " (linear potential flow is not enough for this scene)"
     else:
         reason = (f"{level}: largest error {worst[level]:.3g} ≤ {tolerance:g} on a pilot of "
                   f"{pilot_periods:g} periods")
         if timing:
-            reason += f", {wall_full / wall[level]:.3g}× faster than full"
+            reason += f", {wall_full / wall[level]:.3g}× faster than {top}"
         refused = [lv for lv in LEVELS[:LEVELS.index(level)] if lv in errors]
         if refused:
             reason += "; refused: " + ", ".join(f"{lv} {worst[lv]:.3g} > {tolerance:g}"
@@ -255,4 +311,4 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
     if not timing:
         wall, v_wall = {}, {}
     return Reduction(level, LEVEL_OPTIONS.get(level, {}), errors, wall, reason, tolerance, dt,
-                     (duration, ramp), variant, v_errors, v_wall)
+                     (duration, ramp), with_water(level, variant), v_errors, v_wall)
