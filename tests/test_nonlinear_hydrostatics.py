@@ -187,9 +187,9 @@ def test_drag_on_the_relative_flow():
 
 def test_reduce_says_when_linear_potential_flow_is_enough():
     """mfm.reduce on the sphere given with its nonlinear level: the reference is "nonlinear" and
-    the linear levels run on its linear water. In a steep wave (H 1 m, T 4 s, H/λ = 0.04; at
-    H 0.5 m the linear heave amplitude is 4.7 % off, benchmarks/RESULTS.md, and the short pilot's
-    standard deviations 1.9 %) no linear level is within 2 %: it keeps "nonlinear" and says
+    the linear levels run on its linear water. In a steep wave (H 1 m, T 4 s, H/λ = 0.04; the
+    sphere is unmoored in surge, and the nonlinear level's mean wave force carries it downstream,
+    docs/nonlinear.md) no linear level is within 2 %: it keeps "nonlinear" and says
     why; in a small one (H 0.05 m) the linear "full" is within 2 % (the hulls' own 1 %
     difference), and its run is the linear water's."""
     _, nl = _models_cached()
