@@ -57,6 +57,21 @@ MODES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
 HYDRO_COMPONENTS = ("excitation", "radiation", "added_mass", "hydrostatic", "buoyancy", "drag")
 
 
+def _ramped(wave, T, t):
+    """``wave`` (:class:`hydro.wetted.WaveField`) with its amplitudes ramped at t as the
+    excitation is (:func:`hydro.waves.ramp`: ½(1 − cos πt/T) before T, 1 after; T = 0: 1)."""
+    r = jnp.where(T > 0, 0.5 * (1 - jnp.cos(jnp.pi * jnp.clip(t, 0.0, T) / jnp.where(T > 0, T, 1.0))),
+                  1.0)
+    return type(wave)(wave.amplitude * r, wave.omega, wave.wavenumber, wave.heading, wave.phase,
+                      wave.water_depth)
+
+
+def _still(wave):
+    """``wave`` with no components (still water), its depth kept."""
+    z = jnp.zeros((0,), jnp.float64)
+    return type(wave)(z, z, z, z, z, wave.water_depth)
+
+
 class Hulls(eqx.Module):
     """The nonlinear level's hulls (``[hydro] hydrostatics = "nonlinear"``): the pressure of the
     undisturbed flow, hydrostatic and the incident wave's, on each hydro body's instantaneous
@@ -77,13 +92,9 @@ class Hulls(eqx.Module):
         """(hydrostatic, Froude–Krylov), each (6K,): force and moment about each reference point
         r_k (inertial axes) of the two pressures on the wetted hull cut at the instantaneous
         surface."""
-        from hydro.wetted import WaveField, pressure_loads_rows
+        from hydro.wetted import pressure_loads_rows
 
-        T = self.ramp
-        r = jnp.where(T > 0, 0.5 * (1 - jnp.cos(jnp.pi * jnp.clip(t, 0.0, T) / jnp.where(T > 0, T, 1.0))),
-                      1.0)
-        w = self.wave
-        wave = WaveField(w.amplitude * r, w.omega, w.wavenumber, w.heading, w.phase, w.water_depth)
+        wave = _ramped(self.wave, self.ramp, t)
         idx = np.asarray(geometry.body_index)
         ref = geometry.positions(kin)
         hs, fk = [], []
@@ -97,10 +108,7 @@ class Hulls(eqx.Module):
 
     def still(self) -> "Hulls":
         """These hulls in still water (the linearisation's static load)."""
-        z = lambda a: jnp.zeros((0,), a.dtype)  # noqa: E731
-        w = self.wave
-        return dataclasses.replace(self, wave=type(w)(z(w.amplitude), z(w.omega), z(w.wavenumber),
-                                                      z(w.heading), z(w.phase), w.water_depth))
+        return dataclasses.replace(self, wave=_still(self.wave))
 
 
 class Flow(eqx.Module):
@@ -111,20 +119,13 @@ class Flow(eqx.Module):
 
     def velocity(self, points, t):
         """The flow's velocity (K, 3) at ``points`` (K, 3), ramped as the excitation is."""
-        from hydro.wetted import WaveField, particle_velocity
+        from hydro.wetted import particle_velocity
 
-        T = self.ramp
-        r = jnp.where(T > 0, 0.5 * (1 - jnp.cos(jnp.pi * jnp.clip(t, 0.0, T) / jnp.where(T > 0, T, 1.0))),
-                      1.0)
-        w = self.wave
-        return particle_velocity(WaveField(w.amplitude * r, w.omega, w.wavenumber, w.heading,
-                                           w.phase, w.water_depth), points, t)
+        return particle_velocity(_ramped(self.wave, self.ramp, t), points, t)
 
     def still(self) -> "Flow":
-        z = lambda a: jnp.zeros((0,), a.dtype)  # noqa: E731
-        w = self.wave
-        return dataclasses.replace(self, wave=type(w)(z(w.amplitude), z(w.omega), z(w.wavenumber),
-                                                      z(w.heading), z(w.phase), w.water_depth))
+        """This flow in still water (the linearisation's static load)."""
+        return dataclasses.replace(self, wave=_still(self.wave))
 
 
 class Water(Load):
