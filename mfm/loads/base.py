@@ -48,10 +48,14 @@ class Context(NamedTuple):
 
 
 class LoadOutput(NamedTuple):
+    """``extra``: anything the load hands its own :meth:`Load.reaction_loads` and
+    :meth:`Load.diagnostics` of the same state (they get this output), so that what they share
+    with :meth:`Load.evaluate` is made once when a sample is recorded (None: nothing)."""
     body: jnp.ndarray | None = None
     tau: jnp.ndarray | None = None
     zd: jnp.ndarray | None = None
     mass: jnp.ndarray | None = None
+    extra: Any = None
 
 
 class FrequencyTerms(NamedTuple):

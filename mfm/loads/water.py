@@ -201,7 +201,7 @@ class Water(Load):
         """−∫K ξ̇ and the state derivative, by the radiation strategy."""
         return self.rad.force(t, v, z, memory)
 
-    def _forces(self, t, kin, z, memory, rows):
+    def _forces(self, t, kin, z, memory, rows, hull=None):
         """The Cummins terms of the module docstring on the hydro dofs ``rows`` (static indices),
         each (len(rows),): buoyancy as a load at r_k (moment (CoB − r_k) × f), −A∞ Ḣq̇ as
         ``added_mass_bias``; and the radiation's ż, ξ̇ and Ḣq̇ (6K,). The time step asks for the
@@ -232,8 +232,9 @@ class Water(Load):
             buoy = jnp.concatenate([f, jnp.cross(lever - g._frames(kin)[2], f)], axis=1).reshape(-1)
         else:
             # the pressure on the wetted hull: its hydrostatic part is the buoyancy and the
-            # restoring (C_wp is 0 here), its wave part adds to the tables' diffraction
-            buoy, fk = self.hulls.loads(g, kin, t)
+            # restoring (C_wp is 0 here), its wave part adds to the tables' diffraction (made
+            # once a recorded sample: evaluate hands them to reaction_loads and diagnostics)
+            buoy, fk = self.hulls.loads(g, kin, t) if hull is None else hull
             exc = exc + fk
         return dict(excitation=exc[rows], radiation=rad,
                     hydrostatic=-(self.C_wp[rows] @ xi),
@@ -257,13 +258,13 @@ class Water(Load):
     def _all(self) -> np.ndarray:
         return np.arange(self.A_inf.shape[0])
 
-    def _moved_load(self, ctx, H):
+    def _moved_load(self, ctx, H, hull=None):
         """The hydro load on the moved dofs, F[m] (n_m,), with ``H`` = H[m] (n_m, n_q) (with
         ``added_mass="rhs"`` −A∞ H q̈ of the iterate), and the radiation's ż. Its virtual power is
         the whole load's: the rows of H outside m are 0 at every q (:func:`moving_dofs`), so
         Hᵀ F = H[m]ᵀ F[m]."""
         mv = self._moved
-        comps, zd, _, _ = self._forces(ctx.t, ctx.kin, ctx.z, ctx.memory, mv)
+        comps, zd, _, _ = self._forces(ctx.t, ctx.kin, ctx.z, ctx.memory, mv, hull)
         F = sum(comps.values())
         if self.added_mass == "rhs" and ctx.qdd_guess is not None:
             # Lande-Sudall et al. §5: −A∞ ξ̈ on the right-hand side with the corrector's acceleration iterate.
@@ -277,18 +278,19 @@ class Water(Load):
         # (they are made for the joint reactions only, :meth:`reaction_loads`)
         mv = self._moved
         H = self.geometry.h_matrix(ctx.kin)[0][mv]
-        F, zd = self._moved_load(ctx, H)
+        hull = None if self.hulls is None else self.hulls.loads(self.geometry, ctx.kin, ctx.t)
+        F, zd = self._moved_load(ctx, H, hull)
         tau = jnp.sum(H * F[:, None], axis=0)
         rhs = self.added_mass == "rhs" and ctx.qdd_guess is not None
         mass = None if rhs else se3.matmul_small(H, se3.matmul_small(self.A_inf[mv][:, mv], H),
                                                  transpose_x=True)
-        return LoadOutput(tau=tau, zd=zd, mass=mass)
+        return LoadOutput(tau=tau, zd=zd, mass=mass, extra=hull)
 
     def reaction_loads(self, ctx, out):
         # the whole −A∞ ξ̈ on the bodies: −A∞ Ḣq̇ and −A∞ H q̈ (with added_mass="rhs" the load
         # already holds −A∞ H q̈ of the recorded iterate)
         kin = ctx.kin
-        comps, _, _, _ = self._forces(ctx.t, kin, ctx.z, ctx.memory, self._all)
+        comps, _, _, _ = self._forces(ctx.t, kin, ctx.z, ctx.memory, self._all, out.extra)
         H, _, _ = self.geometry.h_matrix(kin)
         qdd = ctx.qdd_guess if out.mass is None else ctx.qdd
         F = sum(comps.values()) - self.A_inf @ (H @ qdd)
@@ -296,7 +298,7 @@ class Water(Load):
 
     def diagnostics(self, ctx, out):
         kin = ctx.kin
-        comps, _, v, hbias = self._forces(ctx.t, kin, ctx.z, ctx.memory, self._all)
+        comps, _, v, hbias = self._forces(ctx.t, kin, ctx.z, ctx.memory, self._all, out.extra)
         H, _, _ = self.geometry.h_matrix(kin)
         comps["added_mass"] = -(self.A_inf @ (H @ ctx.qdd + hbias))
         comps.pop("added_mass_bias")
