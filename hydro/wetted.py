@@ -39,8 +39,8 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
-# a vertex within this fraction of the panel's s-range of the surface counts as on it (no
-# division by ~0 when an edge runs along the surface)
+# an edge whose ends' s differ by no more than this runs along the surface: no crossing point on
+# it (no division by 0)
 _TINY = 1e-300
 
 
@@ -128,45 +128,27 @@ def check_hull(tri, *, what: str) -> None:
 
 
 # ------------------------------------------------------------------------------ the free surface
-def _phase(wave: WaveField, x, y, t):
-    """k (x cos β + y sin β) − ω t + φ at points (..., ) for every component: (..., J)."""
-    c, s = jnp.cos(wave.heading), jnp.sin(wave.heading)
-    return (wave.wavenumber * (x[..., None] * c + y[..., None] * s) - wave.omega * t
-            + wave.phase)
+def _phase_rows(wave, x, y, t):
+    """The components' phases k (x cos β + y sin β) − ω t + φ at points given as rows x, y
+    (..., n): (J, ..., n)."""
+    shape = (-1,) + (1,) * x.ndim
+    c, s = jnp.cos(wave.heading).reshape(shape), jnp.sin(wave.heading).reshape(shape)
+    return (wave.wavenumber.reshape(shape) * (x[None] * c + y[None] * s)
+            - (wave.omega * t - wave.phase).reshape(shape))
 
 
-def elevation(wave: WaveField, x, y, t):
-    """η(x, y, t) = Σ a cos(k(x cos β + y sin β) − ω t + φ) (m), at points of any shape."""
-    if wave.amplitude.shape[0] == 0:
-        return jnp.zeros(jnp.shape(x))
-    return jnp.sum(wave.amplitude * jnp.cos(_phase(wave, x, y, t)), axis=-1)
+def _stretched(z, eta, h):
+    """Wheeler's z_s: h (z − η)/(h + η), z − η in deep water (module docstring)."""
+    return z - eta if math.isinf(h) else h * (z - eta) / (h + eta)
 
 
-def pressure(wave: WaveField, points, t, *, rho: float, g: float):
-    """p (Pa) of the undisturbed flow at ``points`` (..., 3), inertial axes (z up, 0 at the mean
-    level): −ρ g z + ρ g Σ a f(z_s) cos(…), the decay f at the Wheeler-stretched z_s (module
-    docstring)."""
-    return -rho * g * points[..., 2] + wave_pressure(wave, points, t, rho=rho, g=g)
-
-
-def wave_pressure(wave: WaveField, points, t, *, rho: float, g: float):
-    """The incident wave's dynamic pressure ρ g Σ a f(z_s) cos(…) (Pa) at ``points`` (..., 3)."""
-    x, y, z = points[..., 0], points[..., 1], points[..., 2]
-    if wave.amplitude.shape[0] == 0:
-        return jnp.zeros_like(z)
-    th = _phase(wave, x, y, t)
-    eta = jnp.sum(wave.amplitude * jnp.cos(th), axis=-1)
-    h = wave.water_depth
-    k = wave.wavenumber
+def _decay(k, zs, h):
+    """cosh k(z_s + h)/cosh k h (e^{k z_s} in deep water) at z_s ≤ 0 (clipped to [−h, 0]),
+    without overflow: e^{k z_s} (1 + e^{−2k(z_s+h)})/(1 + e^{−2kh})."""
     if math.isinf(h):
-        zs = (z - eta)[..., None]
-        decay = jnp.exp(k * jnp.minimum(zs, 0.0))
-    else:
-        zs = (h * (z - eta) / (h + eta))[..., None]
-        # cosh k(z_s + h)/cosh k h without overflow: e^{k z_s} (1 + e^{−2k(z_s+h)})/(1 + e^{−2kh})
-        zc = jnp.clip(zs, -h, 0.0)
-        decay = jnp.exp(k * zc) * (1 + jnp.exp(-2 * k * (zc + h))) / (1 + jnp.exp(-2 * k * h))
-    return rho * g * jnp.sum(wave.amplitude * decay * jnp.cos(th), axis=-1)
+        return jnp.exp(k * jnp.minimum(zs, 0.0))
+    zc = jnp.clip(zs, -h, 0.0)
+    return jnp.exp(k * zc) * (1 + jnp.exp(-2 * k * (zc + h))) / (1 + jnp.exp(-2 * k * h))
 
 
 def particle_velocity(wave: WaveField, points, t):
@@ -177,30 +159,32 @@ def particle_velocity(wave: WaveField, points, t):
         θ = k (x cos β + y sin β) − ω t + φ,
 
     f_h = cosh k(z_s + h)/sinh k h, f_v = sinh k(z_s + h)/sinh k h (e^{k z_s} both in deep water),
-    at the Wheeler-stretched z_s of :func:`pressure`; 0 at a point above the instantaneous surface
+    at the Wheeler-stretched z_s of the pressure (module docstring); 0 at a point above the instantaneous surface
     (in air: a reference point on the mean level has flow under a crest, none under a trough,
     so its mean drag follows the wave, as the flow's mean above the troughs does; the surface's
     flow carried up to it would push it back under every trough)."""
     x, y, z = points[..., 0], points[..., 1], points[..., 2]
     if wave.amplitude.shape[0] == 0:
         return jnp.zeros(jnp.shape(points))
-    th = _phase(wave, x, y, t)
-    eta = jnp.sum(wave.amplitude * jnp.cos(th), axis=-1)
-    h, k = wave.water_depth, wave.wavenumber
+    th = _phase_rows(wave, x, y, t)                                        # (J, ...)
+    shape = (-1,) + (1,) * x.ndim
+    a, k = wave.amplitude.reshape(shape), wave.wavenumber.reshape(shape)
+    eta = jnp.sum(a * jnp.cos(th), axis=0)
+    h = wave.water_depth
+    zs = jnp.minimum(_stretched(z, eta, h), 0.0)
     if math.isinf(h):
-        zs = jnp.minimum(z - eta, 0.0)[..., None]
         fh = fv = jnp.exp(k * zs)
     else:
-        zs = jnp.clip(h * (z - eta) / (h + eta), -h, 0.0)[..., None]
         # cosh, sinh k(z_s + h)/sinh k h without overflow: e^{k z_s} (1 ± e^{−2k(z_s+h)})/(1 − e^{−2kh})
+        zs = jnp.clip(zs, -h, 0.0)
         e, d = jnp.exp(k * zs), 1 - jnp.exp(-2 * k * h)
         fh = e * (1 + jnp.exp(-2 * k * (zs + h))) / d
         fv = e * (1 - jnp.exp(-2 * k * (zs + h))) / d
-    aw = wave.amplitude * wave.omega
-    uh = jnp.sum(aw * fh * jnp.cos(th) * jnp.cos(wave.heading), axis=-1), \
-        jnp.sum(aw * fh * jnp.cos(th) * jnp.sin(wave.heading), axis=-1)
-    uz = jnp.sum(aw * fv * jnp.sin(th), axis=-1)
-    return jnp.where((z <= eta)[..., None], jnp.stack([uh[0], uh[1], uz], axis=-1), 0.0)
+    aw = a * wave.omega.reshape(shape)
+    u = jnp.stack([jnp.sum(aw * fh * jnp.cos(th) * jnp.cos(wave.heading).reshape(shape), axis=0),
+                   jnp.sum(aw * fh * jnp.cos(th) * jnp.sin(wave.heading).reshape(shape), axis=0),
+                   jnp.sum(aw * fv * jnp.sin(th), axis=0)], axis=-1)
+    return jnp.where((z <= eta)[..., None], u, 0.0)
 
 
 # ------------------------------------------------------------------------------------- the cut
@@ -212,33 +196,50 @@ def _norm(v):
     return jnp.where(pos, jnp.sqrt(jnp.where(pos, n2, 1.0)), 0.0)
 
 
-def _cut(P, s):
-    """The wet part (s < 0) of triangles P (n, 3, 3) with surface function s (n, 3) at their
-    vertices: two triangles each, (n, 2, 3, 3), and their weights (n, 2) in {0, 1} (0: absent).
-    Sub-triangles keep no orientation (the parent's normal is used)."""
-    order = jnp.argsort(s, axis=1)
-    s = jnp.take_along_axis(s, order, axis=1)
-    P = jnp.take_along_axis(P, order[..., None], axis=1)
-    v0, v1, v2 = P[:, 0], P[:, 1], P[:, 2]
-    s0, s1, s2 = s[:, 0:1], s[:, 1:2], s[:, 2:3]
+def _wet_pieces(V, S):
+    """The wet part (s < 0) of triangles given as rows, ``V`` their three vertices (3, n) each and
+    ``S`` the surface function s at them (n,) each: each triangle's at most two wet triangles
+    (module docstring) as their areas ``A`` (2, 1, n) (0 for an absent piece), every piece's edge
+    midpoints ``X`` (3, 6n) (piece, edge, triangle order: the quadrature's points) and the
+    parents' unit outward normals ``n_hat`` (3, n) (the pieces keep no orientation).
+
+    The vertex order comes from a three-comparator sorting network (element-wise: XLA vectorises
+    it, where a sort and gathers on (n, 3, 3) blocks cost 2.2 times the whole integral)."""
+    V, S = list(V), list(S)
+    area_n = 0.5 * _cross(V[1] - V[0], V[2] - V[0])                       # (3, n): A n̂
+    n_hat = area_n / _norm(area_n.T)[None]
+
+    def swap(i, j):
+        # a compare-swap of the sorting network: after it S[i] ≤ S[j]
+        c = S[j] < S[i]
+        V[i], V[j] = jnp.where(c, V[j], V[i]), jnp.where(c, V[i], V[j])
+        S[i], S[j] = jnp.where(c, S[j], S[i]), jnp.where(c, S[i], S[j])
+
+    swap(0, 1)
+    swap(1, 2)
+    swap(0, 1)
+    v0, v1, v2 = V
+    s0, s1, s2 = S
 
     def point(va, sa, vb, sb):
         # where s crosses 0 on the edge a→b; a safe denominator where the edge does not cross
         d = sa - sb
         ok = jnp.abs(d) > _TINY
-        f = jnp.clip(sa / jnp.where(ok, d, 1.0), 0.0, 1.0)
-        return va + jnp.where(ok, f, 0.0) * (vb - va)
+        f = jnp.where(ok, jnp.clip(sa / jnp.where(ok, d, 1.0), 0.0, 1.0), 0.0)
+        return va + f * (vb - va)
 
     p01, p02, p12 = point(v0, s0, v1, s1), point(v0, s0, v2, s2), point(v1, s1, v2, s2)
     one = (s0 < 0) & (s1 >= 0)            # one vertex wet: a triangle
     two = (s1 < 0) & (s2 >= 0)            # two wet: a quadrilateral, two triangles
     all3 = s2 < 0
-    first = jnp.where(one[..., None], jnp.stack([v0, p01, p02], 1),
-                      jnp.where(two[..., None], jnp.stack([v0, v1, p12], 1),
-                                jnp.stack([v0, v1, v2], 1)))
-    second = jnp.stack([v0, p12, p02], 1)
-    w = jnp.concatenate([(one | two | all3).astype(P.dtype), two.astype(P.dtype)], axis=1)
-    return jnp.stack([first, second], axis=1), w
+    first = (v0, jnp.where(one, p01, v1), jnp.where(one, p02, jnp.where(two, p12, v2)))
+    second = (v0, p12, p02)
+    weights = ((one | two | all3).astype(v0.dtype), two.astype(v0.dtype))
+    areas, mids = [], []
+    for (a, b, c), wk in zip((first, second), weights):
+        areas.append(0.5 * _norm(_cross(b - a, c - a).T) * wk)             # (n,)
+        mids.extend(((a + b) / 2, (b + c) / 2, (c + a) / 2))
+    return jnp.stack(areas)[:, None], jnp.concatenate(mids, axis=1), n_hat
 
 
 def pressure_loads(tri_body, rotation, origin, ref, wave: WaveField, t, *, rho: float, g: float,
@@ -282,14 +283,6 @@ def _kept(x):
     return x.reshape(-1)[perm][np.argsort(perm)].reshape(x.shape)
 
 
-def _phase_rows(wave, x, y, t):
-    """The components' phases at points given as rows x, y (..., n): (J, ..., n)."""
-    shape = (-1,) + (1,) * x.ndim
-    c, s = jnp.cos(wave.heading).reshape(shape), jnp.sin(wave.heading).reshape(shape)
-    return (wave.wavenumber.reshape(shape) * (x[None] * c + y[None] * s)
-            - (wave.omega * t - wave.phase).reshape(shape))
-
-
 def pressure_loads_rows(T, rotation, origin, ref, wave: WaveField, t, *, rho: float, g: float):
     """(hydrostatic, Froude–Krylov) loads (6,) each of :func:`pressure_loads`, the triangles as
     rows ``T`` (3, 3, n) (:func:`soa`): the time step's form.
@@ -299,62 +292,22 @@ def pressure_loads_rows(T, rotation, origin, ref, wave: WaveField, t, *, rho: fl
     one reduction at the end: 2.2 times faster than a sort and gathers on (n, 3, 3) blocks
     (benchmarks/RESULTS.md, issue 53)."""
     V = [origin[:, None] + rotation @ T[i] for i in range(3)]              # 3 × (3, n)
-    area_n = 0.5 * _cross(V[1] - V[0], V[2] - V[0])                       # (3, n): A n̂
-    n_hat = area_n / _norm(area_n.T)[None]
     z = jnp.stack([v[2] for v in V])                                      # (3, n)
     J = wave.amplitude.shape[0]
     if J:
         th = _phase_rows(wave, jnp.stack([v[0] for v in V]), jnp.stack([v[1] for v in V]), t)
         z = _kept(z - jnp.sum(wave.amplitude[:, None, None] * jnp.cos(th), axis=0))
-    S = [z[0], z[1], z[2]]
-
-    def swap(i, j):
-        # a compare-swap of the sorting network: after it S[i] ≤ S[j]
-        c = S[j] < S[i]
-        V[i], V[j] = jnp.where(c, V[j], V[i]), jnp.where(c, V[i], V[j])
-        S[i], S[j] = jnp.where(c, S[j], S[i]), jnp.where(c, S[i], S[j])
-
-    swap(0, 1)
-    swap(1, 2)
-    swap(0, 1)
-    v0, v1, v2 = V
-    s0, s1, s2 = S
-
-    def point(va, sa, vb, sb):
-        # where s crosses 0 on the edge a→b; a safe denominator where the edge does not cross
-        d = sa - sb
-        ok = jnp.abs(d) > _TINY
-        f = jnp.where(ok, jnp.clip(sa / jnp.where(ok, d, 1.0), 0.0, 1.0), 0.0)
-        return va + f * (vb - va)
-
-    p01, p02, p12 = point(v0, s0, v1, s1), point(v0, s0, v2, s2), point(v1, s1, v2, s2)
-    one = (s0 < 0) & (s1 >= 0)            # one vertex wet: a triangle
-    two = (s1 < 0) & (s2 >= 0)            # two wet: a quadrilateral, two triangles
-    all3 = s2 < 0
-    first = (v0, jnp.where(one, p01, v1), jnp.where(one, p02, jnp.where(two, p12, v2)))
-    second = (v0, p12, p02)
-    weights = ((one | two | all3).astype(v0.dtype), two.astype(v0.dtype))
-    areas, mids = [], []
-    for (a, b, c), wk in zip((first, second), weights):
-        areas.append(0.5 * _norm(_cross(b - a, c - a).T) * wk)             # (n,)
-        mids.extend(((a + b) / 2, (b + c) / 2, (c + a) / 2))
-    n = v0.shape[1]
-    X = jnp.concatenate(mids, axis=1)                                     # (3, 6n)
+    A, X, n_hat = _wet_pieces(V, [z[0], z[1], z[2]])
+    n = n_hat.shape[1]
     hs = -rho * g * X[2]
     if J:
         cos = jnp.cos(_phase_rows(wave, X[0], X[1], t))                    # (J, 6n)
         a, k = wave.amplitude[:, None], wave.wavenumber[:, None]
         eta = jnp.sum(a * cos, axis=0)
-        h = wave.water_depth
-        if math.isinf(h):
-            decay = jnp.exp(k * jnp.minimum(X[2] - eta, 0.0)[None])
-        else:
-            zc = jnp.clip(h * (X[2] - eta) / (h + eta), -h, 0.0)[None]
-            decay = jnp.exp(k * zc) * (1 + jnp.exp(-2 * k * (zc + h))) / (1 + jnp.exp(-2 * k * h))
+        decay = _decay(k, _stretched(X[2], eta, wave.water_depth)[None], wave.water_depth)
         dyn = _kept(rho * g * jnp.sum(a * decay * cos, axis=0))
     else:
         dyn = jnp.zeros_like(hs)
-    A = jnp.stack(areas)[:, None]                                          # (2, 1, n)
     Xr = (X - ref[:, None]).reshape(3, 2, 3, n)
 
     def contributions(p):
@@ -380,31 +333,21 @@ def froude_krylov_linear(tri, ref, wavenumber, heading, *, water_depth: float, r
     tri: (n, 3, 3) the closed hull at rest, inertial axes. Numpy (made once per run on the
     host): what the nonlinear level takes out of the database's excitation, leaving the
     diffraction, so that in small waves its total is the database's."""
-    T = np.asarray(tri, float)
-    P, s = jnp.asarray(T), jnp.asarray(T[..., 2])
-    pieces, w = _cut(P, s)
-    pieces, w = np.asarray(pieces), np.asarray(w)
-    a, b, c = pieces[..., 0, :], pieces[..., 1, :], pieces[..., 2, :]
-    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=-1) * w          # (n, 2)
-    area_n = 0.5 * np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0])
-    n_hat = area_n / np.linalg.norm(area_n, axis=1, keepdims=True)
-    mids = np.stack([(a + b) / 2, (b + c) / 2, (c + a) / 2], axis=-2)        # (n, 2, 3, 3)
-    keep = area > 0
-    m, A = mids[keep], area[keep]                                             # (p, 3, 3), (p,)
-    nh = np.broadcast_to(n_hat[:, None], area.shape + (3,))[keep]             # (p, 3)
-    k = np.asarray(wavenumber, float)[:, None, None]
-    beta = np.asarray(heading, float)[:, None, None]
-    z = np.minimum(m[None, ..., 2], 0.0)
-    if math.isinf(water_depth):
-        decay = np.exp(k * z)
-    else:
-        h = float(water_depth)
-        decay = np.exp(k * z) * (1 + np.exp(-2 * k * (z + h))) / (1 + np.exp(-2 * k * h))
-    p = rho * g * decay * np.exp(1j * k * (m[None, ..., 0] * np.cos(beta) + m[None, ..., 1] * np.sin(beta)))
-    Ip = np.einsum("p,jpq->jp", A, p) / 3.0                                   # (J, p)
-    Ixp = np.einsum("p,jpq,pqi->jpi", A, p, m - np.asarray(ref, float)) / 3.0
-    F = -np.einsum("jp,pi->ji", Ip, nh)
-    M = -np.cross(Ixp, nh[None]).sum(axis=1)
+    R = np.transpose(np.asarray(tri, float), (1, 2, 0))                     # (3, 3, n)
+    A, X, n_hat = (np.asarray(x) for x in _wet_pieces([R[0], R[1], R[2]], [R[0][2], R[1][2],
+                                                                           R[2][2]]))
+    n = n_hat.shape[1]
+    k = np.asarray(wavenumber, float)[:, None]
+    beta = np.asarray(heading, float)[:, None]
+    decay = np.asarray(_decay(k, np.minimum(X[2], 0.0)[None], water_depth))   # (J, 6n)
+    p = rho * g * decay * np.exp(1j * k * (X[0][None] * np.cos(beta) + X[1][None] * np.sin(beta)))
+    # the edge-midpoint rule on each piece, then the triangles' sums (as pressure_loads_rows)
+    p = p.reshape(-1, 2, 3, n)
+    Ip = np.sum(A[None] * p, axis=(1, 2)) / 3                                 # (J, n)
+    Xr = (X - np.asarray(ref, float)[:, None]).reshape(3, 2, 3, n)
+    Ixp = np.sum(A[None, None] * p[:, None] * Xr[None], axis=(2, 3)) / 3      # (J, 3, n)
+    F = -np.einsum("jn,in->ji", Ip, n_hat)
+    M = -np.cross(Ixp, n_hat[None], axis=1).sum(axis=2)
     return np.concatenate([F, M], axis=1)
 
 
@@ -415,20 +358,15 @@ def submerged_volume(tri_body, rotation, origin):
     :func:`pressure_loads`."""
     zero = jnp.zeros(3)
     F, M = pressure_loads(tri_body, rotation, origin, zero, still_water(), 0.0, rho=1.0, g=1.0)
-    V = F[2]
-    xb, yb = -M[1] / V, M[0] / V
+    vol = F[2]
+    xb, yb = -M[1] / vol, M[0] / vol
     # z_B: ∫_wet z dV = ½ ∫ z² n_z dA over the wet hull (the cut plane z = 0 adds nothing)
-    P = origin + jnp.einsum("ij,ntj->nti", rotation, tri_body)
-    s = P[..., 2]
-    pieces, w = _cut(P, s)
-    a, b, c = pieces[..., 0, :], pieces[..., 1, :], pieces[..., 2, :]
-    area = 0.5 * _norm(jnp.cross(b - a, c - a)) * w
-    area_n = 0.5 * jnp.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
-    nz = area_n[:, 2] / jnp.linalg.norm(area_n, axis=1)
-    mids = jnp.stack([(a + b) / 2, (b + c) / 2, (c + a) / 2], axis=-2)
-    Iz2 = jnp.sum(area * jnp.mean(mids[..., 2] ** 2, axis=-1), axis=1)
-    zb = 0.5 * jnp.sum(Iz2 * nz) / V
-    return V, jnp.stack([xb, yb, zb])
+    T = soa(tri_body)
+    V = [origin[:, None] + rotation @ T[i] for i in range(3)]
+    A, X, n_hat = _wet_pieces(V, [v[2] for v in V])
+    Iz2 = jnp.sum(A * (X[2] ** 2).reshape(2, 3, -1), axis=(0, 1)) / 3        # ∫ z² dA, (n,)
+    zb = 0.5 * jnp.sum(Iz2 * n_hat[2]) / vol
+    return vol, jnp.stack([xb, yb, zb])
 
 
 # ------------------------------------------------------------------------------------ hulls

@@ -504,6 +504,25 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
                  grid_m=int(m), moving=spec.moving, hulls=hulls, flow=flow)
 
 
+# the attributes that put a spec above linear potential flow (set by load_hydro_spec only when
+# asked, so that every other spec keeps its content key)
+ABOVE_LINEAR = ("hulls", "hydrostatics", "drag_flow")
+
+
+def linear_spec(spec):
+    """A copy of ``spec`` with the linear water (no hulls, drag on the body's velocity): the same
+    database, bodies and options, its own cache holding what ``spec`` has made (the radiation's
+    fits and kernels, the same for both) but not its replaced copies (those carry the hulls)."""
+    import copy
+
+    out = copy.copy(spec)
+    for name in ABOVE_LINEAR:
+        out.__dict__.pop(name, None)
+    out._cache = {k: v for k, v in spec._cache.items()
+                  if not (isinstance(k, tuple) and k and k[0] == "replace")}
+    return out
+
+
 def relative_drag(spec) -> bool:
     """Whether the spec's drag acts on the velocity relative to the flow (``[hydro] drag_flow``)."""
     return getattr(spec, "drag_flow", "body") == "relative"

@@ -69,19 +69,15 @@ def linear_water(model: Model) -> Model:
     """``model`` with the linear water: its spec without the nonlinear level's hulls and with
     drag on the body's velocity (the same database, bodies and options; the radiation's fits and
     kernels shared, as they do not depend on either)."""
-    import copy
     import dataclasses
+
+    from ..loads.water import linear_spec
 
     if not above_linear(model):
         return model
-    spec = copy.copy(model.hydro)
-    for name in ("hulls", "hydrostatics", "drag_flow"):
-        spec.__dict__.pop(name, None)
-    # its own cache, holding what the given spec has made (fits, kernels: the radiation's, the
-    # same for both) but not its replaced copies (those carry the hulls)
-    spec._cache = {k: v for k, v in model.hydro._cache.items()
-                   if not (isinstance(k, tuple) and k and k[0] == "replace")}
-    return dataclasses.replace(model, hydro=spec)
+    return dataclasses.replace(model, hydro=linear_spec(model.hydro))
+
+
 # the within-level options reduce can pilot: name -> the HydroSpec options of the variant
 OPTIONS = {"body_coupling": {"body_coupling": False}}
 
