@@ -326,3 +326,27 @@ def test_names_and_g(tmp_path):
     d1025 = open_any_database(SPHERE_H5, rho=1025.0)
     d1000 = open_any_database(SPHERE_H5)
     np.testing.assert_allclose(d1025.added_mass.values, 1.025 * d1000.added_mass.values, rtol=1e-14)
+
+
+def test_headings_round_trip_in_degrees(tmp_path):
+    """Three headings, each with its own excitation (the sphere's × 1, × 2i, × 3): written in
+    degrees at /simulation_parameters/wave_dir, the excitation (dof, heading, ω) as BEMIO orders it,
+    read back at the same headings in radians within 1e-12."""
+    import xarray as xr
+
+    db = open_any_database(SPHERE_H5)
+    beta = np.deg2rad([0.0, 30.0, 90.0])
+    ex = xr.concat([db.excitation * f for f in (1.0, 2.0j, 3.0)], dim="wave_direction")
+    db = db.drop_vars(["excitation", "wave_direction"]).assign_coords(wave_direction=beta)
+    db["excitation"] = ex.assign_coords(wave_direction=beta).transpose(
+        "omega", "wave_direction", "influenced_dof")
+    out = bemio.write_bemio(db, tmp_path / "three.h5")
+    with _open(out) as nc:
+        np.testing.assert_allclose(nc["simulation_parameters/wave_dir"][...].ravel(), [0, 30, 90])
+        im = np.array(nc["body1/hydro_coeffs/excitation/im"][...])
+    # BEMIO's e^{+iωt}: im = −Im(X)/(ρg); heading 1 is the sphere's × 2i
+    x = db.excitation.values
+    np.testing.assert_allclose(im[2, 1], -(x[:, 1, 2] / (RHO * 9.81)).imag, rtol=1e-12)
+    back = open_any_database(out)
+    np.testing.assert_allclose(back.wave_direction.values, beta, rtol=1e-14)
+    assert np.abs(back.excitation.values - x).max() <= 1e-12 * np.abs(x).max()
