@@ -180,7 +180,12 @@ def build_parser():
     p = sub.add_parser("hydro", help="generate the config's hydro database with capytaine "
                        "(the 'bem' extra: pip install -e \".[bem]\")")
     p.add_argument("config")
-    p.add_argument("--out", help="NetCDF path (default: the config's [hydro] database)")
+    p.add_argument("--out", help="NetCDF path (default: the config's [hydro] database); with "
+                   "--format bemio, the .h5 path (default: out/<config name>.h5)")
+    p.add_argument("--format", choices=["netcdf", "bemio"], default="netcdf",
+                   help="netcdf (default): the config's database; bemio: also write it as a BEMIO "
+                   "HDF5 file for WEC-Sim and SEA-Stack (a config without [hydro.bem] has its "
+                   "database, e.g. WAMIT's, converted without a solve)")
     p.add_argument("--force", action="store_true", help="solve again even if up to date")
     p.add_argument("--threads", type=_count(1), help="threads per BEM solve (default: all cores)")
     p.set_defaults(func="cmd_hydro")

@@ -29,6 +29,9 @@ from hydro.database import (  # noqa: E402,F401
     write_netcdf,
 )
 from hydro.wamit import read_wamit  # noqa: E402,F401
+# BEMIO HDF5 (WEC-Sim's and SEA-Stack's files): read and written (netCDF4 imported when used)
+from hydro import bemio  # noqa: E402,F401
+from hydro.bemio import read_bemio, write_bemio  # noqa: E402,F401
 from hydro.radiation import (  # noqa: E402,F401
     added_mass_from_irf, check_grid, damping_from_irf, impulse_response, memory_length,
 )

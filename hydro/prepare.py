@@ -473,17 +473,20 @@ def _open_any(path, *, names=None, rho=None, g=None) -> xr.Dataset:
     - a NEMOH run: its folder, its ``Nemoh.cal`` or its ``Results/`` (:func:`hydro.nemoh.read_nemoh`,
       v2 and v3);
     - WAMIT output: the ``.out`` (or ``.1``/``.3``/``.hst``, or the stem) of a run with its
-      ``.1``/``.3``/``.hst`` beside it (:func:`hydro.wamit.read_wamit`).
+      ``.1``/``.3``/``.hst`` beside it (:func:`hydro.wamit.read_wamit`);
+    - a BEMIO HDF5 file, ``.h5`` (WEC-Sim's and SEA-Stack's; :func:`hydro.bemio.read_bemio`).
 
     `names`: the bodies in the file's order (WAMIT, NEMOH: their names; another capytaine's file:
-    renames them; ignored for the project's own files, whose names are the config's). `rho`, `g`: WAMIT's scaling (as :func:`hydro.wamit.read_wamit` takes
+    renames them; ignored for the project's own files, whose names are the config's). `rho`, `g`: WAMIT's and BEMIO's scaling (as :func:`hydro.wamit.read_wamit` takes
     them); for NEMOH and other capytaine files (dimensional) they must equal the file's, or the
     call is refused. A
     NetCDF file is read once, whole (:func:`read_netcdf`): safe while the process holds it open.
     """
-    from . import formats, nemoh
+    from . import bemio, formats, nemoh
 
     path = Path(path)
+    if bemio.is_bemio(path):
+        return bemio.read_bemio(path, body_names=names, rho=rho, g=g)
     if path.suffix == ".nc":
         if not path.exists():
             raise FileNotFoundError(f"hydro.database: {str(path)!r} not found; generate it with "
@@ -503,14 +506,15 @@ def _open_any(path, *, names=None, rho=None, g=None) -> xr.Dataset:
         if nemoh.is_nemoh(path):
             return nemoh.read_nemoh(nemoh.find_nemoh_cal(path), body_names=names, rho=rho, g=g)
         raise FileNotFoundError(f"hydro.database: {str(path)!r} is a folder without a Nemoh.cal; "
-                                "accepted: a NetCDF database (.nc), a NEMOH run (its folder or "
-                                "Nemoh.cal) or a WAMIT .out/.1/.3/.hst set")
+                                "accepted: a NetCDF database (.nc), a BEMIO file (.h5), a NEMOH run "
+                                "(its folder or Nemoh.cal) or a WAMIT .out/.1/.3/.hst set")
 
     stem = path.with_suffix("") if path.suffix in (".out", ".1", ".3", ".hst") else path
     if not stem.with_suffix(".out").exists():
         raise FileNotFoundError(f"hydro.database: {str(path)!r}: no WAMIT output {stem}.out and not "
                                 "a .nc file or a NEMOH run; accepted: a NetCDF database (.nc), a "
-                                "NEMOH run (its folder or Nemoh.cal) or a WAMIT .out/.1/.3/.hst set")
+                                "BEMIO file (.h5), a NEMOH run (its folder or Nemoh.cal) or a WAMIT "
+                                ".out/.1/.3/.hst set")
     kw = {}
     if rho is not None:
         kw["rho"] = float(rho)

@@ -12,6 +12,12 @@ writes a subset of their frequencies, the files otherwise byte for byte as the s
 - capytaine NetCDF: the same subset along ``omega`` (xarray isel), written back with the
   file's own variables, dims (the leading ``complex`` dim), coordinates and attributes; the
   hydrostatics files (KH_*.dat, Hydrostatics_*.dat) beside it copied unchanged.
+- a BEMIO HDF5 file (``--bemio-h5 FILE``: the public sphere.h5 of NREL/HydroChrono, the same bytes
+  as SEA-Stack's iea_sphere one): :func:`cut_bemio_h5`, every STEP-th frequency, each dataset's
+  values verbatim at its path with its description/units; the python-BEMIO ``components`` copies,
+  the impulse responses and the state-space fit left out (derived data the reader ignores). The
+  full file's dataset paths and shapes go to ``sphere_layout.json`` beside it (the layout the
+  writer is checked against). HDF5 is written through netCDF4 (hydro.bemio's writer of datasets).
 """
 from __future__ import annotations
 
@@ -94,13 +100,62 @@ def cut_capytaine(root: Path, out: Path):
                 shutil.copyfile(f, dst / f.name)
 
 
+BEMIO_STEP = 10                                     # 240 frequencies 0.05 … 12 → 24, 0.05 … 11.55
+BEMIO_SKIP = ("components", "impulse_response_fun", "state_space")
+
+
+def _h5_walk(g, prefix=""):
+    """(path, netCDF4 variable) of every dataset under the group `g`, groups in file order."""
+    for name, v in g.variables.items():
+        yield f"{prefix}/{name}", v
+    for name, sub in g.groups.items():
+        yield from _h5_walk(sub, f"{prefix}/{name}")
+
+
+def cut_bemio_h5(src: Path, dst: Path, step: int):
+    """Every `step`-th frequency of the BEMIO file `src` into `dst` (module docstring), and the
+    layout of `src` (every dataset's path and shape) into ``<dst stem>_layout.json``."""
+    import json
+
+    import netCDF4
+
+    from hydro.bemio import _Writer
+
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    with netCDF4.Dataset("src.h5", mode="r", memory=Path(src).read_bytes()) as nc:
+        nc.set_auto_mask(False)
+        layout = {p: list(v.shape) for p, v in _h5_walk(nc)}
+        nw = nc["simulation_parameters/w"].shape[0]
+        with netCDF4.Dataset(dst, "w", format="NETCDF4") as out:
+            w = _Writer(out)
+            for p, v in _h5_walk(nc):
+                if any(part in BEMIO_SKIP for part in p.split("/")):
+                    continue
+                a = v[...]
+                if isinstance(a, str) or (isinstance(a, np.ndarray) and a.dtype.kind in "OSU"):
+                    w.text(p, a if isinstance(a, str) else str(np.asarray(a).ravel()[0]))
+                    continue
+                a = np.asarray(a)
+                if p in ("/simulation_parameters/w", "/simulation_parameters/T"):
+                    a = a[::step]                    # (N_ω, 1)
+                elif a.ndim == 3 and a.shape[-1] == nw:
+                    a = a[..., ::step]               # (dof, dof or heading, N_ω)
+                attrs = {k: v.getncattr(k) for k in v.ncattrs()}
+                w.array(p, a, attrs.get("description", ""), attrs.get("units", ""))
+    lines = [f"{json.dumps(p)}: {json.dumps(shape)}" for p, shape in layout.items()]
+    dst.with_name(dst.stem + "_layout.json").write_text("{\n" + ",\n".join(lines) + "\n}\n")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("wecsim", type=Path)
     ap.add_argument("--out", type=Path, default=Path("tests/data/bemio"))
+    ap.add_argument("--bemio-h5", type=Path, help="a public BEMIO .h5 (HydroChrono's sphere.h5)")
     a = ap.parse_args()
     cut_nemoh(a.wecsim, a.out)
     cut_capytaine(a.wecsim, a.out)
+    if a.bemio_h5 is not None:
+        cut_bemio_h5(a.bemio_h5, a.out / "bemio_h5" / "sphere.h5", BEMIO_STEP)
 
 
 if __name__ == "__main__":

@@ -8,6 +8,7 @@ itself.
 from __future__ import annotations
 
 import math
+import os
 import re
 import sys
 import time
@@ -584,8 +585,33 @@ def cmd_rao(args):
 
 
 def cmd_hydro(args):
+    """``mfm hydro CONFIG``: solve the config's hulls into its NetCDF database (capytaine).
+    ``--format bemio``: write the config's database as a BEMIO HDF5 file (WEC-Sim's and
+    SEA-Stack's, :func:`hydro.bemio.write_bemio`) at ``--out`` (default ``out/<config>.h5``): a
+    config with ``[hydro.bem]`` gets its NetCDF database made (or kept when up to date) first; any
+    other config's database (WAMIT, NEMOH, a .nc, a .h5) is converted as it is read."""
+    if getattr(args, "format", "netcdf") != "bemio":
+        generate(args.config, out=args.out, force=args.force, n_threads=args.threads)
+        return
+    from hydro.bemio import solver_code, write_bemio
+    from hydro.prepare import open_any_database
 
-    generate(args.config, out=args.out, force=args.force, n_threads=args.threads)
+    config = Path(args.config)
+    out = _writable(args.out or Path("out") / (config.stem + ".h5"), "--out", (".h5",))
+    options, _ = load_config(config)
+    hydro = options.get("hydro")
+    if hydro is None:
+        raise ValueError(f"{config}: no [hydro] table, so no database to write as BEMIO; add "
+                         "[hydro] database = \"<file>\" (relative to the config)")
+    if hydro.get("bem") is not None:
+        source = generate(config, force=args.force, n_threads=args.threads)
+    else:
+        source = Path(hydro["database"])
+        source = source if source.is_absolute() else Path(os.path.normpath(config.parent / source))
+    db = open_any_database(source, names=hydro.get("names"), rho=hydro.get("rho"), g=hydro.get("g"))
+    write_bemio(db, out, code=solver_code(db))
+    print(f"mfm hydro: {out}: BEMIO HDF5 of {source} ({db.sizes['body']} bodies, "
+          f"{db.sizes['omega']} frequencies, {db.sizes['wave_direction']} headings)")
 
 
 def cmd_fits(args):
