@@ -121,3 +121,16 @@ def switched_off(setting: str | None) -> bool:
     return (setting or "").strip().lower() in OFF_VALUES
 
 
+
+
+def device_array(x, dtype=None):
+    """``x`` (numbers, a list or a numpy array) as a jax array of its numpy dtype (or ``dtype``),
+    put on the device as it is: ``jax.device_put(np.asarray(x, dtype))``. The same values and
+    dtype as ``jnp.asarray(x)`` under x64, without its conversion program: jax 0.10 compiles a
+    small program (``jit(stage)``, or ``broadcast_in_dim`` for ``jnp.zeros``) per new shape,
+    ~15 ms of CPU each, dozens in a first answer, none kept by the compilation cache (too small
+    to be worth it). Host code that hands numpy data to the core uses this."""
+    import jax
+    import numpy as np
+
+    return jax.device_put(np.asarray(x) if dtype is None else np.asarray(x, dtype))

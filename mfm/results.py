@@ -354,7 +354,7 @@ def frequency(model, loads, omega, x, q0, kin0, heading, settings, extra,
     """The dataset of :func:`mfm.frequency_response` from the coordinate amplitudes x (n_ω, n_q);
     ``reactions`` (static, amplitudes) of the joints (:func:`add_joint_reactions`)."""
     Bm = np.asarray(kin0.B)
-    R = np.asarray(kin0.E[:, :3, :3])
+    R = np.asarray(kin0.E)[:, :3, :3]         # sliced on the host (eager: a program each)
     body = np.concatenate([np.einsum("nai,wi->wna", Bm[:, :3], x),
                            np.einsum("nab,nbi,wi->wna", R, Bm[:, 3:], x)], axis=2)
     damped = damped_coordinates(model.damping)

@@ -165,8 +165,10 @@ def test_a_load_imports_only_the_mechanics_and_the_load_protocol():
             bad = {d for d in deps if d.startswith("mfm") and not d.startswith(allowed)}
             assert not bad, f"{m} imports {sorted(bad)}"
     # and the runner builds the water beside the config's loads: loads only, and the checks
+    # (and mfm.backend, the leaf that puts host arrays on the device)
     assert {d for d in graph["mfm.loads.assembly"] if d.startswith("mfm")} <= {
-        "mfm.loads.base", "mfm.loads.water", "mfm.loads.radiation", "mfm.validation"}
+        "mfm.loads.base", "mfm.loads.water", "mfm.loads.radiation", "mfm.validation",
+        "mfm.backend"}
 
 
 def test_model_type_does_not_build():

@@ -31,6 +31,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .. import host
+from ..backend import device_array
 from ..loads.assembly import (RK4_STAGE_OFFSETS, applied_loads, as_loads, carried_loads,
                               compile_view)
 from ..mechanics.dynamics import gravity_loads, joint_loads, mass_matrix
@@ -157,12 +158,15 @@ def equilibrium(model: Model, q_guess=None, *, loads=None, tol: float = 1e-10, m
 
 def _equilibrium(model, loads, q_guess=None, tol=1e-10, max_iter=50):
     keyed, static, mems = _static_functions(model, loads)
-    q = jnp.zeros(model.n_coordinates) if q_guess is None else jnp.asarray(q_guess, jnp.float64)
+    # the iterate on the host, put on the device from numpy (eager jnp would compile a small
+    # program for each operation in every first call); the same IEEE arithmetic
+    q = device_array(np.zeros(model.n_coordinates) if q_guess is None
+                     else np.asarray(q_guess, np.float64))
     at_q = _jet_program(keyed, static, mems, q)
     jet_at = lambda q: at_q(keyed, static, mems, q)  # noqa: E731
     # the size of the loads that must balance: generalised weights, or the largest weight
-    scale = max(float(jnp.max(jnp.abs(jet_at(q).weights))),
-                float(jnp.max(model.mass)) * float(model.gravity))
+    scale = max(float(np.max(np.abs(np.asarray(jet_at(q).weights)))),
+                float(np.max(np.asarray(model.mass))) * float(model.gravity))
     it = 0
     q_ok = q
     for it in range(max_iter):
@@ -175,7 +179,7 @@ def _equilibrium(model, loads, q_guess=None, tol=1e-10, max_iter=50):
             break
         J = np.asarray(at.dQ_dq)
         step = np.linalg.lstsq(J, -g, rcond=1e-10)[0]
-        q = q + jnp.asarray(step)
+        q = device_array(np.asarray(q) + step)
     at = jet_at(q)
     g = np.asarray(at.Q)
     if not np.isfinite(g).all():

@@ -16,6 +16,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..backend import device_array
 from ..validation import check_sea
 from .base import Context, Load, RunGrid
 from .water import build_water, build_water_batch
@@ -205,6 +206,14 @@ def as_loads(loads) -> tuple[Load, ...]:
         if not isinstance(ld, Load):
             raise TypeError(f"loads: {ld!r} is not an mfm.loads.Load")
     return loads
+
+
+def initial_states(model, loads: Sequence[Load]):
+    """z₀ (Σ n_states,): each load's :meth:`~mfm.loads.base.Load.initial_state` end to end, put
+    on the device from numpy (:func:`mfm.backend.device_array`: eager ``jnp.concatenate`` and
+    ``jnp.zeros`` would each compile a small program in every first run)."""
+    parts = [np.asarray(ld.initial_state(model), dtype=np.float64) for ld in loads]
+    return device_array(np.concatenate(parts) if parts else np.zeros(0))
 
 
 def state_offsets(loads: Sequence[Load]) -> np.ndarray:

@@ -26,6 +26,9 @@ from typing import Any, ClassVar, NamedTuple
 
 import equinox as eqx
 import jax.numpy as jnp
+import numpy as np
+
+from ..backend import device_array
 
 # the six modes of a body point (its hydro dofs): translations then rotations, inertial axes
 MODES = ("surge", "sway", "heave", "roll", "pitch", "yaw")
@@ -162,7 +165,7 @@ class Load(eqx.Module):
         return 0
 
     def initial_state(self, model) -> jnp.ndarray:
-        return jnp.zeros(self.n_states)
+        return device_array(np.zeros(self.n_states))
 
     def init_memory(self, model, t0, q0, qd0, dt):
         """Discrete memory at the start of a run (default: none)."""

@@ -21,6 +21,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..validation import body_ref, number, tables
+from ..backend import device_array
 from ..mechanics.points import BodyPoints
 from ..errors import ConfigError
 from .base import MODES, Load, LoadOutput
@@ -129,8 +130,8 @@ class LinearBodyMatrix(Load):
         ratios = tuple((p, t["body"], mode, float(ratio), tuple(float(x) for x in pts[p]))
                        for p, t in enumerate(parsed) for mode, ratio in t["ratios"].items())
         return cls(points=BodyPoints.on_bodies(model.com, idx, pts),
-                   stiffness=jnp.asarray(np.stack([t["stiffness"] for t in parsed])),
-                   damping=jnp.asarray(np.stack([t["damping"] for t in parsed])),
+                   stiffness=device_array(np.stack([t["stiffness"] for t in parsed])),
+                   damping=device_array(np.stack([t["damping"] for t in parsed])),
                    names=tuple(t["name"] for t in parsed), damping_ratios=ratios)
 
     def with_damping(self, p: int, mode: str, c: float) -> "LinearBodyMatrix":

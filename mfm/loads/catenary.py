@@ -72,6 +72,7 @@ from ..mechanics.points import BodyPoints
 from ..errors import ConfigError
 from .base import Load, LoadOutput
 from .. import host
+from ..backend import device_array
 from .catenary_tables import make_table, moorpy_version, table_centre
 
 LINE_KEYS = {"length", "weight", "mass_per_length", "EA", "seabed_friction"}
@@ -217,7 +218,7 @@ class CatenaryLines(Load):
         parts = []
         for k, name in enumerate(self.names):
             ln = dict(self.lines[k])
-            nx, nz = (int(a) for a in np.asarray(self.n[k]))
+            nx, nz = (int(a) for a in np.asarray(self.n)[k])
             parts.append(f"{name}: x {ln['x_lo']:.6g}..{ln['x_hi']:.6g} m ({nx}), "
                          f"z {ln['z_lo']:.6g}..{ln['z_hi']:.6g} m ({nz})")
         lin = {}
@@ -395,8 +396,9 @@ class CatenaryLines(Load):
             padded[k, :c.shape[0], :c.shape[1]] = c
         return cls(fairleads=BodyPoints.on_bodies(model.com, [model.body_index(t["body"]) for t in parsed],
                                                   [t["fairlead"] for t in parsed]),
-                   anchors=jnp.asarray(np.stack([t["anchor"] for t in parsed])),
-                   coef=jnp.asarray(padded), n=jnp.asarray(n), lo=jnp.asarray(np.array(lo)), step=jnp.asarray(np.array(step)),
+                   anchors=device_array(np.stack([t["anchor"] for t in parsed])),
+                   coef=device_array(padded), n=device_array(n), lo=device_array(np.array(lo)),
+                   step=device_array(np.array(step)),
                    names=tuple(t["name"] for t in parsed), lines=tuple(lines))
 
 

@@ -11,6 +11,7 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
+from ..backend import device_array
 from ..validation import number, tables
 from ..errors import ConfigError
 from .base import Load, LoadOutput
@@ -52,4 +53,4 @@ class JointLoad(Load):
                 raise ConfigError(f"{t['where']}.coordinate: {t['coordinate']!r} is not a "
                                   f"coordinate of {model.name!r}; coordinates: {list(model.coordinates)}")
             tau[model.coordinate_index(t["coordinate"])] += t["value"]
-        return cls(values=jnp.asarray(tau), names=tuple(t["name"] for t in parsed))
+        return cls(values=device_array(tau), names=tuple(t["name"] for t in parsed))

@@ -29,6 +29,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 from hydro import phases
+from ..backend import device_array
 
 STRATEGIES = ("convolution", "state_space", "state_space_exact", "none")
 
@@ -189,8 +190,8 @@ class Convolution(NoRadiation):
         S, N, n, _ = W_lag.shape
         # (S, N, n_a, n_b) -> (S, n_a, N·n_b): row a of offset s against the flattened history
         W_flat = np.ascontiguousarray(np.transpose(W_lag, (0, 2, 1, 3)).reshape(S, n, N * n))
-        return cls(W_current=jnp.asarray(W_current), W_lag=jnp.asarray(W_flat),
-                   dt=jnp.asarray(dt, jnp.float64), memory_length=float(T_K),
+        return cls(W_current=device_array(W_current), W_lag=device_array(W_flat),
+                   dt=device_array(dt, np.float64), memory_length=float(T_K),
                    stage_offsets=tuple(float(s) for s in stage_offsets),
                    dofs=tuple(spec.moving), n_lags=N)
 
@@ -268,9 +269,9 @@ class StateSpace(NoRadiation):
         P, C, ins, outs = cache[key][1]
         report = tuple((k, v) for k, v in (getattr(ss, "report", None) or {}).items()
                        if isinstance(v, (int, float, str)))
-        return cls(p=jnp.asarray(np.stack([P.real, P.imag], 1).reshape(-1, 2)),
-                   C=jnp.asarray(np.concatenate([C.real, -C.imag], 1)),
-                   A_inf=jnp.asarray(np.asarray(ss.added_mass_inf) * spec.mask),
+        return cls(p=device_array(np.stack([P.real, P.imag], 1).reshape(-1, 2)),
+                   C=device_array(np.concatenate([C.real, -C.imag], 1)),
+                   A_inf=device_array(np.asarray(ss.added_mass_inf) * spec.mask),
                    inputs=tuple(ins), outputs=tuple(outs),
                    options=tuple(sorted(options.items())), report=report)
 

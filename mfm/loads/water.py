@@ -48,6 +48,7 @@ from hydro import phases
 from hydro.seabatch import components_many
 
 from .. import host
+from ..backend import device_array
 from ..mechanics import se3
 from ..mechanics.points import BodyPoints, h_matrix_at
 from .base import FrequencyTerms, LinearHydro, Load, LoadOutput
@@ -367,8 +368,8 @@ class Water(Load):
         run's length: the loads at rest of every run of a model have one structure (one compiled
         linearisation, :func:`mfm.frequency.rest.linearised_at_rest`) and hold no table of the run's
         length (M4 134, 10⁶ RK4 steps: 0.8 GB)."""
-        def zeros(a):
-            return jnp.zeros((2,) + a.shape[1:], a.dtype)
+        def zeros(a):           # numpy onto the device: no compiled broadcast per shape
+            return device_array(np.zeros((2,) + a.shape[1:], a.dtype))
 
         still = eqx.tree_at(lambda w: (w.exc_values, w.eta_values, w.rad),
                             self, (zeros(self.exc_values), zeros(self.eta_values), NoRadiation()))
@@ -483,9 +484,9 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
         comps = sea.components(water_depth=spec.water_depth, g=spec.g)
         exc = excitation_time_series(spec.database(), comps, t_grid, ramp_duration=ramp)
         eta = np.asarray(elevation(comps, t_grid, ramp_duration=ramp)).reshape(-1)
-    geometry = BodyPoints(body_index=spec.body_index, d_ref=jnp.asarray(spec.d_ref),
-                          ref0=jnp.asarray(spec.ref0))
-    f64 = lambda a: jnp.asarray(a, dtype=jnp.float64)  # noqa: E731
+    geometry = BodyPoints(body_index=spec.body_index, d_ref=device_array(spec.d_ref),
+                          ref0=device_array(spec.ref0))
+    f64 = _f64
     C_wp, buoyancy, hulls, flow = spec.C_wp, spec.rho * spec.g * spec.volume, None, None
     comps = None if sea is None else sea.components(water_depth=spec.water_depth, g=spec.g)
     if nonlinear(spec):
@@ -736,9 +737,9 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
             arrays[name][i, :n] = values[j]
     waves = WaveSum(omega=omega, **arrays, t0=np.full(B, float(t0)), step=steps.copy(),
                     ramp=ramps.copy(), n_grid=n_grid, one_heading=table.beta.shape[0] == 1)
-    geometry = BodyPoints(body_index=spec.body_index, d_ref=jnp.asarray(spec.d_ref),
-                          ref0=jnp.asarray(spec.ref0))
-    f64 = lambda a: jnp.asarray(a, dtype=jnp.float64)  # noqa: E731
+    geometry = BodyPoints(body_index=spec.body_index, d_ref=device_array(spec.d_ref),
+                          ref0=device_array(spec.ref0))
+    f64 = _f64
     water = Water(geometry=geometry, A_inf=f64(rad.added_mass_inf(spec)), C_wp=f64(spec.C_wp),
                   buoyancy=f64(spec.rho * spec.g * spec.volume), d_cob=f64(spec.d_cob),
                   drag=f64(spec.drag), exc_t0=f64(t0), exc_step=steps.copy(),
@@ -933,16 +934,25 @@ def _wrench_map(geometry: BodyPoints, kin0, n_bodies: int):
         jnp.zeros(6 * len(geometry.body_index)))
 
 
+def _f64(a):
+    """``a`` as a float64 jax array: host data put on the device as it is
+    (:func:`mfm.backend.device_array`: no conversion program per shape), a jax array as it is."""
+    if isinstance(a, jax.Array) and a.dtype == jnp.float64:
+        return a
+    return device_array(a, np.float64)
+
+
 def moving_dofs(model, body_index, d_ref, n_samples: int = 3, seed: int = 0) -> np.ndarray:
     """Indices of the hydro dofs (6 per wet body: the velocity of its reference point and its
     angular velocity, inertial axes) that the model's joints can move: the rows of H(q) in
     ξ̇ = H q̇ that are not 0 at ``n_samples`` random configurations (|q| ≤ 0.3). A structural zero
     (a planar model has no sway, roll or yaw) is 0 at every q; a row that is 0 by accident at
     three random q is not generic. Radiation is modelled on these dofs only."""
-    geo = BodyPoints(body_index=tuple(int(i) for i in body_index), d_ref=jnp.asarray(d_ref),
-                     ref0=jnp.zeros((len(body_index), 3)))
+    geo = BodyPoints(body_index=tuple(int(i) for i in body_index),
+                     d_ref=device_array(np.asarray(d_ref, float)),
+                     ref0=device_array(np.zeros((len(body_index), 3))))
     rng = np.random.default_rng(seed)
-    qs = jnp.asarray(rng.uniform(-0.3, 0.3, (n_samples, model.n_coordinates)))
+    qs = device_array(rng.uniform(-0.3, 0.3, (n_samples, model.n_coordinates)))
     args = (model.keyed(), geo, qs)
     # the host's program (the runner's: from disk where an earlier process traced it); run once
     # per load

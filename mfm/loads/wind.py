@@ -45,6 +45,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..validation import body_ref, number, tables, vector
+from ..backend import device_array
 from ..mechanics.points import BodyPoints, h_matrix_at
 from ..errors import ConfigError
 from .base import Load, LoadOutput
@@ -289,11 +290,12 @@ class WindThrust(Load):
         phi = np.radians([t["direction_deg"] for t in parsed])
         return cls(points=BodyPoints.on_bodies(model.com, [model.body_index(t["body"]) for t in parsed],
                                                [t["hub"] for t in parsed]),
-                   wind_speed=jnp.asarray([t["wind_speed"] for t in parsed], dtype=jnp.float64),
-                   thrust_coefficient=jnp.asarray(cts, dtype=jnp.float64),
-                   rho_air=jnp.asarray([t["rho_air"] for t in parsed], dtype=jnp.float64),
-                   area=jnp.asarray([math.pi * t["rotor_radius"] ** 2 for t in parsed]),
-                   direction=jnp.asarray(np.stack([np.cos(phi), np.sin(phi), np.zeros_like(phi)], 1)),
+                   wind_speed=device_array([t["wind_speed"] for t in parsed], np.float64),
+                   thrust_coefficient=device_array(cts, np.float64),
+                   rho_air=device_array([t["rho_air"] for t in parsed], np.float64),
+                   area=device_array([math.pi * t["rotor_radius"] ** 2 for t in parsed]),
+                   direction=device_array(np.stack([np.cos(phi), np.sin(phi), np.zeros_like(phi)],
+                                                   1)),
                    ct_tables=tuple(tabs), ct_sources=tuple(sources), names=names)
 
 

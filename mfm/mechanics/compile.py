@@ -2,8 +2,9 @@
 parameters. The step of :mod:`mfm.build` that knows nothing of configs or loads."""
 from __future__ import annotations
 
-import jax.numpy as jnp
 import numpy as np
+
+from ..backend import device_array
 
 from .model import Model
 from .tree import BodySpec
@@ -46,18 +47,19 @@ def compile_tree(bodies: list[BodySpec], *, name: str = "model", gravity: float 
         damp.extend(j.damping)
         rest.extend(j.rest)
         motions.append(tuple(body_motions))
-        axes_list.append(jnp.asarray(np.array(body_axes, dtype=float).reshape(-1, 3)))
+        axes_list.append(device_array(np.array(body_axes, dtype=float).reshape(-1, 3)))
         points.append(point)
     return Model(
         name=name, body_names=names, parents=tuple(parents), joint_kinds=tuple(kinds),
         motions=tuple(motions), coordinates=tuple(coords),
-        mass=jnp.asarray([b.mass for b in bodies], dtype=jnp.float64),
-        inertia=jnp.asarray(np.stack([b.inertia for b in bodies])),
-        com=jnp.asarray(np.stack([b.com for b in bodies])),
-        joint_point=jnp.asarray(np.stack(points)),
+        # numpy onto the device as it is (backend.device_array: no conversion program each)
+        mass=device_array([b.mass for b in bodies], np.float64),
+        inertia=device_array(np.stack([b.inertia for b in bodies])),
+        com=device_array(np.stack([b.com for b in bodies])),
+        joint_point=device_array(np.stack(points)),
         motion_axes=tuple(axes_list),
-        gravity=jnp.asarray(gravity, dtype=jnp.float64),
-        stiffness=jnp.asarray(np.array(stiff, dtype=float)),
-        damping=jnp.asarray(np.array(damp, dtype=float)),
-        rest=jnp.asarray(np.array(rest, dtype=float)),
+        gravity=device_array(gravity, np.float64),
+        stiffness=device_array(np.array(stiff, dtype=float)),
+        damping=device_array(np.array(damp, dtype=float)),
+        rest=device_array(np.array(rest, dtype=float)),
     )

@@ -7,6 +7,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..backend import device_array
 from . import se3
 
 
@@ -74,8 +75,8 @@ class BodyPoints(eqx.Module):
         whose centres of mass at q = 0 are ``com`` (n, 3)."""
         points = np.asarray(points, dtype=float).reshape(-1, 3)
         d = points - np.asarray(com)[list(body_index)]
-        return cls(body_index=tuple(int(i) for i in body_index), d_ref=jnp.asarray(d),
-                   ref0=jnp.asarray(points))
+        return cls(body_index=tuple(int(i) for i in body_index), d_ref=device_array(d),
+                   ref0=device_array(points))
 
     def positions(self, kin):
         """Inertial positions of the points (K, 3)."""

@@ -15,7 +15,8 @@ import xarray as xr
 
 from .. import results
 from ..errors import SimulationError
-from ..loads.assembly import CaseLoads, as_loads, carried_loads_batch, compile_view
+from ..loads.assembly import (CaseLoads, as_loads, carried_loads_batch, compile_view,
+                              initial_states)
 from ..validation import check_model, finite_number, initial_vector, whole_number
 from ..timedomain import integrators as _integrators
 from .checks import check_sea_read, refuse_impossible
@@ -289,8 +290,7 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     q0 = jnp.asarray(initial_vector(m0, q0, "q0"))
     qd0 = jnp.asarray(initial_vector(m0, qd0, "qd0"))
     first = loads[0]
-    parts = [ld.initial_state(m0) for ld in first]
-    z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
+    z0 = initial_states(m0, first)
 
     recording = Recording(outputs=outputs, states=False)     # the batch form: no z per sample
     known = set(results.record_specs(m0, first)[0])

@@ -153,7 +153,8 @@ def state_space_update(model: Model, *, dt, integrator="rk4", state_space_option
         return "state_space_exact", (f"its states advanced exactly ({integ.name} declares no "
                                      "amplification factor to integrate them with)")
     ss = StateSpace.build(model.hydro, state_space_options)
-    p = np.asarray(ss.p[:, 0]) + 1j * np.asarray(ss.p[:, 1])
+    pr = np.asarray(ss.p)            # on the host: eager slices compile a program each
+    p = pr[:, 0] + 1j * pr[:, 1]
     err = integrated_state_error(amplification, p * float(dt))
     biggest = float(np.max(np.abs(p))) * float(dt) if p.size else 0.0
     what = (f"{p.size} fitted poles, largest |p| dt {biggest:.3g}: {integ.name} integrates them "

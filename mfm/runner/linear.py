@@ -72,7 +72,8 @@ def lti_matrices(M, C, K, H0=None, rad=None, free=()):
     A[vs, :ns] = -Minv @ K[:, stiff]
     A[vs, vs] = -Minv @ C
     if nx:
-        pr, pi = np.asarray(rad.p[:, 0]), np.asarray(rad.p[:, 1])
+        p_host = np.asarray(rad.p)
+        pr, pi = p_host[:, 0], p_host[:, 1]
         zr, zi = slice(ns + n, ns + n + nx), slice(ns + n + nx, N)
         out = np.zeros((H0.shape[0], 2 * nx))
         out[np.asarray(rad.outputs)] = np.asarray(rad.C)

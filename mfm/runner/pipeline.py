@@ -11,7 +11,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..loads.assembly import compile_view
+from ..loads.assembly import compile_view, initial_states
 from ..timedomain.record import DEFERRED_RECORD_WIDTH, EVERY, STATE, Recording, deferred
 from ..timedomain.rollout import (chunk_jit, headed_chunk_jit, init_memories_jit, outputs_jit,
                                   start_jit, steps_jit, rollout_jit)
@@ -53,8 +53,7 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
     whole run in one program, or with ``chunked`` in chunks of one
     (:func:`~.progress.run_chunked`). The same numbers every way."""
     began = time.perf_counter()
-    parts = [ld.initial_state(model) for ld in loads]
-    z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
+    z0 = initial_states(model, loads)
     q0, qd0 = jnp.asarray(q0, jnp.float64), jnp.asarray(qd0, jnp.float64)
     t0, dt = jnp.asarray(t0, jnp.float64), jnp.asarray(dt, jnp.float64)
     model, loads = compile_view(model, loads)

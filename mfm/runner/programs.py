@@ -14,7 +14,7 @@ static data (:func:`_fingerprint`: ints, strings, tuples, frozen dataclasses, nu
 their bytes); the shape, dtype and weak type of each array leaf; the static arguments; the source
 of the mfm and hydro packages (every ``.py`` file and ``mfm/data``); the versions of jax, jaxlib
 and equinox; the backend and its device kind; ``XLA_FLAGS`` and the jax settings that change a
-trace; mfm's module-level settings as they are at the call (:func:`_settings`). Anything the hash cannot key with certainty (a function, a user's own Load class outside
+trace; mfm's module-level settings as they are at the call (:func:`_settings`). A function is keyed by its name where it is a top-level function of mfm or hydro (its code is in the source hash). Anything the hash cannot key with certainty (any other function, a user's own Load class outside
 mfm, an object of unknown type among the static data) makes the call take the ordinary path:
 this is a cache, never a second meaning. The results are the same bits (the same program;
 tests/test_first_call.py).
@@ -37,6 +37,7 @@ import os
 import pickle
 import sys
 import threading
+import types
 from pathlib import Path
 
 import jax
@@ -118,8 +119,26 @@ def _fingerprint(x, out: list) -> None:
         out.append(")")
     elif type(x).__name__ == "_Missing" and type(x).__module__.startswith("equinox"):
         out.append("eqx-missing")
+    elif _own_function(x):
+        # a function of mfm or hydro at its module's top level (optimize's mean power): its code
+        # is in the source hash, so its name determines it
+        out.append(f"fn:{x.__module__}.{x.__qualname__}")
     else:
         raise _Unkeyable(f"{type(x).__module__}.{type(x).__qualname__}")
+
+
+def _own_function(x) -> bool:
+    """Whether ``x`` is a plain function defined at the top level of an mfm or hydro module
+    (no closure, no defaults that could differ, the module's own object under its name): one
+    whose source :func:`_source_hash` keys. A user's function, a lambda or a closure is not."""
+    if not isinstance(x, types.FunctionType) or x.__closure__ or x.__defaults__ \
+            or x.__kwdefaults__:
+        return False
+    module = getattr(x, "__module__", "") or ""
+    if module.split(".")[0] not in ("mfm", "hydro") or "<" in x.__qualname__ \
+            or "." in x.__qualname__:
+        return False
+    return getattr(sys.modules.get(module), x.__qualname__, None) is x
 
 
 def _treedef(td, out: list) -> None:

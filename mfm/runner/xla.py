@@ -50,8 +50,11 @@ def once_options() -> dict | None:
 CACHE_ENV = "MFM_COMPILATION_CACHE"
 # the most the cache folder mfm chooses may hold (jax drops the least recently used beyond it)
 CACHE_BYTES = 2 * 2**30
-# programs that took at least this long to compile are kept (jax's default is 1 s)
-MIN_COMPILE_SECONDS = 0.1
+# programs that took at least this long to compile are kept (jax's default is 1 s): all of them.
+# A first answer still compiles a few small programs of 10–50 ms each (the loads' memories at
+# rest, H at q0, the frequency domain's wrench maps) that a later process would compile again;
+# read back, each costs ~1 ms
+MIN_COMPILE_SECONDS = 0.0
 
 
 def default_cache_dir() -> str:
@@ -75,7 +78,7 @@ def _set_cache() -> str | None:
     _seal_entries(path)
     jax.config.update("jax_compilation_cache_dir", path)
     if jax.config.jax_persistent_cache_min_compile_time_secs == 1.0:     # jax's default
-        # a first run also compiles a dozen programs of 0.1–0.6 s (tables, the memories' start,
+        # a first run also compiles a dozen programs of 0.01–0.6 s (tables, the memories' start,
         # the radiation's samples): RM3 1.9 s of a cached first call's 7 s
         jax.config.update("jax_persistent_cache_min_compile_time_secs", MIN_COMPILE_SECONDS)
     if jax.config.jax_compilation_cache_max_size == -1:

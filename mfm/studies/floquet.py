@@ -25,7 +25,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..loads.assembly import as_loads, compile_view
+from ..loads.assembly import as_loads, compile_view, initial_states
 from ..timedomain.rollout import dynamics_function, init_memories, update_memories
 from ..timedomain.setup import model_loads
 from ..validation import check_model, initial_vector
@@ -191,8 +191,7 @@ def floquet(model, sea, *, period, dt, t_start, integrator="verlet",
                       added_mass=added_mass, integrator=integ) + as_loads(loads)
     q0 = jnp.asarray(initial_vector(model, q0, "q0"))
     qd0 = jnp.asarray(initial_vector(model, qd0, "qd0"))
-    parts = [ld.initial_state(model) for ld in lds]
-    z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
+    z0 = initial_states(model, lds)
     dt_ = jnp.asarray(dt, jnp.float64)
 
     km, kl = compile_view(model, lds)       # what the compiled calls see (numbers-only variants share)

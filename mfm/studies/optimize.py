@@ -32,7 +32,8 @@ import numpy as np
 import xarray as xr
 from hydro.seabatch import components_many
 
-from .. import results
+from .. import host, results
+from ..backend import device_array
 from ..errors import OptimizeError
 from ..frequency.rest import (_equilibrium, _static_functions, linear_hydro, linear_hydro_index,
                               system_loads)
@@ -104,6 +105,13 @@ def _parameters(model, parameters, table):
     return out
 
 
+@jax.jit
+def _kinematics_at_rest(model):
+    """The kinematics at q = q̇ = 0."""
+    zero = jnp.zeros(model.n_coordinates)
+    return kinematics(model, zero, zero)
+
+
 def _sea_union(model, seas, lds, radiation, state_space_options):
     """ω (U,), a² (S, U), Zb (U, 6K, 6K), X (U, 6K) on the union of the seas' (β, ω) pairs."""
     comps = components_many(seas, water_depth=model.hydro.water_depth, g=model.hydro.g)
@@ -112,7 +120,10 @@ def _sea_union(model, seas, lds, radiation, state_space_options):
     for s, c in enumerate(comps):
         np.add.at(a2[s], inverse[bounds[s]:bounds[s + 1]], c.amplitude ** 2)
     water = linear_hydro(lds)
-    kin = kinematics(model, jnp.zeros(model.n_coordinates), jnp.zeros(model.n_coordinates))
+    args = (model.keyed(),)
+    # compiled, once per structure (op by op, the tree walk was ~190 small compilations: ~3 s of
+    # CPU of every first optimum, cached or not)
+    kin = host.current().program(_kinematics_at_rest, "kinematics_at_rest", args, once=True)(*args)
     options = {"radiation": radiation, "state_space_options": state_space_options}
     nd = 6 * len(water.geometry.body_index)
     Zb = np.zeros((len(union), nd, nd), complex)
@@ -187,12 +198,13 @@ def _setup(model, seas, parameters, objective, constraints, weights, loads, radi
     drag = np.zeros(Zb.shape[1])
     D = np.asarray(water.drag)                           # (K, 3) on the translations
     drag.reshape(-1, 6)[:, :3] = D
-    pb = Problem(kmodel, static, mems, jnp.asarray(q0), jnp.asarray(omega), jnp.asarray(a2),
-                 jnp.asarray(Zb), jnp.asarray(X), jnp.asarray(drag), jnp.asarray(w),
+    dev = device_array          # numpy onto the device without a compiled conversion each
+    pb = Problem(kmodel, static, mems, dev(q0), dev(omega), dev(a2), dev(Zb), dev(X), dev(drag),
+                 dev(w),
                  tuple(grp for _, grp, *_ in params), joint,
                  hydraulic[0] if hydraulic else -1, water_index,
                  int(drag_iterations) if np.any(drag > 0) else 0, lines,
-                 control=jnp.zeros(model.n_coordinates))
+                 control=dev(np.zeros(model.n_coordinates)))
 
     labels = [p[0] for p in params]
     lower = np.array([p[2] for p in params])
@@ -204,8 +216,8 @@ def _setup(model, seas, parameters, objective, constraints, weights, loads, radi
     # CPU, Stansby & Li's two dampings 23 against 27 s)
     forward = derivatives == "forward" or (derivatives == "auto"
                                            and len(params) <= max(n_out, FORWARD_UP_TO))
-    lo_j, hi_j = jnp.asarray(lower), jnp.asarray(upper)
-    lim_j = jnp.asarray([lm.limit for lm in limits]).reshape(-1)
+    lo_j, hi_j = device_array(lower), device_array(upper)
+    lim_j = device_array(np.asarray([lm.limit for lm in limits], float).reshape(-1))
     return SimpleNamespace(model=model, seas=seas, S=S, w=w, objective_fn=objective_fn, lds=lds,
                            params=params, pb=pb, pto_names=pto_names, limits=limits, spec=spec,
                            labels=labels, lower=lower, upper=upper, baseline=baseline,
@@ -230,9 +242,16 @@ def _check_equilibrium(P, r, values, last_good):
 
 
 def _run(P, u, scale):
-    """(outputs, jacobian, responses) of the request at scaled parameters u, as numpy."""
-    out, J, r = _evaluate(P.pb, jnp.asarray(u, jnp.float64), P.lo_j, P.hi_j, P.lim_j,
-                          jnp.asarray(scale, jnp.float64), P.objective_fn, P.spec, P.forward)
+    """(outputs, jacobian, responses) of the request at scaled parameters u, as numpy. The
+    compiled objective is the host's program (:meth:`mfm.host.Host.program`; the runner's: from
+    disk where an earlier process traced it, so that a later process neither traces nor lowers
+    it: Stansby & Li's two dampings, ~4 s of CPU of a cached first optimum). Its arguments are
+    put on the device as numpy (``jax.device_put``): ``jnp.asarray`` of a new shape compiles a
+    small program of its own."""
+    args = (P.pb, jax.device_put(np.asarray(u, np.float64)), P.lo_j, P.hi_j, P.lim_j,
+            jax.device_put(np.asarray(scale, np.float64)))
+    static = dict(objective=P.objective_fn, spec=P.spec, forward=P.forward)
+    out, J, r = host.current().program(_evaluate, "optimize_evaluate", args, static)(*args)
     return np.asarray(out), np.asarray(J), jax.tree_util.tree_map(np.asarray, r)
 
 

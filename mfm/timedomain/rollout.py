@@ -9,7 +9,7 @@ from typing import Sequence
 import jax
 import jax.numpy as jnp
 
-from ..loads.assembly import applied_loads, as_loads, compile_view
+from ..loads.assembly import applied_loads, as_loads, compile_view, initial_states
 from ..loads.base import Load
 from ..mechanics.dynamics import evaluate
 from ..mechanics.kinematics import kinematics
@@ -205,8 +205,7 @@ def rollout_call(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, 
     q0 = jnp.asarray(q0, jnp.float64)
     qd0 = jnp.asarray(qd0, jnp.float64)
     if z0 is None:
-        parts = [ld.initial_state(model) for ld in loads]
-        z0 = jnp.concatenate(parts) if parts else jnp.zeros(0)
+        z0 = initial_states(model, loads)
     model, loads = compile_view(model, loads)       # numbers-only variants share the compile
     args = (model, loads, q0, qd0, jnp.asarray(z0, jnp.float64), jnp.asarray(t0, jnp.float64),
             jnp.asarray(dt, jnp.float64))
