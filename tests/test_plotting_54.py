@@ -184,3 +184,17 @@ def test_the_notebooks_time_series_give_power_in_kw_with_its_mean(rm3_irregular)
     np.testing.assert_allclose(_line(a, "mean").get_ydata(), [mean_kw, mean_kw], rtol=1e-12)
     _legends_beside(fig)
     plt.close(fig)
+
+
+def test_a_regular_wave_s_spectra_mark_the_wave(rm3_irregular):
+    # the drawing given a regular sea (the series are the irregular run's: what is drawn is
+    # under test): amplitude spectra over 0 to 4 ω (the wave and its harmonics), the wave marked
+    sea = hydro.Regular(height=2.0, period=8.0)
+    fig = plotting.plot_simulation(rm3_irregular, sea=sea)
+    spectra = [a for a in fig.axes if a.get_xlabel() == "ω [rad/s]"]
+    assert [a.get_ylabel() for a in spectra] == ["amplitude of q [m]", "amplitude of q [rad]"]
+    for a in spectra:
+        assert a.get_xlim() == pytest.approx((0.0, 4 * sea.omega))
+        np.testing.assert_allclose(_line(a, "the wave").get_xdata(), [sea.omega] * 2)
+    assert not [a for a in fig.axes if a.get_ylabel().startswith("S_η")]   # no PSD, no target
+    plt.close(fig)

@@ -352,7 +352,13 @@ def plot_simulation(ds, sea=None):
         if band is not None:
             a.set_xlim(*band)
         elif len(th) >= 16:
-            a.set_xlim(0.0, np.pi / dt)
+            # still water: up to ten times the strongest response's frequency (its harmonics),
+            # not the Nyquist frequency of a fine step
+            peaks = [ln.get_xdata()[np.argmax(ln.get_ydata())] for ln in a.get_lines()]
+            a.set_xlim(0.0, min(np.pi / dt, 10.0 * max(peaks)) if peaks else np.pi / dt)
+        if sea is not None and not irregular:
+            a.axvline(2 * np.pi / sea.period, color="C9", ls=":", lw=1.2,
+                      label=f"the wave, ω {2 * np.pi / sea.period:.4g} rad/s")
         a.set_xlabel("ω [rad/s]")
         a.grid(alpha=0.3)
         _legend(a)
