@@ -115,7 +115,8 @@ def test_generate_tiny_config_loads_with_mfm(tmp_path, capsys):
     exact_b = 2 / 3 * math.pi * 0.1**3 + math.pi * 0.1**2 * 0.05
     assert 0.95 * exact_b < V[1] < exact_b
     # provenance
-    assert ds.attrs["generated_by"] == f"mfm hydro {cfg}"
+    assert ds.attrs["generated_by"] == "mfm hydro two.toml"     # relative to the config
+    assert ds.attrs["mfm_config"] == "two.toml"
     import hashlib
     assert ds.attrs["mfm_config_sha256"] == hashlib.sha256(cfg.read_bytes()).hexdigest()
     assert json.loads(ds.attrs["mfm_bem_settings"])["dx"] == 0.05
@@ -141,7 +142,7 @@ def test_overrides_and_out(tmp_path, capsys):
     assert "no A∞, so mfm.load cannot use this file" in capsys.readouterr().out
     ds = bem.load(out)
     np.testing.assert_allclose(ds["omega"].values, [3.0, 5.0])
-    assert ds.attrs["generated_by"] == f"mfm hydro {cfg} --out {out}"
+    assert ds.attrs["generated_by"] == "mfm hydro two.toml --out other.nc"   # relative to the config
     assert json.loads(ds.attrs["mfm_overrides"])["n_omega"] == 2
 
 
@@ -244,3 +245,45 @@ def test_shipped_m4_databases(layout, n_headings):
     spec = model.hydro
     assert sorted(spec.config_names) == sorted(com) and spec.water_depth == 1.0
     assert np.all(np.isfinite(spec.A_inf_db)) and np.all(np.diag(spec.A_inf_db)[2::6] > 0)
+
+
+def test_a_database_records_no_folder_of_the_machine(tmp_path, monkeypatch):
+    # issue 54 item 11: a database a user shares should not carry their machine's folders. The
+    # BEM solve is replaced by the shipped sphere's result carrying the specs it is handed, as
+    # hydro.bem.solve records them (no capytaine run); the rest is generate's own path: the mesh
+    # hull's checks, the provenance, the check by loading. The config is given as an absolute
+    # path from another working folder, where every path generate sees is absolute.
+    import trimesh
+
+    from hydro import bem
+
+    case = tmp_path / "case"
+    (case / "hulls").mkdir(parents=True)
+    trimesh.creation.icosphere(subdivisions=3, radius=1.0).export(case / "hulls" / "sphere.stl")
+    sphere = (CONFIGS / "sphere.toml").read_text()
+    cfg = case / "sphere.toml"
+    cfg.write_text(sphere.replace('"../hydro/data/sphere.nc"', '"sphere.nc"')
+                   + '[bodies.geometry]\nshape = "mesh"\nfile = "hulls/sphere.stl"\n')
+    shipped = bem.load(ROOT / "hydro" / "data" / "sphere.nc")
+
+    def solve(specs, **kw):
+        ds = shipped.copy()
+        ds.attrs["bodies"] = json.dumps(specs)
+        return ds
+    monkeypatch.setattr(bem, "solve", solve)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    out = bemgen.generate(cfg.resolve(), progress=False, out=(case / "sub" / "db.nc").resolve(),
+                          overrides={"omega_min": 0.1, "omega_max": 6.0, "n_omega": 60,
+                                     "dx": 0.05})
+    attrs = bem.load(out).attrs
+    for k, v in attrs.items():
+        assert str(tmp_path) not in str(v) and "/tmp" not in str(v), (k, v)
+    assert attrs["mfm_config"] == "sphere.toml"
+    assert attrs["generated_by"] == "mfm hydro sphere.toml --out sub/db.nc"
+    assert "relative to the folder of the config" in attrs["mfm_paths"]
+    assert json.loads(attrs["bodies"])[0]["file"] == "hulls/sphere.stl"
+    # the hull's identity is its content, wherever it lies: the stamp still matches the config
+    stale, why = bemgen.database_is_stale(cfg, out)
+    assert not stale, why

@@ -150,3 +150,27 @@ def test_stored_outputs_are_compared():
     nb = nbformat.read(ROOT / "notebooks" / "quickstart.ipynb", as_version=4)
     stored = stored_outputs(nb)
     assert stored and all(any(c.isdigit() for l in v for c in l) for v in stored.values()), stored
+
+
+def _stored_texts(cell):
+    """Every text a cell's stored outputs show: streams, tracebacks and the text forms of rich
+    outputs (not the images' base64)."""
+    for o in cell.get("outputs", []):
+        yield "".join(o.get("text", ""))
+        yield "\n".join(o.get("traceback", []))
+        for kind, value in o.get("data", {}).items():
+            if not kind.startswith("image/"):
+                yield value if isinstance(value, str) else "".join(value)
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
+def test_stored_outputs_name_no_folder_of_a_machine(path):
+    # issue 54 item 11: design.ipynb printed /work/wt-studies36/notebooks/figures/design; the
+    # notebooks print paths relative to the repository, and a warning's source path is trimmed
+    nb = nbformat.read(path, as_version=4)
+    for k, cell in enumerate(nb.cells):
+        for text in _stored_texts(cell):
+            for folder in ("/work/", "/home/", "/root/", "/Users/", "/tmp/"):
+                assert folder not in text, (
+                    f"{path.name} cell {k}: a stored output names {folder}...: "
+                    f"{text[max(0, text.index(folder) - 80):text.index(folder) + 80]!r}")

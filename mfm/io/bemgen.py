@@ -479,6 +479,28 @@ def check_hulls(specs, bodies, raw, settings) -> None:
 # Generation
 
 
+PATHS_NOTE = ("relative to the folder of the config (mfm_config): the config itself, --out in "
+              "generated_by, and each mesh file in bodies")
+
+
+def relative_to_config(path, config_path) -> str:
+    """``path`` relative to the folder of ``config_path`` (POSIX separators), as a database made
+    by ``mfm hydro`` records it (``mfm_paths``): no folder of the machine that made it."""
+    folder = os.path.dirname(os.path.abspath(config_path))
+    return Path(os.path.relpath(os.path.abspath(path), folder)).as_posix()
+
+
+def _specs_relative(specs, config_path) -> list[dict]:
+    """Body specs with each mesh ``file`` relative to the config's folder."""
+    out = []
+    for s in specs:
+        s = dict(s)
+        if s.get("shape") == "mesh" and isinstance(s.get("file"), str):
+            s["file"] = relative_to_config(s["file"], config_path)
+        out.append(s)
+    return out
+
+
 def _sha256(path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
@@ -785,10 +807,16 @@ def generate(config_path, *, out=None, force=False, progress=True, n_threads=Non
                    cache_dir=cache_dir, **kw)
     wall = time.perf_counter() - t0
     _check_finite(ds, kw["infinite_frequency"])
-    command = f"mfm hydro {config_path}" + (f" --out {out}" if out_given else "")
+    # paths as seen from the config's folder: a file a user shares carries no folder of their
+    # machine (hydro.bem.solve records the specs it was given, mesh files as absolute paths)
+    command = f"mfm hydro {config_path.name}" + (
+        f" --out {relative_to_config(out, config_path)}" if out_given else "")
     ds.attrs.update({
+        "bodies": json.dumps(_specs_relative(json.loads(ds.attrs["bodies"]), config_path))
+        if "bodies" in ds.attrs else json.dumps(_specs_relative(specs, config_path)),
         "generated_by": command,
-        "mfm_config": str(config_path),
+        "mfm_config": config_path.name,
+        "mfm_paths": PATHS_NOTE,
         "mfm_config_sha256": config_sha,
         "mfm_bem_settings": json.dumps(settings["record"], sort_keys=True, default=str),
         "mfm_overrides": json.dumps(overrides or {}, sort_keys=True, default=str),

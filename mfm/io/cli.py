@@ -400,6 +400,9 @@ def cmd_simulate(args):
     if "pto_power" in ds:
         for p in ds.pto.values:
             print(f"  mean power of {p}: {float(half.pto_power.sel(pto=p).mean()):.6g} W")
+        if ds.sizes["pto"] > 1:
+            print(f"  mean power of all {ds.sizes['pto']} PTOs: "
+                  f"{float(half.pto_power.sum('pto').mean()):.6g} W")
     print("  " + _restoring_text(ds.attrs.get("no_restoring", "not checked")))
     if sea is None and _at_rest(ds):
         print("  " + _at_rest_text(model, args))
@@ -408,7 +411,7 @@ def cmd_simulate(args):
     if not args.no_plot:
         from .plotting import save_result_plot
 
-        save_result_plot(ds, png)
+        save_result_plot(ds, png, sea=sea)
         print(f"  figure -> {png}")
 
 

@@ -66,23 +66,40 @@ def plot_layout(model: "Model", q=None, *, ax=None, title=None):
 
 
 def plot_time_series(ds, variables=("q",), *, ax=None):
-    """Each variable of a simulation dataset against time, one line per coordinate/body."""
+    """Each variable of a simulation dataset against time, one line per coordinate/body; the
+    PTO power in kW with its mean over the second half drawn across that window (the window of
+    `mfm simulate`'s summary). Legends beside the panels (:data:`LEGEND`), never over the curves."""
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(len(variables), 1, figsize=(9, 2.8 * len(variables)), sharex=True,
-                             squeeze=False) if ax is None else (ax.figure, np.array([[ax]]))
+    if ax is None:
+        fig, axes = plt.subplots(len(variables), 1, figsize=(10, 2.6 * len(variables)),
+                                 sharex=True, squeeze=False, layout="constrained")
+    else:
+        fig, axes = ax.figure, np.array([[ax]])
+    t = np.asarray(ds.time.values, dtype=float)
+    h0 = len(t) // 2
     for a, v in zip(axes[:, 0], variables):
         da = ds[v]
+        unit = da.attrs.get("units", "")
+        scale = 1.0
+        if v == "pto_power" and unit == "W":
+            scale, unit = 1e-3, "kW"
         other = [d for d in da.dims if d != "time"]
         flat = da.stack(line=other) if other else da.expand_dims(line=[v])
         for k in range(flat.sizes["line"]):
             lbl = flat.line.values[k]
-            a.plot(ds.time, flat.isel(line=k), label=" ".join(map(str, lbl)) if isinstance(lbl, tuple) else str(lbl))
-        a.set_ylabel(f"{v} [{da.attrs.get('units', '')}]")
+            a.plot(t, scale * flat.isel(line=k).values,
+                   label=" ".join(map(str, lbl)) if isinstance(lbl, tuple) else str(lbl))
+        if v == "pto_power" and len(t) > h0:
+            total = scale * np.asarray(flat.values, dtype=float).reshape(len(t), -1).sum(axis=1)
+            m = float(np.mean(total[h0:]))
+            what = "mean" if flat.sizes["line"] == 1 else f"mean of the total of {flat.sizes['line']}"
+            a.plot([t[h0], t[-1]], [m, m], "--", color="k", lw=1.2,
+                   label=f"{what} {m:.4g} {unit} (t ≥ {t[h0]:.4g} s)")
+        a.set_ylabel(f"{v} [{unit}]")
         a.grid(alpha=0.3)
-        a.legend(fontsize=7, ncol=3)
+        _legend(a, ncol=1 + (len(a.get_lines()) > 2 * MAX_LINES))
     axes[-1, 0].set_xlabel("time [s]")
-    fig.tight_layout()
     return fig
 
 
@@ -108,51 +125,246 @@ def _coordinate_units(ds):
             for c in ds.coordinate.values]
 
 
-def plot_simulation(ds):
-    """A simulation result: q (one panel per unit: m, rad), PTO power, and the amplitude spectra
-    of q over the second half (after any start-up transient). Returns the figure."""
+# a panel holds at most this many curves: with more (Wu & Yuan's 12 hinges and 6 platform
+# coordinates) the lines cannot be told apart and the legend outgrows the panel
+MAX_LINES = 6
+LEGEND = dict(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=7)
+
+
+def _legend(a, **kw):
+    """The legend beside the axes, on the right (never over the curves)."""
+    if a.get_legend_handles_labels()[0]:
+        a.legend(**{**LEGEND, **kw})
+
+
+def _chunks(items, size=MAX_LINES):
+    """Consecutive chunks of at most ``size``, evenly filled (12 → 6 + 6, 7 → 4 + 3)."""
+    n = -(-len(items) // size) if items else 0
+    return [list(c) for c in np.array_split(np.arange(len(items)), n)] if n else []
+
+
+def coordinate_panels(names, units, size=MAX_LINES):
+    """How the coordinates share panels: a list of (unit, indices, title). One panel per unit
+    (m, rad) while it holds at most ``size`` coordinates; beyond, a body with several coordinates
+    of that unit gets its own panel(s) (the platform's roll, pitch, yaw) and the bodies with one
+    (the hinged floats) share evenly filled panels of at most ``size``."""
+    out = []
+    for u in dict.fromkeys(units):
+        idx = [k for k, v in enumerate(units) if v == u]
+        if len(idx) <= size:
+            out.append((u, idx, ""))
+            continue
+        body = [str(names[k]).rsplit(".", 1)[0] for k in idx]
+        count = {b: body.count(b) for b in body}
+        for b in dict.fromkeys(body):
+            if count[b] > 1:
+                mine = [k for k, bb in zip(idx, body) if bb == b]
+                out += [(u, [mine[i] for i in c], b) for c in _chunks(mine, size)]
+        single = [k for k, bb in zip(idx, body) if count[bb] == 1]
+        for c in _chunks(single, size):
+            ks = [single[i] for i in c]
+            first, last = (str(names[ks[0]]).rsplit(".", 1)[0], str(names[ks[-1]]).rsplit(".", 1)[0])
+            out.append((u, ks, first if first == last else f"{first} … {last}"))
+    return out
+
+
+def sea_of(ds, sea=None):
+    """The sea of a simulation: ``sea`` if given, else rebuilt from the dataset's ``sea`` attribute
+    (the repr of hydro.Regular, Jonswap or PiersonMoskowitz: their keywords read as literals, the
+    spreading left out, which no spectrum depends on); None for still water or a sea the attribute
+    cannot rebuild (a UserSpectrum's table, a measured record)."""
+    if sea is not None:
+        return sea
+    import ast
+
+    import hydro
+
+    text = str(ds.attrs.get("sea", ""))
+    try:
+        call = ast.parse(text, mode="eval").body
+    except SyntaxError:
+        return None
+    if not (isinstance(call, ast.Call) and isinstance(call.func, ast.Name)
+            and call.func.id in ("Regular", "Jonswap", "PiersonMoskowitz")):
+        return None
+    kw = {}
+    for k in call.keywords:
+        if k.arg in (None, "spreading"):
+            continue
+        try:
+            kw[k.arg] = ast.literal_eval(k.value)
+        except ValueError:
+            return None
+    try:
+        return getattr(hydro, call.func.id)(**kw)
+    except (TypeError, ValueError):
+        return None
+
+
+def welch_psd(x, dt):
+    """One-sided PSD of ``x`` sampled every ``dt`` s, in units² s/rad over ω (rad/s), by Welch's
+    method (scipy.signal.welch: Hann segments of ~2n/9 samples, a power of two, half overlapping,
+    so ~8 of them, the mean removed): S(ω) = S_f(f)/(2π) at ω = 2πf, so ∫ S dω estimates the variance of x.
+    Returns (ω, S, the number of segments averaged)."""
+    from scipy.signal import welch
+
+    x = np.asarray(x, dtype=float)
+    n = len(x)
+    nperseg = int(min(n, 2 ** max(4, int(round(np.log2(max(2 * n / 9, 16)))))))
+    f, S = welch(x, fs=1.0 / dt, window="hann", nperseg=nperseg, noverlap=nperseg // 2,
+                 detrend="constant", scaling="density")
+    segments = 1 + (n - nperseg) // (nperseg - nperseg // 2)
+    return 2 * np.pi * f, S / (2 * np.pi), segments
+
+
+def _power_panels(ds):
+    """(title, lines in kW, show the mean) for the PTO power: each PTO (panels of at most
+    MAX_LINES), and with several PTOs their total first."""
+    P = np.asarray(ds.pto_power.values, dtype=float) / 1e3        # W → kW
+    names = [str(p) for p in ds.pto.values]
+    panels = []
+    if len(names) > 1:
+        panels.append((f"total of {len(names)} PTOs", [("total", P.sum(axis=1))], True))
+    for c in _chunks(names):
+        lines = [(names[i], P[:, i]) for i in c]
+        panels.append(("" if len(names) <= MAX_LINES else f"{names[c[0]]} … {names[c[-1]]}",
+                       lines, len(names) == 1))
+    return panels
+
+
+def plot_simulation(ds, sea=None):
+    """A simulation result, one column of panels over time and frequency:
+
+    * the wave elevation η at the origin (m), when the run had a sea;
+    * the coordinates q, one panel per unit (m, rad), split into panels of at most
+      :data:`MAX_LINES` curves where there are more (:func:`coordinate_panels`);
+    * the PTO power in kW, with several PTOs their total first, its mean over the second half of
+      the run (the window of `mfm simulate`'s summary) drawn across that window;
+    * the spectra over the second half, over the sea's band: for an irregular sea the PSDs
+      S(ω) (Welch, :func:`welch_psd`; ∫S dω = variance) of η with the sea's target spectrum over
+      it and of the coordinates; for a regular wave or still water the amplitude spectra of the
+      coordinates (|FFT| × 2/N, Hann window: a sine of amplitude a → a); the coordinates in the
+      panels of their time series.
+
+    Legends sit beside the panels, never over the curves. ``sea``: the hydro sea of the run
+    (else rebuilt from the dataset's attribute, :func:`sea_of`). Returns the figure."""
     import matplotlib.pyplot as plt
 
+    sea = sea_of(ds, sea)
     units = _coordinate_units(ds)
-    groups = [u for u in ("m", "rad") if u in units]
-    power = "pto_power" in ds
-    n = len(groups) + int(power)
-    fig, axes = plt.subplots(n + 1, 1, figsize=(9, 2.4 * (n + 1)), squeeze=False)
-    axes = axes[:, 0]
+    names = [str(c) for c in ds.coordinate.values]
     t = np.asarray(ds.time.values, dtype=float)
-    for a, u in zip(axes, groups):
-        for k, c in enumerate(ds.coordinate.values):
-            if units[k] == u:
-                a.plot(t, ds.q.isel(coordinate=k), lw=1, label=str(c))
+    h0 = len(t) // 2
+    t_half = t[h0] if len(t) else 0.0
+    wave = "eta" in ds and float(np.abs(ds.eta).max()) > 0.0
+    irregular = sea is not None and hasattr(sea, "spectrum")
+    q_panels = coordinate_panels(names, units)
+    p_panels = _power_panels(ds) if "pto_power" in ds else []
+    n_spec = int(wave and irregular) + len(q_panels)
+    n = int(wave) + len(q_panels) + len(p_panels) + n_spec
+    fig, axes = plt.subplots(n, 1, figsize=(10, 2.2 * n), squeeze=False, layout="constrained")
+    axes = list(axes[:, 0])
+    time_axes = axes[:n - n_spec]
+    for a in time_axes[1:]:
+        a.sharex(time_axes[0])
+    k = 0
+    if wave:
+        a = axes[k]
+        k += 1
+        a.plot(t, ds.eta.values, lw=1, color="C9", label="η")
+        a.set_ylabel("η [m]")
+        a.set_title("wave elevation at the origin", fontsize=9, loc="left")
+    for u, idx, title in q_panels:
+        a = axes[k]
+        k += 1
+        for i in idx:
+            a.plot(t, ds.q.isel(coordinate=i), lw=1, label=names[i])
         a.set_ylabel(f"q [{u}]")
-    if power:
-        a = axes[len(groups)]
-        for p in ds.pto.values:
-            a.plot(t, ds.pto_power.sel(pto=p), lw=1, label=f"{p}")
-        a.set_ylabel("PTO power [W]")
-    for a in axes[:n]:
-        a.set_xlabel("time [s]")
+        if title:
+            a.set_title(title, fontsize=9, loc="left")
+    for title, lines, mean in p_panels:
+        a = axes[k]
+        k += 1
+        for name, y in lines:
+            a.plot(t, y, lw=1, label=name)
+        if mean and len(t) > h0:
+            y = lines[0][1]
+            m = float(np.mean(y[h0:]))
+            a.plot([t_half, t[-1]], [m, m], "--", color="k", lw=1.2,
+                   label=f"mean {m:.4g} kW (t ≥ {t_half:.4g} s)")
+        a.set_ylabel("PTO power [kW]")
+        if title:
+            a.set_title(title, fontsize=9, loc="left")
+    for a in time_axes:
         a.grid(alpha=0.3)
-        a.legend(fontsize=7, ncol=3)
-    # amplitude spectrum of the second half (one-sided, |FFT| × 2/N: a sine of amplitude a → a)
-    a = axes[n]
-    half = ds.isel(time=slice(len(t) // 2, None))
-    th = np.asarray(half.time.values, dtype=float)
-    if len(th) >= 8:
-        dt = float(np.median(np.diff(th)))
-        om = 2 * np.pi * np.fft.rfftfreq(len(th), dt)
-        for k, c in enumerate(ds.coordinate.values):
-            x = np.asarray(half.q.isel(coordinate=k).values, dtype=float)
-            amp = 2 * np.abs(np.fft.rfft((x - x.mean()) * np.hanning(len(x)))) / np.hanning(len(x)).sum()
-            a.semilogy(om[1:], np.maximum(amp[1:], 1e-12), lw=1, label=f"{c} [{units[k]}]")
-        a.set_xlim(0, min(om[-1], 10 * om[np.argmax(amp[1:]) + 1] if len(om) > 2 else om[-1]))
-    a.set_xlabel("ω [rad/s]")
-    a.set_ylabel(f"amplitude, t ≥ {th[0]:.4g} s" if len(th) else "amplitude")
-    a.grid(alpha=0.3)
-    a.legend(fontsize=7, ncol=3)
+        _legend(a)
+    if time_axes:
+        time_axes[-1].set_xlabel("time [s]")
+
+    # spectra over the second half (after any start-up transient)
+    half = ds.isel(time=slice(h0, None))
+    th = t[h0:]
+    dt = float(np.median(np.diff(th))) if len(th) > 1 else 1.0
+    if irregular:
+        band = sea.band
+    elif sea is not None:
+        band = (0.0, 4.0 * 2 * np.pi / sea.period)        # the wave and its first harmonics
+    else:
+        band = None
+    spec_axes = axes[n - n_spec:]
+    j = 0
+    if wave and irregular:
+        a = spec_axes[j]
+        j += 1
+        if len(th) >= 16:
+            w, S, K = welch_psd(half.eta.values, dt)
+            a.plot(w, S, lw=1, color="C9", label=f"η, Welch ({K} segments)")
+        wt = np.linspace(band[0], band[1], 400)
+        a.plot(wt, sea.spectrum(wt), "--", color="k", lw=1.2, label="target S(ω)")
+        a.set_ylabel("S_η [m² s/rad]")
+        a.set_title(f"wave spectrum, t ≥ {t_half:.4g} s", fontsize=9, loc="left")
+    for u, idx, group in q_panels:
+        a = spec_axes[j]
+        j += 1
+        for i in idx:
+            x = np.asarray(half.q.isel(coordinate=i).values, dtype=float)
+            if len(x) < 16:
+                continue
+            if irregular:
+                w, S, _ = welch_psd(x, dt)
+                a.semilogy(w[1:], np.maximum(S[1:], 1e-30), lw=1, label=names[i])
+            else:
+                win = np.hanning(len(x))
+                w = 2 * np.pi * np.fft.rfftfreq(len(x), dt)
+                amp = 2 * np.abs(np.fft.rfft((x - x.mean()) * win)) / win.sum()
+                a.semilogy(w[1:], np.maximum(amp[1:], 1e-12), lw=1, label=names[i])
+        # six decades below the largest value in the band: the floor of round-off says nothing
+        top = [np.max(ln.get_ydata()[(ln.get_xdata() >= (band or (0, np.inf))[0])
+                                     & (ln.get_xdata() <= (band or (0, np.inf))[1])], initial=0.0)
+               for ln in a.get_lines()]
+        if top and max(top) > 0.0:
+            a.set_ylim(max(top) * 1e-6, max(top) * 3.0)
+        a.set_ylabel(f"PSD of q [{u}² s/rad]" if irregular else f"amplitude of q [{u}]")
+        a.set_title(("PSD" if irregular else "amplitude spectrum") + " of the coordinates"
+                    + (f" ({group})" if group else "") + f", t ≥ {t_half:.4g} s", fontsize=9,
+                    loc="left")
+    for a in spec_axes:
+        if band is not None:
+            a.set_xlim(*band)
+        elif len(th) >= 16:
+            # still water: up to ten times the strongest response's frequency (its harmonics),
+            # not the Nyquist frequency of a fine step
+            peaks = [ln.get_xdata()[np.argmax(ln.get_ydata())] for ln in a.get_lines()]
+            a.set_xlim(0.0, min(np.pi / dt, 10.0 * max(peaks)) if peaks else np.pi / dt)
+        if sea is not None and not irregular:
+            a.axvline(2 * np.pi / sea.period, color="C9", ls=":", lw=1.2,
+                      label=f"the wave, ω {2 * np.pi / sea.period:.4g} rad/s")
+        a.set_xlabel("ω [rad/s]")
+        a.grid(alpha=0.3)
+        _legend(a)
     title = ds.attrs.get("model", ds.attrs.get("config", "simulation"))
-    fig.suptitle(f"{title}: {ds.attrs.get('sea_label', ds.attrs.get('sea', 'still water'))}"[:110], fontsize=10)
-    fig.tight_layout()
+    label = ds.attrs.get("sea_label", str(sea) if sea is not None else "still water")
+    fig.suptitle(f"{title}: {label}"[:110], fontsize=10)
     return fig
 
 
@@ -220,9 +432,10 @@ def plot_batch(ds, discard=0.5):
     return fig
 
 
-def save_result_plot(ds, path, *, dpi=120) -> str:
+def save_result_plot(ds, path, *, dpi=120, sea=None) -> str:
     """Draw a result dataset (simulation, RAO or batch; see :func:`result_kind`) into a PNG at
-    `path`. Returns a few words saying what was drawn."""
+    `path`. ``sea``: a simulation's sea (else rebuilt from its attribute). Returns a few words
+    saying what was drawn."""
     import matplotlib
 
     if matplotlib.get_backend().lower() not in ("agg", "module://matplotlib_inline.backend_inline"):
@@ -230,8 +443,9 @@ def save_result_plot(ds, path, *, dpi=120) -> str:
     import matplotlib.pyplot as plt
 
     kind = result_kind(ds)
-    fig = {"simulation": plot_simulation, "rao": plot_rao, "batch": plot_batch}[kind](ds)
+    fig = (plot_simulation(ds, sea) if kind == "simulation" else
+           {"rao": plot_rao, "batch": plot_batch}[kind](ds))
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
-    return {"simulation": "time series, PTO power and spectra", "rao": "RAOs",
+    return {"simulation": "wave elevation, time series, PTO power and spectra", "rao": "RAOs",
             "batch": "mean power per case"}[kind]
