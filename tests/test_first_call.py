@@ -524,3 +524,57 @@ def test_a_pipelined_run_steps_before_its_outputs_program_is_ready(monkeypatch, 
     assert order[-1] == "outputs compiled", order
     for name in ("q", "qd", "joint_force", "hydro_force"):
         np.testing.assert_array_equal(ds[name].values, plain[name].values, err_msg=name)
+
+
+# What a first answer compiles, counted (mfm.runner.xla.counting: jax.monitoring's events), not
+# timed: the same on any machine. A first RM3 run with empty caches compiles the run's programs
+# (the whole run, the checks' linearisation, the moved dofs' samples, the loads' memories at rest)
+# and no program per host operation: a jnp.asarray or jnp.zeros of host data, an eager slice or
+# sum compiled a program each (15 in this run before issue 55; mfm.backend.device_array). A
+# second process with the caches filled compiles nothing: every program from the compilation
+# cache, small ones included (MIN_COMPILE_SECONDS 0), the run's programs not traced again.
+COUNTED = textwrap.dedent("""
+    import sys, warnings
+    import hydro, mfm
+    from mfm.runner.xla import counting
+    with counting() as c:
+        m = mfm.load(sys.argv[1])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            ds = mfm.simulate(m, hydro.Regular(height=2.5, period=8.0), duration=20.0, dt=0.1,
+                              ramp=4.0)
+    ds.to_netcdf(sys.argv[2])
+    print("COUNTS", c.compiled, c.loaded, c.traced)
+""")
+# the programs of that first run: the whole run, the checks' linearisation (static_jet), the
+# moved dofs' samples (h_samples), the loads' memories at rest, H at q0 for the fit's
+# judgement; 5 on the tree of issue 55, one more of headroom for a program a change may add
+MAX_FIRST_RUN_PROGRAMS = 6
+
+
+def test_a_first_answer_compiles_its_programs_only_and_a_cached_one_none(tmp_path):
+    import xarray as xr
+
+    script = tmp_path / "run.py"
+    script.write_text(COUNTED)
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MFM_COMPILATION_CACHE=str(tmp_path / "jax"),
+               MFM_FIT_CACHE=str(tmp_path / "fits"))
+    for var in ("JAX_COMPILATION_CACHE_DIR", "JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS"):
+        env.pop(var, None)             # this test's own caches, with mfm's own settings
+    counts = []
+    for k in range(2):
+        r = subprocess.run([sys.executable, str(script), str(CONFIGS / "rm3.toml"),
+                            str(tmp_path / f"{k}.nc")], env=env, capture_output=True, text=True,
+                           timeout=600)
+        assert r.returncode == 0, r.stderr[-3000:]
+        line = next(ln for ln in r.stdout.splitlines() if ln.startswith("COUNTS"))
+        counts.append(tuple(int(v) for v in line.split()[1:]))
+    (compiled0, loaded0, _), (compiled1, loaded1, traced1) = counts
+    assert 3 <= compiled0 <= MAX_FIRST_RUN_PROGRAMS and loaded0 == 0, counts
+    assert compiled1 == 0 and loaded1 == compiled0, counts
+    # traced again: the few small jitted helpers that are not kept as traced programs (the
+    # memories at rest, H at q0); the run's programs come from disk untraced
+    assert traced1 < compiled0 + 4, counts
+    a, b = xr.open_dataset(tmp_path / "0.nc"), xr.open_dataset(tmp_path / "1.nc")
+    for var in ("q", "qd", "qdd", "pto_power"):
+        np.testing.assert_array_equal(a[var].values, b[var].values, err_msg=var)

@@ -20,6 +20,7 @@ The cache is turned on by ``mfm.load`` or the runner's first program, whichever 
 """
 from __future__ import annotations
 
+import contextlib
 import os
 import threading
 
@@ -231,3 +232,73 @@ def compilation_cache() -> str | None:
                     pass
             _installed = True
     return COMPILATION_CACHE
+
+
+# ------------------------------------------------------------------------------ counting programs
+class Compilations:
+    """What jax did for the programs of a block of code (:func:`counting`), counted from
+    :mod:`jax.monitoring`'s events, in every thread of the process while the block runs:
+
+    - ``compiled``: programs XLA compiled (not found in the persistent compilation cache);
+    - ``loaded``: programs read back from that cache instead of compiled;
+    - ``traced``: functions jax traced to a jaxpr (a program kept on disk by
+      :mod:`mfm.runner.programs` is neither traced nor lowered again).
+
+    A counter, not a timer: the same on any machine and at any load."""
+
+    def __init__(self):
+        self.backend = 0            # jax's backend compilations: it times a cache hit as one too
+        self.loaded = 0
+        self.traced = 0
+
+    @property
+    def compiled(self) -> int:
+        return self.backend - self.loaded
+
+    def __repr__(self):
+        return (f"Compilations(compiled={self.compiled}, loaded={self.loaded}, "
+                f"traced={self.traced})")
+
+
+_counters: list = []
+_counters_lock = threading.Lock()
+_listening = False
+
+
+def _on_event(event, **_):
+    if event == "/jax/compilation_cache/cache_hits":
+        with _counters_lock:
+            for c in _counters:
+                c.loaded += 1
+
+
+def _on_duration(event, _seconds, **_):
+    field = ("backend" if event.endswith("/backend_compile_duration") else
+             "traced" if event.endswith("/jaxpr_trace_duration") else None)
+    if field is None:
+        return
+    with _counters_lock:
+        for c in _counters:
+            setattr(c, field, getattr(c, field) + 1)
+
+
+@contextlib.contextmanager
+def counting():
+    """Count jax's compilations while the block runs: ``with counting() as c: ...`` then
+    ``c.compiled``, ``c.loaded``, ``c.traced`` (:class:`Compilations`)."""
+    import jax.monitoring
+
+    global _listening
+    with _counters_lock:
+        if not _listening:
+            jax.monitoring.register_event_listener(_on_event)
+            jax.monitoring.register_event_duration_secs_listener(_on_duration)
+            _listening = True
+    c = Compilations()
+    with _counters_lock:
+        _counters.append(c)
+    try:
+        yield c
+    finally:
+        with _counters_lock:
+            _counters.remove(c)
