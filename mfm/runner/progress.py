@@ -127,7 +127,7 @@ def _advance(bar, done: int, take: int, save_every: int, began: float):
         bar.update(take * save_every)
 
 
-def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis, began=None):
+def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis, began=None, c=None):
     """Run ``start()`` then ``chunk(carry, c)`` (``c`` blocks, from :func:`chunk_plan`) until
     ``n_blocks`` are done,
     updating ``bar`` between chunks; stops early once a chunk has a non-finite q or q̇ (the caller
@@ -137,8 +137,10 @@ def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis, began=None):
     ``start()`` gives (carry, the initial sample's outputs), or (carry, None) where each chunk
     gives its incoming carry's outputs first (a head: kept from the first chunk, dropped from the
     others). ``began``: when the compilation began (``time.perf_counter()``), where it was done
-    before the call; the bar says how long it took."""
-    c, n_chunks = chunk_plan(n_blocks)
+    before the call; the bar says how long it took. ``c``: the chunk length (None: from
+    :func:`chunk_plan`)."""
+    c = chunk_plan(n_blocks)[0] if c is None else c
+    n_chunks = -(-n_blocks // c)
     if began is None:
         # compiled by the first calls below; else before this call, under its own phase
         _say(bar, "compiling")
