@@ -6,11 +6,16 @@
 from __future__ import annotations
 
 import io
+import json
+import os
+import shutil
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 
-from conftest import CONFIGS
+from conftest import CONFIGS, ROOT
 
 import hydro
 import mfm
@@ -33,3 +38,47 @@ def test_a_progress_bar_gives_the_bits_of_the_run_without_one():
     differ = [v for v in plain.data_vars
               if not np.array_equal(plain[v].values, barred[v].values, equal_nan=True)]
     assert not differ, differ
+
+
+# a first run that counts what it traced and saved (mfm.runner.programs.COUNTS) and jax's
+# persistent cache's misses (its monitoring events)
+_WARM_RUN = """
+import json, jax, hydro, mfm
+from mfm.runner import programs
+misses = []
+jax.monitoring.register_event_listener(
+    lambda name, **kw: misses.append(name) if name.endswith("/cache_misses") else None)
+m = mfm.load(%r)
+mfm.simulate(m, hydro.Regular(height=1.0, period=8.0), duration=10.0, dt=0.1, ramp=5.0)
+print(json.dumps(dict(programs.COUNTS, misses=len(misses))))
+"""
+
+
+def _files(folder):
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file())
+
+
+def test_a_warm_cache_copied_to_another_folder_is_used_there(tmp_path):
+    """Item 18: the traced programs' key held the cache's folder (mfm.runner.xla.COMPILATION_CACHE
+    among mfm's settings), and jax's compilation keys held it too (its default GPU autotuning
+    folder inside the cache's, in every compilation's options): a warm cache copied elsewhere
+    traced and compiled every program again. Counted, not timed: the second process in the copy
+    saves no program, misses nothing in jax's cache and adds no file."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith("JAX_COMPILATION_CACHE")}
+    env.update(MFM_FIT_CACHE=str(tmp_path / "fits"), PYTHONPATH=str(ROOT))
+    code = _WARM_RUN % str(CONFIGS / "sphere.toml")
+
+    def run(folder):
+        out = subprocess.run([sys.executable, "-c", code], env=dict(env, MFM_COMPILATION_CACHE=str(
+            folder)), capture_output=True, text=True, timeout=600, cwd=ROOT)
+        assert out.returncode == 0, out.stderr[-3000:]
+        return json.loads(out.stdout.strip().splitlines()[-1])
+
+    first = run(tmp_path / "a")
+    assert first["saved"] > 0 and first["misses"] > 0, first       # it filled the cache
+    shutil.copytree(tmp_path / "a", tmp_path / "b")
+    before = _files(tmp_path / "b")
+    second = run(tmp_path / "b")
+    assert second["saved"] == 0 and second["loaded"] == first["saved"], (first, second)
+    assert second["misses"] == 0, second
+    assert _files(tmp_path / "b") == before
