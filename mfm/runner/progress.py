@@ -4,13 +4,14 @@ made on a second thread while its steps go on, :func:`run_pipelined`); the same 
 order, so the same numbers as the run in one call."""
 from __future__ import annotations
 
-import concurrent.futures
 import sys
 import threading
 import time
 
 import jax
 import numpy as np
+
+from .threads import Serial
 
 
 def chunk_plan(n_blocks: int, fewest: int = 20, most: int = 100,
@@ -189,7 +190,8 @@ def run_pipelined(carry, steps, outputs, c, n_blocks, save_every, bar=None, bega
     or q̇ (the caller finds where, from the outputs made up to that chunk). Returns the saved
     samples as numpy, the initial one first, as the unchunked rollout does."""
     n_chunks = -(-n_blocks // c)
-    pool = concurrent.futures.ThreadPoolExecutor(1, thread_name_prefix="mfm-outputs")
+    # a daemon thread (mfm.runner.threads): a Ctrl-C does not wait for the chunk it makes
+    pool = Serial("mfm-outputs")
 
     def finish(head, carries, cut):
         return jax.tree_util.tree_map(lambda a: np.asarray(a)[cut], outputs(head, carries))
@@ -213,8 +215,8 @@ def run_pipelined(carry, steps, outputs, c, n_blocks, save_every, bar=None, bega
                 break
         pieces = [f.result() for f in made]
     finally:
-        # an interrupted run (Ctrl-C) waits for the chunk being made, not for those queued
-        pool.shutdown(wait=True, cancel_futures=True)
+        # an interrupted run (Ctrl-C) waits neither for the chunk being made nor for those queued
+        pool.close()
         if bar is not None:
             bar.close()
     return jax.tree_util.tree_map(lambda *a: np.concatenate(a, axis=0), *pieces)
