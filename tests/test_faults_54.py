@@ -3,6 +3,10 @@
 - 15: a Ctrl-C while a first run compiles ends the process at once (its compilations ran on pool
   threads that Python joins at exit: the process ended when they had, 9 to 35 s later).
 
+- 16: a sweep on a cluster whose workers die (every one holding the model) finishes on the
+  restarted workers with the clean run's bits (the model was scattered data, lost with them:
+  every chunk not yet run failed); a LocalCluster that does not start is blamed on a missing
+  ``__main__`` guard only where the script lacks one.
 - 18: ``progress=True`` (the command line's path) gives the bits of the run without a bar, every
   output variable; a warm cache copied to another folder is used there (nothing compiled anew).
 """
@@ -15,7 +19,9 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -139,3 +145,97 @@ def test_a_warm_cache_copied_to_another_folder_is_used_there(tmp_path):
     assert second["misses"] == 0, second
     assert _files(tmp_path / "b") == before
 
+
+# the sweep's fast path of tests/test_sweep.py: 60 steps at 0.1 s
+SWEEP_KW = dict(n_steps=60, integrator="verlet", radiation="state_space_exact", progress=False)
+
+
+def test_a_sweep_whose_workers_are_killed_finishes_with_the_clean_bits(tmp_path):
+    """Item 16. Two workers; when the third chunk's case starts (a marker file), both workers are
+    killed (SIGKILL: every copy of the model gone) and their nannies start new ones. The sweep
+    finishes every chunk and equals the same sweep run in this process, bit for bit (chunk_size
+    1: each chunk one case, one thread, the same program on both sides; the workers get this
+    process's XLA flags)."""
+    distributed = pytest.importorskip("distributed")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rm3 = mfm.load(CONFIGS / "rm3.toml")
+    seas = [hydro.Regular(height=h, period=T) for h in (1.0, 2.0) for T in (7.0, 8.0)]
+    marker = str(tmp_path / "reached")
+
+    def same(i, loads):
+        return loads
+
+    def stall_once(i, loads):
+        """The third case waits to be killed, the first time it runs (a nested function:
+        cloudpickle sends it by value)."""
+        if i == 2:
+            try:
+                open(marker, "x").close()
+            except FileExistsError:
+                return loads
+            time.sleep(120)
+        return loads
+
+    clean = mfm.sweep(rm3, seas, dt=0.1, chunk_size=1, vary_loads=same, **SWEEP_KW)
+    env = {"XLA_FLAGS": os.environ.get("XLA_FLAGS", ""), "OPENBLAS_NUM_THREADS": "1"}
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None, env=env) as cluster, \
+            distributed.Client(cluster) as client:
+        pids = client.run(os.getpid)
+        killed = []
+
+        def kill_when_reached():
+            deadline = time.monotonic() + 300
+            while not os.path.exists(marker) and time.monotonic() < deadline:
+                time.sleep(0.05)
+            time.sleep(0.3)
+            for pid in pids.values():
+                os.kill(pid, signal.SIGKILL)
+                killed.append(pid)
+
+        threading.Thread(target=kill_when_reached, daemon=True).start()
+        ds = mfm.sweep(rm3, seas, dt=0.1, chunk_size=1, client=client, vary_loads=stall_once,
+                       **SWEEP_KW)
+        assert sorted(killed) == sorted(pids.values())
+        assert set(client.run(os.getpid).values()).isdisjoint(killed)    # new workers ran it
+    assert not ds.failed.values.any(), ds.sweep_failed_chunks
+    for name in clean.data_vars:
+        np.testing.assert_array_equal(ds[name].values, clean[name].values, err_msg=name)
+
+
+@pytest.mark.parametrize("guarded", [True, False])
+def test_a_cluster_that_does_not_start_blames_the_main_guard_only_where_it_lacks(
+        tmp_path, monkeypatch, guarded):
+    """Item 16: the refusal said "needs its code under `if __name__ == '__main__':`" for any
+    RuntimeError of the LocalCluster, to a script that had the guard. Now only where the script
+    (sys.modules['__main__'], its file read) has none; else the error and where to look. The
+    cluster's start is stood in by a LocalCluster that fails as distributed's does when its
+    workers die while starting."""
+    distributed = pytest.importorskip("distributed")
+    import types
+
+    sweep_mod = sys.modules["mfm.studies.sweep"]
+    script = tmp_path / "power_matrix.py"
+    body = "import mfm\nmfm.sweep(model, seas, client='local')\n"
+    script.write_text("def main():\n    " + body.replace("\n", "\n    ").rstrip() + "\n\n"
+                      "if __name__ == '__main__':\n    main()\n" if guarded else body)
+    main = types.ModuleType("__main__")
+    main.__file__ = str(script)
+    monkeypatch.setitem(sys.modules, "__main__", main)
+
+    def dies(*a, **k):
+        try:
+            raise OSError("Nanny failed to start worker process: the worker was killed")
+        except OSError as e:
+            raise RuntimeError("Cluster failed to start: Nanny failed to start.") from e
+
+    monkeypatch.setattr(distributed, "LocalCluster", dies)
+    with pytest.raises(RuntimeError) as err:
+        sweep_mod._open_client("local", 2)
+    text = str(err.value)
+    assert "Nanny failed to start worker process: the worker was killed" in text
+    if guarded:
+        assert "put its code under" not in text and "The script is not the cause" in text
+    else:
+        assert "put its code under `if __name__ == '__main__':`" in text
