@@ -155,7 +155,8 @@ def test_a_sweep_whose_workers_are_killed_finishes_with_the_clean_bits(tmp_path)
     killed (SIGKILL: every copy of the model gone) and their nannies start new ones. The sweep
     finishes every chunk and equals the same sweep run in this process, bit for bit (chunk_size
     1: each chunk one case, one thread, the same program on both sides; the workers get this
-    process's XLA flags)."""
+    process's XLA flags). Then a chunk that kills every worker it runs on is reported by name and
+    a resume= of that sweep gives the clean bits."""
     distributed = pytest.importorskip("distributed")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -199,9 +200,23 @@ def test_a_sweep_whose_workers_are_killed_finishes_with_the_clean_bits(tmp_path)
                        **SWEEP_KW)
         assert sorted(killed) == sorted(pids.values())
         assert set(client.run(os.getpid).values()).isdisjoint(killed)    # new workers ran it
-    assert not ds.failed.values.any(), ds.sweep_failed_chunks
+        assert not ds.failed.values.any(), ds.sweep_failed_chunks
+        for name in clean.data_vars:
+            np.testing.assert_array_equal(ds[name].values, clean[name].values, err_msg=name)
+
+        # a chunk that kills every worker it runs on: once the scheduler gives up on it
+        # (allowed-failures, 0 here to keep the test short), it is named for resume=, the others
+        # kept; the resume runs it alone and gives the clean bits
+        cluster.scheduler.allowed_failures = 0
+        dies = mfm.sweep(rm3, seas, dt=0.1, chunk_size=1, client=client,
+                         vary_loads=lambda i, loads: os._exit(1) if i == 1 else loads, **SWEEP_KW)
+        assert list(dies.failed.values) == [False, True, False, False]
+        assert "chunk 1 (cases 1–1): KilledWorker" in dies.sweep_failed_chunks
+        fixed = mfm.sweep(rm3, seas, dt=0.1, chunk_size=1, client=client, vary_loads=same,
+                          resume=dies, **SWEEP_KW)
+    assert fixed.sweep_chunks_run == "1"
     for name in clean.data_vars:
-        np.testing.assert_array_equal(ds[name].values, clean[name].values, err_msg=name)
+        np.testing.assert_array_equal(fixed[name].values, clean[name].values, err_msg=name)
 
 
 @pytest.mark.parametrize("guarded", [True, False])
