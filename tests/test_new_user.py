@@ -527,8 +527,9 @@ def test_chunk_plan_one_length_few_blocks_wasted():
 
 
 def test_progress_bar_gives_the_same_numbers_with_one_compilation(capsys):
-    """progress=True runs the scan in chunks of one compiled function (211 steps: chunks of 3,
-    the last one past the end, its extra step dropped) and writes the bar to stderr; the results
+    """progress=True runs the scan in chunks of one compiled function (211 steps: 7 chunks of 32,
+    a multiple of the outputs' group width, the last one past the end, its extra steps dropped)
+    and writes the bar to stderr; the results
     equal the unchunked run's to the last bit."""
     import mfm
     from mfm.timedomain.rollout import TRACES

@@ -4,7 +4,6 @@ other threads while the start runs, and long runs in chunks whose outputs are ma
 thread as the next chunk steps (:mod:`.progress`)."""
 from __future__ import annotations
 
-import concurrent.futures
 import time
 
 import jax
@@ -18,6 +17,7 @@ from ..timedomain.rollout import (chunk_jit, headed_chunk_jit, init_memories_jit
 from . import programs as _programs
 from . import progress
 from .progress import chunk_plan, run_chunked, run_pipelined
+from .threads import background, wait
 
 
 def _strong(tree):
@@ -68,15 +68,23 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
         opts = dict(n_steps=n_steps, integrator=integrator, save_every=save_every,
                     record=recording)
         whole = _programs.program(rollout_jit, "rollout", start_args, opts)
-        whole.compile(*start_args)
+        # compiled on a daemon thread while this one waits: a Ctrl-C ends the process at once
+        # (mfm.runner.threads)
+        wait(whole.compile, *start_args)
         return lambda bar: whole(*start_args)
-    if pipelined:
-        # a multiple of the outputs' group width: each sample in the place of its group it has
-        # in the run made in one program (the same bits; progress.run_pipelined)
-        c, _ = (chunk_plan(n_blocks, multiple=DEFERRED_RECORD_WIDTH) if chunked
-                else progress.pipeline_plan(n_blocks, multiple=DEFERRED_RECORD_WIDTH))
+    if pipelined and not chunked:
+        c, _ = progress.pipeline_plan(n_blocks, multiple=DEFERRED_RECORD_WIDTH)
     else:
-        c, _ = chunk_plan(n_blocks)
+        # where the outputs are made after the steps (pipelined, or in each headed chunk), a
+        # multiple of their group width: each sample in the place of its group it has in the run
+        # made in one program (the same bits; progress.run_pipelined). A headed chunk of 20
+        # blocks put RM3's samples elsewhere in their groups: q̈, the joint and hydro forces
+        # 1e-9 to 2e-7 relative off the run without a bar (issue 54, item 18)
+        c, n = chunk_plan(n_blocks, multiple=DEFERRED_RECORD_WIDTH if headed else 1)
+        if n * c - n_blocks > n_blocks // 4:
+            # a short run (under ~128 blocks) in one chunk, rather than stepping up to 31 blocks
+            # more than it saves: its first sample starts a group as in the run in one program
+            c = n_blocks
     # the outputs of the initial sample come with the first chunk's (its head) where they are
     # made after the steps; else the start makes them, in the loop's way
     start_kw = dict(integrator=integrator, recording=STATE if headed else recording)
@@ -95,28 +103,28 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
         return made
 
     steps_kw = dict(n_blocks=c, integrator=integrator, save_every=save_every)
-    pool = concurrent.futures.ThreadPoolExecutor(2)
-    try:
-        if pipelined:
-            stacked = jax.tree_util.tree_map(
-                lambda a: jax.ShapeDtypeStruct((c,) + a.shape, a.dtype), shapes)
-            ahead = [pool.submit(compiled, steps_jit, "rollout_steps", (model, loads, shapes, dt),
-                                 steps_kw),
-                     pool.submit(compiled, outputs_jit, "rollout_outputs",
-                                 (model, loads, shapes, stacked), dict(recording=recording))]
-        else:
-            fn, name = ((headed_chunk_jit, "rollout_chunk_headed") if headed
-                        else (chunk_jit, "rollout_chunk"))
-            ahead = [pool.submit(compiled, fn, name, (model, loads, shapes, dt),
-                                 dict(steps_kw, recording=recording))]
-        carry, first = start(*start_args)
-        carry = _strong(carry)
-        # a pipelined run steps once its steps' program is ready: the outputs' program (the
-        # larger: M4 134 3.5 s, Wu & Yuan 4–9 s of compilation on 2 cores) goes on compiling
-        # beside the first chunks, whose outputs wait for it on the outputs' thread
-        made = [ahead[0].result(), ahead[1]] if pipelined else [f.result() for f in ahead]
-    finally:
-        pool.shutdown(wait=False)
+    # on daemon threads (mfm.runner.threads): a Ctrl-C while they compile ends the process at
+    # once instead of at the end of their compilations
+    if pipelined:
+        stacked = jax.tree_util.tree_map(
+            lambda a: jax.ShapeDtypeStruct((c,) + a.shape, a.dtype), shapes)
+        ahead = [background(compiled, steps_jit, "rollout_steps", (model, loads, shapes, dt),
+                            steps_kw),
+                 background(compiled, outputs_jit, "rollout_outputs",
+                            (model, loads, shapes, stacked), dict(recording=recording))]
+    else:
+        fn, name = ((headed_chunk_jit, "rollout_chunk_headed") if headed
+                    else (chunk_jit, "rollout_chunk"))
+        ahead = [background(compiled, fn, name, (model, loads, shapes, dt),
+                            dict(steps_kw, recording=recording))]
+    # the start compiled on a third while this one waits, then run here
+    wait(start.compile, *start_args)
+    carry, first = start(*start_args)
+    carry = _strong(carry)
+    # a pipelined run steps once its steps' program is ready: the outputs' program (the
+    # larger: M4 134 3.5 s, Wu & Yuan 4–9 s of compilation on 2 cores) goes on compiling
+    # beside the first chunks, whose outputs wait for it on the outputs' thread
+    made = [ahead[0].result(), ahead[1]] if pipelined else [f.result() for f in ahead]
     if pipelined:
         steps, outputs = made
         return lambda bar: run_pipelined(
@@ -134,4 +142,4 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
         return made[0](model, loads, _strong(carry), dt)
 
     return lambda bar: run_chunked(lambda: (carry, first), chunk, n_blocks, save_every, bar,
-                                   time_axis=0, began=began)
+                                   time_axis=0, began=began, c=c)

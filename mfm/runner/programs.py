@@ -211,10 +211,18 @@ def _settings() -> list:
         if mod is None or mod_name.split(".")[0] not in ("mfm", "hydro"):
             continue
         for attr, value in sorted(vars(mod).items()):
+            if f"{mod_name}.{attr}" in _WHERE:
+                continue
             if attr.isupper() and (isinstance(value, simple) or isinstance(value, tuple) and all(
                     isinstance(v, simple) for v in value)):
                 out.append(f"{mod_name}.{attr}={value!r}")
     return out
+
+
+# settings that say where the caches are, not what a program is: a warm cache copied to another
+# folder keeps its keys (with the folder in the key, RM3's first run there took 38.7 s, not 5.5 s:
+# every program traced and compiled again; issue 54, item 18)
+_WHERE = frozenset({"mfm.runner.xla.COMPILATION_CACHE"})
 
 
 def key(name: str, args: tuple, static: dict) -> str:

@@ -4,13 +4,14 @@ made on a second thread while its steps go on, :func:`run_pipelined`); the same 
 order, so the same numbers as the run in one call."""
 from __future__ import annotations
 
-import concurrent.futures
 import sys
 import threading
 import time
 
 import jax
 import numpy as np
+
+from .threads import Serial
 
 
 def chunk_plan(n_blocks: int, fewest: int = 20, most: int = 100,
@@ -127,7 +128,7 @@ def _advance(bar, done: int, take: int, save_every: int, began: float):
         bar.update(take * save_every)
 
 
-def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis, began=None):
+def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis, began=None, c=None):
     """Run ``start()`` then ``chunk(carry, c)`` (``c`` blocks, from :func:`chunk_plan`) until
     ``n_blocks`` are done,
     updating ``bar`` between chunks; stops early once a chunk has a non-finite q or q̇ (the caller
@@ -137,8 +138,10 @@ def run_chunked(start, chunk, n_blocks, save_every, bar, time_axis, began=None):
     ``start()`` gives (carry, the initial sample's outputs), or (carry, None) where each chunk
     gives its incoming carry's outputs first (a head: kept from the first chunk, dropped from the
     others). ``began``: when the compilation began (``time.perf_counter()``), where it was done
-    before the call; the bar says how long it took."""
-    c, n_chunks = chunk_plan(n_blocks)
+    before the call; the bar says how long it took. ``c``: the chunk length (None: from
+    :func:`chunk_plan`)."""
+    c = chunk_plan(n_blocks)[0] if c is None else c
+    n_chunks = -(-n_blocks // c)
     if began is None:
         # compiled by the first calls below; else before this call, under its own phase
         _say(bar, "compiling")
@@ -187,7 +190,8 @@ def run_pipelined(carry, steps, outputs, c, n_blocks, save_every, bar=None, bega
     or q̇ (the caller finds where, from the outputs made up to that chunk). Returns the saved
     samples as numpy, the initial one first, as the unchunked rollout does."""
     n_chunks = -(-n_blocks // c)
-    pool = concurrent.futures.ThreadPoolExecutor(1, thread_name_prefix="mfm-outputs")
+    # a daemon thread (mfm.runner.threads): a Ctrl-C does not wait for the chunk it makes
+    pool = Serial("mfm-outputs")
 
     def finish(head, carries, cut):
         return jax.tree_util.tree_map(lambda a: np.asarray(a)[cut], outputs(head, carries))
@@ -211,8 +215,8 @@ def run_pipelined(carry, steps, outputs, c, n_blocks, save_every, bar=None, bega
                 break
         pieces = [f.result() for f in made]
     finally:
-        # an interrupted run (Ctrl-C) waits for the chunk being made, not for those queued
-        pool.shutdown(wait=True, cancel_futures=True)
+        # an interrupted run (Ctrl-C) waits neither for the chunk being made nor for those queued
+        pool.close()
         if bar is not None:
             bar.close()
     return jax.tree_util.tree_map(lambda *a: np.concatenate(a, axis=0), *pieces)

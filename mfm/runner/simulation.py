@@ -6,7 +6,6 @@ Many runs at once are :func:`~.batch.simulate_batch`.
 """
 from __future__ import annotations
 
-import concurrent.futures
 
 import numpy as np
 import xarray as xr
@@ -27,6 +26,7 @@ from .checks import (check_sea_read, nonfinite_message, refuse_impossible, warn_
 from .choices import convolution_or_state_space, judge_radiation, judged_choice, state_space_update
 from .pipeline import prepare_run
 from .progress import phase, progress_bar, progress_options
+from .threads import background
 
 
 def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="rk4",
@@ -137,13 +137,13 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     fit = model.hydro is not None and radiation.startswith("state_space")
     phase(bar, "preparing the loads" + (" (the radiation's state-space fit: up to a minute)"
                                         if fit else ""))
-    pool = concurrent.futures.ThreadPoolExecutor(1)
     try:
         if check_stability:
             # still water's loads at rest have the structure of the run's, so the jet compiles
             # while this thread builds the run's water (its radiation fit) and is then evaluated
-            # with the run's own loads
-            ahead = pool.submit(rest.compile_jet, model, rest.still_water_loads(
+            # with the run's own loads; on a daemon thread, which a Ctrl-C does not wait for
+            # (mfm.runner.threads)
+            ahead = background(rest.compile_jet, model, rest.still_water_loads(
                 model, extra, added_mass=added_mass, stage_offsets=stage_offsets(integ)), q0)
         # the fit says how far it is (its orders, its passivity iterations) on the bar
         with phases.reporting(None if bar is None else
@@ -194,8 +194,6 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
         if bar is not None:
             bar.close()
         raise
-    finally:
-        pool.shutdown(wait=False)
     if check_stability:
         warn_stability(integ, dt, rest.period_from_jacobian(J))
     if sea is not None:

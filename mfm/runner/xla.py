@@ -78,6 +78,7 @@ def _set_cache() -> str | None:
     path = setting or default_cache_dir()
     _seal_entries(path)
     jax.config.update("jax_compilation_cache_dir", path)
+    _portable_keys()
     if jax.config.jax_persistent_cache_min_compile_time_secs == 1.0:     # jax's default
         # a first run also compiles a dozen programs of 0.01–0.6 s (tables, the memories' start,
         # the radiation's samples): RM3 1.9 s of a cached first call's 7 s
@@ -91,6 +92,27 @@ def _set_cache() -> str | None:
             jax.config.update("jax_compilation_cache_max_size", CACHE_BYTES)
     return path
 
+
+
+def _portable_keys() -> None:
+    """Keep the cache's folder out of its entries' keys on a CPU: jax's default
+    ``jax_persistent_cache_enable_xla_caches`` puts a GPU autotuning folder inside the cache's
+    folder into every compilation's options, and its key hashes them, path and all: a warm cache
+    copied or moved to another folder was compiled again, entry by entry (RM3's first run 38.7 s
+    there against 5.5 s; issue 54, item 18). A CPU has no autotuning to keep; on a GPU (where it
+    saves the autotuning of a program compiled again) and where the setting is yours, it stays."""
+    import jax
+
+    try:
+        if (jax.config.jax_persistent_cache_enable_xla_caches == _JAX_XLA_CACHES
+                and jax.default_backend() == "cpu"):
+            jax.config.update("jax_persistent_cache_enable_xla_caches", "none")
+    except AttributeError:       # a jax without the setting: no such folder in the options
+        pass
+
+
+# jax's default of jax_persistent_cache_enable_xla_caches (0.4.36 to today)
+_JAX_XLA_CACHES = "xla_gpu_per_fusion_autotune_cache_dir"
 
 
 def _seal_entries(path: str) -> None:

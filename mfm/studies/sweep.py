@@ -11,8 +11,11 @@ that one chunk that fails does not lose the others.
 
 Every chunk has the same number of cases (the last one padded by repeating its last case, the
 padding dropped after), so a worker compiles one shape once and reuses it for all its chunks; the
-model is sent to each worker once (``scatter``) and kept there under a hash of its pickled bytes,
-so later sweeps of the same model on the same cluster (a resume) do not compile again.
+model is a task's result (its pickled bytes unpickled on a worker, fetched by the others), kept
+there under a hash of those bytes, so later sweeps of the same model on the same cluster (a
+resume) do not compile again. Not scattered data: the scheduler makes a task's result again when
+the workers holding it die, where scattered data is lost with them (and every chunk not yet run
+with it); a chunk whose worker dies is run again by the scheduler.
 
 ``level="spectral"`` skips all of that for a model linear over its sea states: the cases are the
 linear frequency-domain response of :func:`mfm.runner.spectral.spectral_sweep` (one linearisation, one RAO
@@ -134,6 +137,70 @@ def _distributed():
     return distributed
 
 
+def _error_chain(e: BaseException) -> str:
+    """The text of ``e`` and of its causes and contexts."""
+    parts, seen = [], set()
+    while e is not None and id(e) not in seen:
+        seen.add(id(e))
+        parts.append(f"{type(e).__name__}: {e}")
+        e = e.__cause__ or e.__context__
+    return " <- ".join(parts)
+
+
+def _main_guard_missing() -> bool:
+    """Whether this process's main script would start workers again when they import it: the
+    workers are started by spawning (dask's ``distributed.worker.multiprocessing-method``, spawn
+    by default, or forkserver), ``__main__`` is a file (not a notebook, ``-c`` or an interactive
+    session, which workers do not import), and that file has no ``__name__ == "__main__"``
+    test; or this process is such a worker itself (``__mp_main__``)."""
+    import ast
+    import multiprocessing
+    import sys
+
+    try:
+        import dask
+
+        method = dask.config.get("distributed.worker.multiprocessing-method", "spawn")
+    except Exception:       # noqa: BLE001 - dask's default
+        method = "spawn"
+    if method not in ("spawn", "forkserver"):
+        return False
+    main = sys.modules.get("__main__")
+    if multiprocessing.parent_process() is not None and "__mp_main__" in sys.modules:
+        return True
+    path = getattr(main, "__file__", None)
+    if not path:
+        return False
+    try:
+        with open(path, encoding="utf-8") as f:
+            tree = ast.parse(f.read())
+    except (OSError, SyntaxError, ValueError, UnicodeDecodeError):
+        return False            # not readable: no evidence against the script
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Compare):
+            names = [node.left, *node.comparators]
+            if any(isinstance(n, ast.Name) and n.id == "__name__" for n in names) and any(
+                    isinstance(n, ast.Constant) and n.value == "__main__" for n in names):
+                return False
+    return True
+
+
+def _cluster_failed_text(e: RuntimeError) -> str:
+    """What a LocalCluster that did not start says: a missing ``__main__`` guard only where the
+    error is the one it makes (multiprocessing's "bootstrapping phase") or the script has none
+    (:func:`_main_guard_missing`); else the error, and where to look."""
+    chain = _error_chain(e)
+    head = f"client='local': the LocalCluster's workers did not start ({chain})."
+    if "bootstrapping phase" in chain or _main_guard_missing():
+        return (f"{head} The workers are new processes that import the main script, and this "
+                "one starts a cluster when imported: put its code under "
+                "`if __name__ == '__main__':`; or run the chunks here with client=None")
+    return (f"{head} The script is not the cause (it has its `if __name__ == '__main__':` "
+            "guard, or the workers do not import it): see the workers' errors logged above (a "
+            "worker killed for memory, a package they cannot import, no free port); or run the "
+            "chunks here with client=None")
+
+
 def _open_client(client, n_workers):
     """(client, what to close afterwards, a description of the scheduler)."""
     if client is None:
@@ -145,11 +212,7 @@ def _open_client(client, n_workers):
                 cluster = distributed.LocalCluster(n_workers=n_workers, threads_per_worker=1,
                                                    processes=True, dashboard_address=None)
             except RuntimeError as e:
-                # the usual cause: the workers are new processes that import the main script
-                raise RuntimeError(
-                    f"client='local': the LocalCluster's workers did not start ({e}). A script "
-                    "that starts one needs its code under `if __name__ == '__main__':` (the "
-                    "workers import the script); or run the chunks here with client=None") from e
+                raise RuntimeError(_cluster_failed_text(e)) from e
             c = distributed.Client(cluster)
             return c, [c, cluster], f"LocalCluster ({len(cluster.workers)} workers)"
         try:
@@ -390,10 +453,17 @@ def _run_on_cluster(c, models, chunks, todo, seas_l, dts, ramps, args, bar):
                               integrator=o.get("integrator", "rk4"))
     blob = cloudpickle.dumps(models)
     token = hashlib.sha256(blob).hexdigest()
-    remote = c.scatter(models, broadcast=True, hash=False)
+    # the model as a task's result, not scattered data: the scheduler keeps the task (the
+    # pickled bytes) and makes the model again on a live worker when every worker holding it
+    # died; scattered data is lost with them, and with it every chunk not yet run ("cluster
+    # lost scattered data": issue 54, item 16)
+    remote = c.submit(_model_from, blob, token, key=f"mfm-sweep-model-{token}", pure=False)
+
     futures = {}
     for k in todo:
         ch = chunks[k]
+        # a chunk whose worker dies is run again by the scheduler (up to its allowed-failures,
+        # then KilledWorker: reported by name below, for resume=)
         f = c.submit(_run_chunk, remote, token, ch.cases, ch.n_real,
                      [seas_l[i] for i in ch.cases], dts[ch.cases], ramps[ch.cases], **args,
                      pure=False, key=f"mfm-sweep-{token[:12]}-chunk{k}-{time.time_ns()}")
@@ -403,12 +473,22 @@ def _run_on_cluster(c, models, chunks, todo, seas_l, dts, ramps, args, bar):
         k = futures[f]
         try:
             results[k] = f.result()
-        except Exception as e:      # noqa: BLE001 - a lost worker, a cancelled task
+        except Exception as e:      # noqa: BLE001 - a chunk that killed its workers, a cancel
             results[k] = ("failed", f"{type(e).__name__}: {e} (on the cluster)", None)
         f.release()
         if bar is not None:
             bar.update(1)
+    remote.release()
     return results
+
+
+def _model_from(blob: bytes, token: str):
+    """The sweep's model(s) on a worker, from their pickled bytes (the one this worker keeps
+    under ``token`` where it has it: :func:`_run_chunk`)."""
+    import cloudpickle
+
+    kept = _WORKER_MODELS.get(token)
+    return kept if kept is not None else cloudpickle.loads(blob)
 
 
 def _parameter_labels(parameters, B):
