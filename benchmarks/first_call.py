@@ -115,11 +115,15 @@ print(float(jax.jit(run)(jnp.linspace(0.1, 0.6, 12)).sum()))
 # prints it on stderr at the end
 COUNTED = """
 import atexit, runpy, sys
-from mfm.runner.xla import counting
-block = counting()
-c = block.__enter__()
-atexit.register(lambda: print(f"COUNTS compiled={c.compiled} loaded={c.loaded} traced={c.traced}",
-                              file=sys.stderr))
+try:
+    from mfm.runner.xla import counting
+except ImportError:          # a tree before the counter (this script run on an older one)
+    counting = None
+if counting is not None:
+    block = counting()
+    c = block.__enter__()
+    atexit.register(lambda: print(f"COUNTS compiled={c.compiled} loaded={c.loaded} "
+                                  f"traced={c.traced}", file=sys.stderr))
 target, sys.argv = sys.argv[1], sys.argv[1:]
 runpy.run_path(target, run_name="__main__")
 """
