@@ -210,10 +210,30 @@ def test_config_errors_name_the_key_and_what_is_accepted(change, message):
         _model(el)
 
 
+def test_from_python_it_is_the_config_s_load():
+    """MorisonElements.create (start/end for the table's from/to) gives the load the config
+    builds: the same structure and every array equal (so a run with it as loads= is the
+    config's)."""
+    from mfm.loads.morison import MorisonElements
+
+    el = {"body": "sphere", "from": [0.0, 0.0, -5.0], "to": [1.0, 0.0, 0.5], "segments": 3,
+          "cd": 0.8, "diameter": 0.5, "ca": 1.0}
+    m = _model(el)
+    ld = MorisonElements.create(mfm.load(CONFIGS / "sphere.toml"), "sphere", start=el["from"],
+                                end=el["to"], segments=3, cd=0.8, diameter=0.5, ca=1.0)
+    cfg = m.loads[-1]
+    assert jax.tree_util.tree_structure(cfg) == jax.tree_util.tree_structure(ld)
+    for a, b in zip(jax.tree_util.tree_leaves(cfg), jax.tree_util.tree_leaves(ld)):
+        np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
+    with pytest.raises(ConfigError, match=r"morison\[0\]\.segments: missing"):
+        MorisonElements.create(m, "sphere", start=el["from"], end=el["to"], cd=1.0, area=1.0)
+
+
 def test_a_model_without_water_and_the_frequency_domain_refuse_it():
     """[[morison]] without [hydro] names the table to add; a frequency response to waves names
-    mfm.simulate (the wave force is not in the frequency domain), while the natural frequencies
-    take the element's added mass (ρ C_A V lowers the heave frequency as √(M/(M + ρ C_A V)))."""
+    mfm.simulate (the wave force is not in the frequency domain), while the linearisation at rest
+    takes the element's added mass ρ C_A V on its point's translations (to round-off) and no
+    damping or stiffness (the drag's slope at rest is 0)."""
     cfg = tomllib.loads((CONFIGS / "double_pendulum.toml").read_text())
     cfg["morison"] = [{"body": cfg["bodies"][0]["name"], "point": [0.0, 0.0, 0.0], "cd": 1.0,
                        "area": 1.0}]
@@ -224,6 +244,16 @@ def test_a_model_without_water_and_the_frequency_domain_refuse_it():
                 "volume": 2.0, "ca": 0.5})
     with pytest.raises(NotImplementedError, match="mfm.simulate"):
         mfm.frequency_response(m, np.array([1.0, 2.0]))
+    # at rest the element is its added mass on its point's translations (the point is the
+    # sphere's CoM: surge and heave, not pitch), its drag of zero slope, no stiffness
+    from mfm.frequency.rest import linear_system
+
+    q0 = np.zeros(m.n_coordinates)
+    a, b = linear_system(m, q0), linear_system(mfm.load(CONFIGS / "sphere.toml"), q0)
+    ma = float(m.hydro.rho) * 0.5 * 2.0
+    np.testing.assert_allclose(a.M - b.M, np.diag([ma, ma, 0.0]), rtol=0, atol=1e-9 * ma)
+    np.testing.assert_allclose(a.K, b.K, rtol=0, atol=1e-9 * np.abs(b.K).max())
+    np.testing.assert_allclose(a.C, b.C, rtol=0, atol=1e-9 * max(np.abs(b.C).max(), 1.0))
 
 
 def test_a_batch_of_regular_seas_is_the_single_runs():

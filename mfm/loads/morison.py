@@ -29,8 +29,10 @@ The sea comes through :meth:`MorisonElements.for_run` (every component of the ru
 headings, spreading), ramped as the water's excitation is; still water leaves the drag on the
 element's own velocity. ρ, g and the water depth are the model's ``[hydro]`` (a ``[[morison]]``
 without one is refused). Linearised at rest (equilibrium, natural frequencies) the load is its
-added mass (the drag has zero slope at rest); a frequency response with waves, the linear level
-and ``simulate_batch`` refuse it (its wave force is not there yet): use :func:`mfm.simulate`.
+added mass (the drag has zero slope at rest); a frequency response to waves and the linear and
+spectral levels refuse it (its wave force is not there yet): use :func:`mfm.simulate`.
+``simulate_batch`` takes it for seas of as many components (their wave arrays stack on the case
+axis; others are refused by :func:`mfm.loads.assembly.stack_cases`).
 
 Outputs (dims ``morison_element``, ``axis``): ``morison_force`` the force on each element (its
 segments summed), inertial axes (N), the added-mass term included.
@@ -133,7 +135,8 @@ class MorisonElements(Load):
         return self.points.to_body_wrench(F, ctx.kin, ctx.model.n_bodies)
 
     def diagnostics(self, ctx, out):
-        S = (np.arange(len(self.names))[:, None] == np.asarray(self.element)[None]).astype(float)
+        el = np.asarray(self.element)
+        S = (np.arange(el.max() + 1)[:, None] == el[None]).astype(float)
         return {"morison_force": jnp.einsum("ep,pa->ea", S, self._forces(ctx))}
 
     def outputs(self):
@@ -169,8 +172,31 @@ class MorisonElements(Load):
                 "their added mass)")
         return FrequencyTerms()
 
+    def host_view(self):
+        # the names are the host's (outputs, provenance): loads that differ only in them share
+        # one compilation
+        return dataclasses.replace(self, names=(), kinds=())
+
     def provenance(self):
         return {"morison_elements": ", ".join(f"{n} ({k})" for n, k in zip(self.names, self.kinds))}
+
+    # -- construction
+    @classmethod
+    def create(cls, model, body: str, *, point=None, start=None, end=None, segments=None,
+               cd: float, diameter=None, area=None, ca: float = 0.0, volume=None,
+               name: str | None = None) -> "MorisonElements":
+        """One element on ``body`` from Python, as a ``[[morison]]`` entry would give it: a point
+        (``point``) or a strip from ``start`` to ``end`` (the table's ``from``, ``to``) in
+        ``segments``; the same checks and errors."""
+        entry = {"body": body, "cd": cd, "ca": ca}
+        for key, v in (("point", point), ("from", start), ("to", end)):
+            if v is not None:
+                entry[key] = np.asarray(v, dtype=float).tolist()
+        for key, v in (("segments", segments), ("diameter", diameter), ("area", area),
+                       ("volume", volume), ("name", name)):
+            if v is not None:
+                entry[key] = v
+        return cls.from_parsed(cls.parse_table([entry], list(model.body_names)), model)
 
     # -- config
     @staticmethod
