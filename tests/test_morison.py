@@ -272,3 +272,40 @@ def test_a_batch_of_regular_seas_is_the_single_runs():
                                    atol=1e-12 * np.abs(r.q.values).max())
     with pytest.raises(ValueError, match=r"\[\[morison\]\], seas of as many components.*mfm\.simulate"):
         mfm.simulate_batch(m, [seas[0], hydro.Jonswap(hs=1.0, tp=6.0)], n_steps=40, **run)
+
+
+def test_a_point_element_at_rest_takes_every_component_at_any_heading():
+    """A point element (C_D 0.9, A 1.5 m², V 0.8 m³, C_A 0.7) held at z = −2 m in a 1.2 m wave
+    heading 60°: the force (surge, heave on the planar sphere; the sway part has no coordinate,
+    so surge reads f_x) against ½ ρ C_D A |u| u + ρ (1 + C_A) V u̇ of the closed-form deep-water
+    kinematics, u = a ω e^{kz_s} (cos θ cos β, cos θ sin β, sin θ), u̇ = a ω² e^{kz_s} (sin θ cos β,
+    sin θ sin β, −cos θ), z_s = z − η (Wheeler), θ = k(x cos β + y sin β) − ωt: 1e-12 of the
+    largest (the same arithmetic in another order). With a ramp of one period the amplitude is
+    a ½(1 − cos πt/T) before it, as the water's excitation (hydro.waves.ramp)."""
+    x0 = np.array([0.4, 0.0, -2.0])
+    m = _model({"body": "sphere", "point": x0.tolist(), "cd": 0.9, "area": 1.5, "volume": 0.8,
+                "ca": 0.7})
+    beta, a, T = math.radians(60.0), 0.6, 5.0
+    sea = hydro.Regular(height=2 * a, period=T, heading=beta)
+    times = np.linspace(0.0, 2 * T, 33)
+    q = jnp.zeros(m.n_coordinates)
+    kin = kinematics(m, q, q)
+    w = 2 * math.pi / T
+    k = w**2 / G
+    th = k * (x0[0] * math.cos(beta) + x0[1] * math.sin(beta)) - w * times
+    rho = float(m.hydro.rho)
+    for ramp in (0.0, T):
+        laid = m.loads[-1].for_run(m, RunGrid(sea, 0.0, 0.1, 10, ramp, (0.0, 0.5, 1.0)))
+        f = jax.jit(jax.vmap(lambda t: laid.evaluate(Context(m, t, q, q, jnp.zeros(0), kin)).tau))
+        tau = np.asarray(f(jnp.asarray(times)))
+        ar = a * (np.where(times < ramp, 0.5 * (1 - np.cos(np.pi * times / T)), 1.0) if ramp
+                  else 1.0)
+        e = np.exp(k * (x0[2] - ar * np.cos(th)))
+        u = ar * w * e * np.stack([np.cos(th) * math.cos(beta), np.cos(th) * math.sin(beta),
+                                   np.sin(th)])
+        ud = ar * w**2 * e * np.stack([np.sin(th) * math.cos(beta), np.sin(th) * math.sin(beta),
+                                       -np.cos(th)])
+        ref = 0.5 * rho * 0.9 * 1.5 * np.linalg.norm(u, axis=0) * u + rho * 1.7 * 0.8 * ud
+        for c, i in (("sphere.surge", 0), ("sphere.heave", 2)):
+            j = list(m.coordinates).index(c)
+            np.testing.assert_allclose(tau[:, j], ref[i], rtol=0, atol=1e-12 * np.abs(ref).max())
