@@ -127,6 +127,8 @@ class MorisonElements(Load):
     def _forces(self, ctx):
         """The whole force at each point (P, 3), the added-mass term of ``ctx.qdd`` included."""
         f, _, Hn = self._terms(ctx.kin, ctx.t)
+        if not self.has_added:
+            return f
         return f - self.added[:, None] * jnp.einsum("pai,i->pa", Hn, ctx.qdd)
 
     def reaction_loads(self, ctx, out):
