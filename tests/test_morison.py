@@ -309,3 +309,50 @@ def test_a_point_element_at_rest_takes_every_component_at_any_heading():
         for c, i in (("sphere.surge", 0), ("sphere.heave", 2)):
             j = list(m.coordinates).index(c)
             np.testing.assert_allclose(tau[:, j], ref[i], rtol=0, atol=1e-12 * np.abs(ref).max())
+
+
+def test_an_inclined_member_takes_the_flow_normal_to_its_axis():
+    """A submerged member inclined at 45° in the x–z plane (from (−3, 0, −12) to (3, 0, −6)),
+    held, in a 2 m, 6 s deep-water wave: the surge and heave force and the pitch moment about
+    the CoM against scipy's quad along the member of f = ½ ρ C_D D |u_n| u_n + ρ (1 + C_A)
+    (π D²/4) u̇_n, u_n = u − e (e·u), with the closed-form stretched kinematics (independent of
+    hydro.wetted): within 3e-5 of each series' largest at N = 100, the midpoint rule's error on
+    this smooth integrand (measured 4.7e-6 for the forces, 9.9e-6 for the moment, whose lever
+    adds to the integrand's curvature; (kΔ)²/24 ≈ 4e-6). Without the projection the axial flow
+    would add a force of the order of the normal one."""
+    from scipy.integrate import quad
+
+    a0, b0 = np.array([-3.0, 0.0, -12.0]), np.array([3.0, 0.0, -6.0])
+    m = _model({"body": "sphere", "from": a0.tolist(), "to": b0.tolist(), "segments": 100,
+                "cd": 1.1, "diameter": 0.8, "ca": 0.9})
+    a, T = 1.0, 6.0
+    sea = hydro.Regular(height=2 * a, period=T)
+    laid = m.loads[-1].for_run(m, RunGrid(sea, 0.0, 0.1, 10, 0.0, (0.0, 0.5, 1.0)))
+    times = np.linspace(0.0, T, 9)
+    q = jnp.zeros(m.n_coordinates)
+    kin = kinematics(m, q, q)
+    tau = np.asarray(jax.jit(jax.vmap(lambda t: laid.evaluate(
+        Context(m, t, q, q, jnp.zeros(0), kin)).tau))(jnp.asarray(times)))
+    w = 2 * math.pi / T
+    k = w**2 / G
+    rho, L = float(m.hydro.rho), float(np.linalg.norm(b0 - a0))
+    e = (b0 - a0) / L
+    com = np.asarray(m.com)[0]
+
+    def per_metre(s, t):
+        x = a0 + s * e
+        th = k * x[0] - w * t
+        decay = math.exp(k * (x[2] - a * math.cos(th)))
+        u = a * w * decay * np.array([math.cos(th), 0.0, math.sin(th)])
+        ud = a * w**2 * decay * np.array([math.sin(th), 0.0, -math.cos(th)])
+        un, udn = u - e * (e @ u), ud - e * (e @ ud)
+        f = 0.5 * rho * 1.1 * 0.8 * np.linalg.norm(un) * un + rho * 1.9 * math.pi * 0.16 * udn
+        return f, np.cross(x - com, f)
+
+    ref = np.array([[quad(lambda s: (per_metre(s, t)[0][0], per_metre(s, t)[0][2],
+                                     per_metre(s, t)[1][1])[i], 0.0, L, epsabs=0,
+                          epsrel=1e-10)[0] for i in range(3)] for t in times])
+    for i, c in enumerate(("sphere.surge", "sphere.heave", "sphere.pitch")):
+        j = list(m.coordinates).index(c)
+        np.testing.assert_allclose(tau[:, j], ref[:, i], rtol=0,
+                                   atol=3e-5 * np.abs(ref[:, i]).max(), err_msg=c)
