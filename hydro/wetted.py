@@ -68,6 +68,21 @@ def still_water() -> WaveField:
     return WaveField(z, z, z, z, z)
 
 
+def ramped(wave: WaveField, T, t) -> WaveField:
+    """``wave`` with its amplitudes ramped at t as the excitation is (:func:`hydro.waves.ramp`:
+    ½(1 − cos πt/T) before T, 1 after; T = 0: 1). T and t may be traced."""
+    r = jnp.where(T > 0, 0.5 * (1 - jnp.cos(jnp.pi * jnp.clip(t, 0.0, T) / jnp.where(T > 0, T, 1.0))),
+                  1.0)
+    return type(wave)(wave.amplitude * r, wave.omega, wave.wavenumber, wave.heading, wave.phase,
+                      wave.water_depth)
+
+
+def still(wave: WaveField) -> WaveField:
+    """``wave`` with no components (still water), its depth kept."""
+    z = jnp.zeros((0,), jnp.float64)
+    return type(wave)(z, z, z, z, z, wave.water_depth)
+
+
 def triangles(vertices, faces) -> np.ndarray:
     """The panels of a mesh as triangles (n, 3, 3): ``vertices`` (V, 3), ``faces`` (F, 3) or
     (F, 4) vertex indices ordered for the outward normal (a quadrilateral split along its first
@@ -151,21 +166,12 @@ def _decay(k, zs, h):
     return jnp.exp(k * zc) * (1 + jnp.exp(-2 * k * (zc + h))) / (1 + jnp.exp(-2 * k * h))
 
 
-def particle_velocity(wave: WaveField, points, t):
-    """The undisturbed flow's velocity (m/s) at ``points`` (..., 3), inertial axes: linear wave
-    kinematics, each component's
-
-        u_h = a ω f_h(z_s) cos θ (cos β, sin β),   u_z = a ω f_v(z_s) sin θ,
-        θ = k (x cos β + y sin β) − ω t + φ,
-
-    f_h = cosh k(z_s + h)/sinh k h, f_v = sinh k(z_s + h)/sinh k h (e^{k z_s} both in deep water),
-    at the Wheeler-stretched z_s of the pressure (module docstring); 0 at a point above the instantaneous surface
-    (in air: a reference point on the mean level has flow under a crest, none under a trough,
-    so its mean drag follows the wave, as the flow's mean above the troughs does; the surface's
-    flow carried up to it would push it back under every trough)."""
+def _kinematics(wave: WaveField, points, t):
+    """What the flow's velocity and acceleration share at ``points`` (..., 3): the phases θ
+    (J, ...), the depth decays f_h, f_v (J, ...) at the Wheeler-stretched z_s, a ω (J, 1…), the
+    heading's cos and sin (J, 1…), and whether each point is under the instantaneous surface
+    (...)."""
     x, y, z = points[..., 0], points[..., 1], points[..., 2]
-    if wave.amplitude.shape[0] == 0:
-        return jnp.zeros(jnp.shape(points))
     th = _phase_rows(wave, x, y, t)                                        # (J, ...)
     shape = (-1,) + (1,) * x.ndim
     a, k = wave.amplitude.reshape(shape), wave.wavenumber.reshape(shape)
@@ -180,11 +186,49 @@ def particle_velocity(wave: WaveField, points, t):
         e, d = jnp.exp(k * zs), 1 - jnp.exp(-2 * k * h)
         fh = e * (1 + jnp.exp(-2 * k * (zs + h))) / d
         fv = e * (1 - jnp.exp(-2 * k * (zs + h))) / d
-    aw = a * wave.omega.reshape(shape)
-    u = jnp.stack([jnp.sum(aw * fh * jnp.cos(th) * jnp.cos(wave.heading).reshape(shape), axis=0),
-                   jnp.sum(aw * fh * jnp.cos(th) * jnp.sin(wave.heading).reshape(shape), axis=0),
+    return (th, fh, fv, a * wave.omega.reshape(shape), jnp.cos(wave.heading).reshape(shape),
+            jnp.sin(wave.heading).reshape(shape), z <= eta)
+
+
+def particle_velocity(wave: WaveField, points, t):
+    """The undisturbed flow's velocity (m/s) at ``points`` (..., 3), inertial axes: linear wave
+    kinematics, each component's
+
+        u_h = a ω f_h(z_s) cos θ (cos β, sin β),   u_z = a ω f_v(z_s) sin θ,
+        θ = k (x cos β + y sin β) − ω t + φ,
+
+    f_h = cosh k(z_s + h)/sinh k h, f_v = sinh k(z_s + h)/sinh k h (e^{k z_s} both in deep water),
+    at the Wheeler-stretched z_s of the pressure (module docstring); 0 at a point above the instantaneous surface
+    (in air: a reference point on the mean level has flow under a crest, none under a trough,
+    so its mean drag follows the wave, as the flow's mean above the troughs does; the surface's
+    flow carried up to it would push it back under every trough)."""
+    if wave.amplitude.shape[0] == 0:
+        return jnp.zeros(jnp.shape(points))
+    th, fh, fv, aw, cb, sb, wet = _kinematics(wave, points, t)
+    c = aw * fh * jnp.cos(th)
+    u = jnp.stack([jnp.sum(c * cb, axis=0), jnp.sum(c * sb, axis=0),
                    jnp.sum(aw * fv * jnp.sin(th), axis=0)], axis=-1)
-    return jnp.where((z <= eta)[..., None], u, 0.0)
+    return jnp.where(wet[..., None], u, 0.0)
+
+
+def particle_acceleration(wave: WaveField, points, t):
+    """The undisturbed flow's local acceleration ∂u/∂t (m/s²) at ``points`` (..., 3), inertial
+    axes, of the linear kinematics of :func:`particle_velocity` (the same f_h, f_v at the same
+    Wheeler-stretched z_s, 0 above the instantaneous surface):
+
+        u̇_h = a ω² f_h(z_s) sin θ (cos β, sin β),   u̇_z = −a ω² f_v(z_s) cos θ.
+
+    Linear theory's: the convective part u·∇u and the stretching's own time derivative (through
+    η(t) in z_s) are second order in ka, the order the stretching itself leaves out. What
+    Morison's inertia term ρ (1 + C_A) V u̇ takes."""
+    if wave.amplitude.shape[0] == 0:
+        return jnp.zeros(jnp.shape(points))
+    th, fh, fv, aw, cb, sb, wet = _kinematics(wave, points, t)
+    w = wave.omega.reshape(aw.shape)
+    s = aw * w * fh * jnp.sin(th)
+    a = jnp.stack([jnp.sum(s * cb, axis=0), jnp.sum(s * sb, axis=0),
+                   -jnp.sum(aw * w * fv * jnp.cos(th), axis=0)], axis=-1)
+    return jnp.where(wet[..., None], a, 0.0)
 
 
 # ------------------------------------------------------------------------------------- the cut

@@ -173,7 +173,9 @@ def stack_cases(load: Load, laid: Sequence[Load]) -> tuple[Load, object]:
             raise ValueError(f"load {type(load).__name__}: its for_run gives the cases arrays of "
                              f"different shapes ({sorted({np.shape(lv[j]) for lv in leaves})}); a "
                              "batch stacks them on one case axis (give the cases one dt and "
-                             "duration, or run them apart)")
+                             "duration, and for a load that reads the sea's components, such as "
+                             "[[morison]], seas of as many components, e.g. all regular; or run "
+                             "them apart with mfm.simulate)")
         return any(not np.array_equal(np.asarray(lv[j]), a0) for lv in leaves[1:])
 
     flags = [differs(j) for j in range(len(leaves[0]))]

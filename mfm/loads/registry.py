@@ -17,6 +17,7 @@ TABLES = {
     "points": ("mfm.loads.probes", "BodyPointOutputs"),
     "wind_thrust": ("mfm.loads.wind", "WindThrust"),
     "catenary_lines": ("mfm.loads.catenary", "CatenaryLines"),
+    "morison": ("mfm.loads.morison", "MorisonElements"),
 }
 
 

@@ -46,6 +46,9 @@ import jax.numpy as jnp
 import numpy as np
 from hydro import phases
 from hydro.seabatch import components_many
+# the ramp and still water of a wave field live beside it: the Morison elements
+# (mfm.loads.morison) ramp their flow as the water does
+from hydro.wetted import ramped as _ramped, still as _still
 
 from .. import host
 from ..backend import device_array
@@ -56,21 +59,6 @@ from .radiation import NoRadiation, grid_subdivisions, strategy, strategy_many
 
 MODES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
 HYDRO_COMPONENTS = ("excitation", "radiation", "added_mass", "hydrostatic", "buoyancy", "drag")
-
-
-def _ramped(wave, T, t):
-    """``wave`` (:class:`hydro.wetted.WaveField`) with its amplitudes ramped at t as the
-    excitation is (:func:`hydro.waves.ramp`: ½(1 − cos πt/T) before T, 1 after; T = 0: 1)."""
-    r = jnp.where(T > 0, 0.5 * (1 - jnp.cos(jnp.pi * jnp.clip(t, 0.0, T) / jnp.where(T > 0, T, 1.0))),
-                  1.0)
-    return type(wave)(wave.amplitude * r, wave.omega, wave.wavenumber, wave.heading, wave.phase,
-                      wave.water_depth)
-
-
-def _still(wave):
-    """``wave`` with no components (still water), its depth kept."""
-    z = jnp.zeros((0,), jnp.float64)
-    return type(wave)(z, z, z, z, z, wave.water_depth)
 
 
 class Hulls(eqx.Module):
