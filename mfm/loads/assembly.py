@@ -214,7 +214,11 @@ def initial_states(model, loads: Sequence[Load]):
     """z₀ (Σ n_states,): each load's :meth:`~mfm.loads.base.Load.initial_state` end to end, put
     on the device from numpy (:func:`mfm.backend.device_array`: eager ``jnp.concatenate`` and
     ``jnp.zeros`` would each compile a small program in every first run)."""
-    parts = [np.asarray(ld.initial_state(model), dtype=np.float64) for ld in loads]
+    parts = [ld.initial_state(model) for ld in loads]
+    if any(isinstance(p, jax.core.Tracer) for p in parts):
+        # inside a trace (a rollout under a user's jit or vmap): the traced states as they are
+        return jnp.concatenate(parts) if parts else jnp.zeros(0)
+    parts = [np.asarray(p, dtype=np.float64) for p in parts]
     return device_array(np.concatenate(parts) if parts else np.zeros(0))
 
 
