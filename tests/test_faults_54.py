@@ -65,7 +65,13 @@ print(json.dumps(dict(programs.COUNTS, misses=len(misses))))
 """
 
 
+# Python's own SIGINT handler set first, as an interpreter started with SIGINT not ignored sets
+# it: a child of a process that ignores SIGINT (a test worker after some suites' clusters)
+# inherits the ignoring, and Python then installs no handler: the interrupt never arrived (the
+# run went to its end in the full suite)
 _INTERRUPTED_RUN = """
+import signal
+signal.signal(signal.SIGINT, signal.default_int_handler)
 import sys, jax, hydro, mfm
 m = mfm.load(%r)
 mfm.simulate(m, hydro.Regular(height=2.5, period=8.0), duration=200.0, dt=0.1, ramp=40.0,
