@@ -570,7 +570,8 @@ def from_capytaine(ds: xr.Dataset, body_names=None, *, source=None) -> xr.Datase
     from a ``cpt.export_dataset`` NetCDF (the split ``complex`` dim is rejoined here). Steps:
     transpose to (omega, influenced_dof, radiating_dof); omega = inf → ``added_mass_inf``, omega = 0
     → ``added_mass_zero``; ``excitation = Froude_Krylov_force + diffraction_force``; the rotation
-    centres → ``reference_point``; ``displaced_volume``, ``center_of_buoyancy``,
+    centres → ``reference_point``; ``mean_drift`` (``hydro.bem.solve(drift=…)``) carried;
+    ``displaced_volume``, ``center_of_buoyancy``,
     ``waterplane_stiffness``, ``hydrostatic_stiffness`` are carried when present (the project's BEM
     generator ``mfm hydro`` writes them with the schema names). A single body's bare dof names
     ("Heave") get the body name (capytaine's ``body`` coordinate, else `body_names`, else "body0").
@@ -662,6 +663,9 @@ def from_capytaine(ds: xr.Dataset, body_names=None, *, source=None) -> xr.Datase
         df = freq(vec(ds["diffraction_force"]).drop_vars(drop, errors="ignore")).astype(complex)
         out["froude_krylov"], out["diffraction"] = fk, df
         out["excitation"] = fk + df
+    if "mean_drift" in ds:
+        out["mean_drift"] = freq(vec(ds["mean_drift"]).drop_vars(drop, errors="ignore")).astype(float)
+        out["mean_drift"].attrs.update(ds["mean_drift"].attrs)
     for name in ("waterplane_stiffness", "hydrostatic_stiffness"):
         if name in ds:
             out[name] = mat(ds[name]).drop_vars(drop, errors="ignore").astype(float)
