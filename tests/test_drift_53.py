@@ -205,3 +205,132 @@ def test_rigid_mass_matrix_kinetic_energy():
         q = np.concatenate([v, w])
         assert 0.5 * q @ M @ q == pytest.approx(T, rel=1e-12)
     np.testing.assert_allclose(M, M.T, atol=1e-12)
+
+
+# ------------------------------------------------------------------------------ the load
+def _drift_db():
+    from hydro.prepare import open_any_database
+
+    return open_any_database(CYLINDER)
+
+
+def test_newman_mean_and_difference_frequencies():
+    """Newman's slow drift of a JONSWAP sea whose frequencies repeat (multiples of 2 pi/T_r):
+    over one repeat period the cross terms average out exactly, so its mean is the spectrum's
+    mean drift sum_j D_j a_j^2 to round-off; its spectrum lies at the difference frequencies
+    |w_j - w_l| <= w_max - w_min (no sum frequency: nothing near 2 w_p); "mean" is that constant."""
+    import hydro
+    from hydro.drift import drift_time_series, mean_drift_of
+
+    db = _drift_db()
+    Tr = 200.0
+    sea = hydro.Jonswap(hs=1.0, tp=2 * np.pi / 2.6, omega_range=(2.05, 3.45), repeat_period=Tr,
+                        frequency_jitter=0.0, seed=4)
+    with pytest.warns(hydro.waves.SeaStateWarning, match="omega_range"):   # the band is cut
+        comps = sea.components()                                           # to the database's
+    assert comps.repeat_period == pytest.approx(Tr)
+    n = 8192
+    t = Tr * np.arange(n) / n
+    F = drift_time_series(db, comps, t, mode="newman")
+    mean = mean_drift_of(db, comps)
+    surge = 0
+    assert mean[surge] > 0
+    assert F[:, surge].mean() == pytest.approx(mean[surge], rel=1e-10)
+    F_mean = drift_time_series(db, comps, t, mode="mean")
+    np.testing.assert_allclose(F_mean, np.broadcast_to(mean, F_mean.shape), rtol=1e-13)
+    spec = np.abs(np.fft.rfft(F[:, surge] - F[:, surge].mean())) ** 2
+    w = 2 * np.pi * np.fft.rfftfreq(n, Tr / n)
+    band = comps.omega.max() - comps.omega.min()
+    assert spec[w > band + 1e-9].sum() < 1e-20 * spec.sum()
+    assert spec.sum() > 0                                          # it does vary slowly
+    # heave, roll, pitch: 0 in the database, 0 here
+    assert np.all(F[:, 2:5] == 0)
+
+
+def test_regular_wave_newman_is_the_mean_drift():
+    import hydro
+    from hydro.drift import drift_time_series
+
+    db = _drift_db()
+    a = 0.3
+    comps = hydro.Regular(height=2 * a, period=2 * np.pi / 2.5).components()
+    D = float(db["mean_drift"].sel(omega=2.5, wave_direction=0.0, influenced_dof="cylinder__Surge"))
+    t = np.linspace(0.0, 10.0, 101)
+    for mode in ("mean", "newman"):
+        F = drift_time_series(db, comps, t, mode=mode)
+        np.testing.assert_allclose(F[:, 0], D * a * a, rtol=1e-13)
+    # between the database's frequencies: linear interpolation of D
+    comps = hydro.Regular(height=2 * a, period=2 * np.pi / 2.75).components()
+    Dm = db["mean_drift"].sel(wave_direction=0.0, influenced_dof="cylinder__Surge")
+    expected = 0.5 * (float(Dm.sel(omega=2.5)) + float(Dm.sel(omega=3.0))) * a * a
+    assert drift_time_series(db, comps, t, mode="mean")[0, 0] == pytest.approx(expected, rel=1e-12)
+    with pytest.raises(ValueError, match="drift mode 'slow'"):
+        drift_time_series(db, comps, t, mode="slow")
+    with pytest.raises(KeyError, match="mean drift force per unit wave amplitude squared"):
+        drift_time_series(db.drop_vars("mean_drift"), comps, t, mode="mean")
+
+
+def _moored_cylinder(drift):
+    """The drift check's cylinder (R 1 m, draft 8 m, its own mass) free in surge on a spring."""
+    import mfm
+
+    m = 1000.0 * np.pi * 8.0
+    cfg = {"model": {"name": "moored cylinder", "gravity": 9.81},
+           "bodies": [{"name": "cylinder", "mass": m, "com": [0.0, 0.0, 0.0],
+                       "principal_inertia": [1e5, 1e5, 1e4],
+                       "joint": {"type": "free", "dofs": ["surge"], "stiffness": [2000.0]}}],
+           "hydro": {"database": str(CYLINDER), "drift": drift}}
+    return mfm.load(cfg)
+
+
+def test_regular_wave_mean_drift_applied_through_the_water():
+    """[hydro] drift = "mean" in a regular wave: the applied drift_force (recorded) is D a^2 at
+    every sample after the ramp (to round-off: a constant table), and over the ramp it rises as
+    the excitation's ramp; the run with drift against the one without differs by that force."""
+    import hydro
+    import mfm
+    from hydro.waves import ramp
+
+    a, w = 0.2, 2.5
+    sea = hydro.Regular(height=2 * a, period=2 * np.pi / w)
+    D = float(_drift_db()["mean_drift"].sel(omega=w, wave_direction=0.0,
+                                            influenced_dof="cylinder__Surge"))
+    dt, T_ramp = 0.05, 5.0
+    res = mfm.simulate(_moored_cylinder("mean"), sea, duration=20.0, dt=dt, ramp=T_ramp,
+                       check_stability=False)
+    F = res["drift_force"].sel(hydro_dof="cylinder__Surge").values
+    t = res["time"].values
+    np.testing.assert_allclose(F, D * a * a * ramp(t, T_ramp), rtol=1e-12, atol=1e-12 * D * a * a)
+    after = t >= T_ramp
+    # the mean over whole periods after the ramp: D a^2
+    per = int(round(2 * np.pi / w / dt))
+    assert F[after][: per * (after.sum() // per)].mean() == pytest.approx(D * a * a, rel=1e-12)
+    assert "drift_force" not in mfm.simulate(_moored_cylinder("off"), sea, duration=1.0, dt=dt,
+                                             check_stability=False)
+
+
+def test_drift_is_above_linear_for_reduce():
+    """mfm.reduce's reference: a model with drift is above linear; its linear water has none."""
+    from mfm.studies.fidelity import above_linear, linear_water
+
+    model = _moored_cylinder("newman")
+    assert above_linear(model) and model.hydro.drift == "newman"
+    lin = linear_water(model)
+    assert not above_linear(lin) and getattr(lin.hydro, "drift", "off") == "off"
+    assert not above_linear(_moored_cylinder("off"))
+
+
+@pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
+def test_drift_setting_errors():
+    import mfm
+    from mfm.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="hydro.drift: 'slow'"):
+        _moored_cylinder("slow")
+    cfg = {"model": {"name": "x"},
+           "bodies": [{"name": "float", "mass": 727010.0, "com": [0.0, 0.0, -0.72],
+                       "principal_inertia": [2e7, 2e7, 3.7e7],
+                       "joint": {"type": "free", "dofs": ["heave"]}}],
+           "hydro": {"database": str(RM3 / "rm3.out"), "names": ["float", "spar"], "drift": "mean"}}
+    with pytest.raises(ConfigError, match="needs the database's mean_drift"):
+        mfm.load(cfg)
