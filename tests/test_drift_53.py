@@ -345,3 +345,26 @@ def test_drift_setting_errors():
            "hydro": {"database": str(RM3 / "rm3.out"), "names": ["float", "spar"], "drift": "mean"}}
     with pytest.raises(ConfigError, match="needs the database's mean_drift"):
         mfm.load(cfg)
+
+
+def test_free_drift_against_capytaines_own_pipeline():
+    """hydro.bem.solve(drift="free") of a cylinder off the origin (reference point (2, 1) m,
+    unequal roll and pitch inertias, headings 0 and 30 degrees) against capytaine 3.0's own chain
+    on the same body (tools/drift_free_check.py: fill_dataset with theta, post_pro.rao,
+    far_field_mean_drift_force): the same numbers to round-off (1e-9 of the largest: the same
+    operations in another order), the yaw moment after moving capytaine's, about the origin, to
+    the reference point: M_r = M_0 - (x_r F_y - y_r F_x)."""
+    from hydro import bem
+
+    ds = bem.load(Path(__file__).resolve().parents[1] / "hydro" / "data" / "drift_free_check.nc")
+    fin = np.isfinite(ds["omega"].values)
+    ours = ds["mean_drift"].values[fin]
+    ref = ds["mean_drift_capytaine"].values[fin]
+    assert "free" in ds["mean_drift"].attrs["motions"]
+    scale = np.max(np.abs(ref[..., :2]))
+    np.testing.assert_allclose(ours[..., :2], ref[..., :2], rtol=0, atol=1e-9 * scale)
+    x_r, y_r = ds["reference_point"].values[0, :2]
+    moved = ref[..., 5] - (x_r * ref[..., 1] - y_r * ref[..., 0])
+    np.testing.assert_allclose(ours[..., 5], moved, rtol=0, atol=1e-9 * np.max(np.abs(moved)))
+    assert np.max(np.abs(ours[..., 5])) < 0.2 * np.max(np.abs(ref[..., 5]))   # the move matters
+    assert np.all(ours[..., 2:5] == 0)
