@@ -368,3 +368,28 @@ def test_free_drift_against_capytaines_own_pipeline():
     np.testing.assert_allclose(ours[..., 5], moved, rtol=0, atol=1e-9 * np.max(np.abs(moved)))
     assert np.max(np.abs(ours[..., 5])) < 0.2 * np.max(np.abs(ref[..., 5]))   # the move matters
     assert np.all(ours[..., 2:5] == 0)
+
+
+def test_mfm_info_says_the_drift(tmp_path, capsys):
+    from mfm_cli import main
+
+    cfg = tmp_path / "moored.toml"
+    cfg.write_text(f"""[model]
+name = "moored cylinder"
+[hydro]
+database = "{CYLINDER}"
+drift = "newman"
+[[bodies]]
+name = "cylinder"
+mass = 25132.74
+com = [0.0, 0.0, 0.0]
+principal_inertia = [1e5, 1e5, 1e4]
+[bodies.joint]
+type = "free"
+dofs = ["surge"]
+stiffness = [2e4]
+""")
+    assert main(["info", str(cfg), "--no-restoring"]) == 0
+    out = capsys.readouterr().out
+    assert "mean wave drift: far field" in out and "motions fixed" in out
+    assert "applied ([hydro] drift = 'newman')" in out
