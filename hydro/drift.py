@@ -23,9 +23,11 @@ Limits (say them where the force is used): valid for the slow drift of soft-moor
 natural periods (surge, sway, yaw on the moorings) are long against the wave periods, so that
 only the QTF near its diagonal (small ω_j − ω_l) matters; no sum-frequency terms (springing,
 ringing of stiff systems); D is that of the body at rest at its mean heading (its offset and yaw
-do not change the coefficients: no wave-drift damping), for the motions the database's drift
+do not change the coefficients: no wave-drift damping) and of the motions the database's drift
 was computed with (``mean_drift.attrs["motions"]``: fixed, or freely floating with a given
-inertia), not the model's own motions; no current.
+inertia), not the model's own motions; with directional spreading, pairs of components of
+different headings take the same sgn(D_j) √(|D_j| |D_l|) (the bidirectional QTF is not known);
+no current.
 
 r(t) is the start-up ramp of :func:`hydro.waves.ramp`, applied to the force as the excitation's
 is applied to the excitation (so a ramped regular wave's drift rises over the ramp to D a²).
