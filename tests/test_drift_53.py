@@ -393,3 +393,49 @@ stiffness = [2e4]
     out = capsys.readouterr().out
     assert "mean wave drift: far field" in out and "motions fixed" in out
     assert "applied ([hydro] drift = 'newman')" in out
+
+
+def _rm3_float_alone(tmp_path):
+    """RM3's WAMIT set cut to its first body (the float): the .out's first body block, the .1,
+    .3 and .hst rows of modes 1-6 (a single-body set, where WAMIT's .8 is the body's own drift)."""
+    text = (RM3 / "rm3.out").read_text()
+    head, first = text.split("Body number: N=")[:2]
+    (tmp_path / "f.out").write_text(head + "Body number: N=" + first)
+    for ext, cols in (("1", slice(1, 3)), ("3", slice(2, 3)), ("hst", slice(0, 2))):
+        keep = []
+        for line in (RM3 / f"rm3.{ext}").read_text().splitlines():
+            parts = line.split()
+            try:
+                modes = [int(p) for p in parts[cols]]
+                assert modes
+            except (ValueError, AssertionError):
+                keep.append(line)                          # the header
+                continue
+            if max(modes) <= 6:
+                keep.append(line)
+        (tmp_path / f"f.{ext}").write_text("\n".join(keep) + "\n")
+    return tmp_path / "f"
+
+
+def test_wamit_single_body_momentum_drift(tmp_path):
+    """A single body's .8 (far field) is read by "auto" before its .9; "pressure" reads the .9."""
+    stem = _rm3_float_alone(tmp_path)
+    base = read_wamit(stem, body_names=["float"])
+    assert base.sizes["influenced_dof"] == 6
+    om, beta = base["omega"].values, base["wave_direction"].values
+    rho, g = float(base.attrs["rho"]), float(base.attrs["g"])
+    far = np.random.default_rng(8).normal(size=(len(om), len(beta), 3)) * 1e3
+    _capytaine_drift_file(tmp_path / "f.8", om, beta, far, rho=rho, g=g, L=1.0)
+    _capytaine_drift_file(tmp_path / "f.9", om, beta, 2 * far, rho=rho, g=g, L=1.0)
+    db = validate(read_wamit(stem, body_names=["float"]), warn=False)
+    assert "far field" in db["mean_drift"].attrs["method"]
+    np.testing.assert_allclose(db["mean_drift"].sel(influenced_dof=["float__Surge", "float__Sway",
+                                                                    "float__Yaw"]).values,
+                               far, rtol=2e-6)
+    near = read_wamit(stem, body_names=["float"], drift="pressure")["mean_drift"]
+    assert "near field" in near.attrs["method"]
+    np.testing.assert_allclose(near.sel(influenced_dof="float__Surge").values, 2 * far[..., 0],
+                               rtol=2e-6)
+    (tmp_path / "f.9").unlink()
+    with pytest.raises(FileNotFoundError, match="drift='pressure' needs the WAMIT .9"):
+        read_wamit(stem, drift="pressure")
