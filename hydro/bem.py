@@ -14,6 +14,8 @@ schema variables of the mfm hydro database:
 - ``hydrostatic_stiffness(influenced_dof, radiating_dof)``: buoyancy only, block diagonal: the
   water-plane terms + ρgV(z_B − z_r) in C44, C55 and C46 = −ρgV(x_B − x_r), C56 = −ρgV(y_B − y_r);
   no weight terms (the masses are not inputs here).
+- ``mean_drift(omega, wave_direction, influenced_dof)`` only with ``drift=``: capytaine's far-field
+  mean drift of a single body, held or freely floating (:func:`_far_field_drift`).
 
 Settings: lid on the water plane against irregular frequencies; ω = ∞ (radiation only) appended
 when ``infinite_frequency``; finite or infinite depth; symmetry "auto" uses the rotation symmetry
