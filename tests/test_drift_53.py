@@ -439,3 +439,23 @@ def test_wamit_single_body_momentum_drift(tmp_path):
     (tmp_path / "f.9").unlink()
     with pytest.raises(FileNotFoundError, match="drift='pressure' needs the WAMIT .9"):
         read_wamit(stem, drift="pressure")
+
+
+def test_newman_through_the_water_is_the_hydro_series():
+    """[hydro] drift = "newman" in an irregular sea through mfm.simulate: the recorded drift_force
+    at the samples is hydro.drift.drift_time_series of the same components at those times (the
+    table is sampled on the run's stages: the samples fall on it, to round-off)."""
+    import hydro
+    import mfm
+    from hydro.drift import drift_time_series
+
+    sea = hydro.Jonswap(hs=0.3, tp=2 * np.pi / 2.6, omega_range=(2.05, 3.45), seed=2)
+    model = _moored_cylinder("newman")
+    with pytest.warns(hydro.waves.SeaStateWarning, match="omega_range"):
+        res = mfm.simulate(model, sea, duration=10.0, dt=0.05, ramp=2.0, check_stability=False)
+        comps = sea.components(water_depth=model.hydro.water_depth, g=model.hydro.g)
+    t = res["time"].values
+    F = drift_time_series(model.hydro.database(), comps, t, mode="newman", ramp_duration=2.0)
+    got = res["drift_force"].values
+    np.testing.assert_allclose(got, F, rtol=0, atol=1e-10 * np.abs(F).max())
+    assert np.ptp(got[t > 2.0, 0]) > 0.1 * np.abs(got[t > 2.0, 0]).mean()     # it varies
