@@ -18,6 +18,9 @@ from hydro.seabatch import components_many  # noqa: E402,F401
 from hydro.excitation import (  # noqa: E402,F401
     excitation_coefficients, excitation_dataarray, excitation_time_series,
 )
+# second order: the mean and Newman's slow wave drift force from a database's mean_drift
+from hydro import drift  # noqa: E402,F401
+from hydro.drift import drift_time_series, mean_drift_of  # noqa: E402,F401
 
 # BEM databases from capytaine (capytaine itself is imported lazily inside them).
 from hydro import bem, geometry  # noqa: E402,F401

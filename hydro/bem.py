@@ -14,6 +14,8 @@ schema variables of the mfm hydro database:
 - ``hydrostatic_stiffness(influenced_dof, radiating_dof)``: buoyancy only, block diagonal: the
   water-plane terms + ρgV(z_B − z_r) in C44, C55 and C46 = −ρgV(x_B − x_r), C56 = −ρgV(y_B − y_r);
   no weight terms (the masses are not inputs here).
+- ``mean_drift(omega, wave_direction, influenced_dof)`` only with ``drift=``: capytaine's far-field
+  mean drift of a single body, held or freely floating (:func:`_far_field_drift`).
 
 Settings: lid on the water plane against irregular frequencies; ω = ∞ (radiation only) appended
 when ``infinite_frequency``; finite or infinite depth; symmetry "auto" uses the rotation symmetry
@@ -343,7 +345,8 @@ def build_body(specs, dx, *, lid=True, symmetry="auto"):
 # Solving
 
 
-def _solve_problems(body, omegas, directions, *, water_depth, rho, g, progress, n_threads):
+def _solve_problems(body, omegas, directions, *, water_depth, rho, g, progress, n_threads,
+                    keep_details=False):
     """Radiation (all dofs) and diffraction (all headings, finite ω only) problems, solved one
     frequency at a time so that the LU factorisation is shared by the problems of one ω.
     ``water_depth``: one depth, or one per ω (finite depth where it matters, deep water above)."""
@@ -366,7 +369,7 @@ def _solve_problems(body, omegas, directions, *, water_depth, rho, g, progress, 
     results = []
     for pbs in tqdm(groups, desc="BEM frequencies", unit="ω", disable=not progress):
         results += solver.solve_all(pbs, progress_bar=False, n_threads=n_threads,
-                                    _check_wavelength=False)
+                                    _check_wavelength=False, keep_details=keep_details)
     return solver, results
 
 
@@ -383,6 +386,109 @@ def _warn_once(problems):
         _check_wavelength_and_mesh_resolution(problems)
         _check_wavelength_and_water_depth(problems)
         _check_wavelength_and_irregular_frequencies(problems)
+
+
+# ------------------------------------------------------------------------------------------------
+# Mean drift (far field)
+
+DRIFT_MOTIONS = ("fixed", "free")
+#: Kochin functions are evaluated on this many directions over the circle (1°): the far-field
+#: integral ∫|H|² cos θ dθ is a trapezoid sum of a smooth periodic function, exact to round-off
+#: long before 1° for the bodies here (kR < 10)
+DRIFT_N_THETA = 360
+
+
+def rigid_mass_matrix(mass, com, inertia, reference_point):
+    """The 6×6 rigid-body mass matrix about `reference_point` (inertial axes): [[m I, −m S(r)],
+    [m S(r), J + m (|r|² I − r rᵀ)]] with r = com − reference_point, S(r) the cross-product
+    matrix (S(r) v = r × v) and J (3×3) the inertia about the centre of mass."""
+    r = np.asarray(com, float) - np.asarray(reference_point, float)
+    S = np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
+    M = np.zeros((6, 6))
+    M[:3, :3] = mass * np.eye(3)
+    M[:3, 3:] = -mass * S
+    M[3:, :3] = mass * S
+    M[3:, 3:] = np.asarray(inertia, float) + mass * (r @ r * np.eye(3) - np.outer(r, r))
+    return M
+
+
+def gravity_stiffness(mass, com, reference_point, g):
+    """The weight's part of the linear restoring matrix about `reference_point` (the buoyancy's
+    part is ``hydrostatic_stiffness``): C44 = C55 = −m g (z_G − z_r), C46 = m g (x_G − x_r),
+    C56 = m g (y_G − y_r) (WAMIT's convention, hydro.wamit)."""
+    r = np.asarray(com, float) - np.asarray(reference_point, float)
+    C = np.zeros((6, 6))
+    C[3, 3] = C[4, 4] = -mass * g * r[2]
+    C[3, 5] = mass * g * r[0]
+    C[4, 5] = mass * g * r[1]
+    return C
+
+
+def _far_field_drift(ds, results, directions, *, motions, inertia, reference_point, rho, g):
+    """``mean_drift`` (omega, wave_direction, influenced_dof) of ONE body by capytaine 3.0's
+    far-field formula (``capytaine.post_pro.far_field_mean_drift_force``: Maruo's momentum flux
+    for surge and sway, Newman's for yaw, from the Kochin functions of the diffraction and the
+    radiation potentials; Delhommeau's thesis eq. 2.170), per unit wave amplitude squared.
+
+    motions "fixed": the body held (diffraction only); "free": freely floating,
+    X = [−ω²(M + A) − iωB + C]⁻¹ F with M the rigid mass matrix of `inertia` (mass, com, inertia
+    about the CoM) and C = hydrostatic_stiffness + the weight's terms. Heave, roll, pitch are 0
+    (the far field gives the horizontal plane only). The yaw moment is moved from the Kochin
+    functions' origin (x, y) = (0, 0) to `reference_point`: M_r = M_0 − (x_r F_y − y_r F_x).
+    NaN at ω = ∞ (as the excitation)."""
+    import capytaine as cpt
+    from capytaine.post_pro.kochin import compute_kochin
+
+    dtheta = 2 * np.pi / DRIFT_N_THETA
+    # capytaine wants θ beyond [0, 2π] on both sides and every heading strictly inside
+    theta = dtheta * np.arange(-1, DRIFT_N_THETA + 2)
+    betas = np.mod(np.asarray(directions, float), 2 * np.pi)
+    om_all = np.asarray(ds["omega"].values, float)
+    dofs = [str(d) for d in ds["radiating_dof"].values]
+    if ([d.split("__")[-1] for d in dofs] != list(geo.MODES)
+            or [str(d) for d in ds["influenced_dof"].values] != dofs):
+        # M and C below are in MODES order
+        raise RuntimeError(f"capytaine's dofs {dofs} are not the rigid modes {geo.MODES} in order")
+    out = np.full((om_all.size, len(directions), 6), np.nan)
+    for iw, w in enumerate(om_all):
+        if not np.isfinite(w):
+            continue
+        rad = {str(r.radiating_dof): r for r in results
+               if isinstance(r.problem, cpt.RadiationProblem) and float(r.omega) == w}
+        dif = {float(r.wave_direction): r for r in results
+               if isinstance(r.problem, cpt.DiffractionProblem) and float(r.omega) == w}
+        any_r = next(iter(dif.values()))
+        h = float(any_r.water_depth)
+        Hd = np.array([compute_kochin(dif[float(b)], theta) for b in directions])
+        Hr = np.array([compute_kochin(rad[d], theta) for d in dofs])
+        if motions == "free":
+            M = rigid_mass_matrix(inertia["mass"], inertia["com"], inertia["inertia"], reference_point)
+            C = (np.asarray(ds["hydrostatic_stiffness"].values, float)
+                 + gravity_stiffness(inertia["mass"], inertia["com"], reference_point, g))
+            A = np.asarray(ds["added_mass"].values[iw], float)
+            B = np.asarray(ds["radiation_damping"].values[iw], float)
+            F = np.asarray(ds["excitation_force"].sel(omega=w).transpose(
+                "wave_direction", "influenced_dof").values, complex)
+            Z = -w * w * (M + A) - 1j * w * B + C
+            X = np.linalg.solve(Z, F.T).T                     # (n_β, 6), m or rad per m of wave
+        else:
+            X = np.zeros((len(directions), len(dofs)), complex)
+        data = xr.Dataset(
+            {"kochin_diffraction": (("omega", "wave_direction", "theta"), Hd[None]),
+             "kochin_radiation": (("omega", "radiating_dof", "theta"), Hr[None])},
+            coords={"omega": [w], "wavenumber": ("omega", [float(any_r.wavenumber)]),
+                    "water_depth": h, "rho": rho, "g": g, "theta": theta,
+                    "wave_direction": betas, "radiating_dof": dofs})
+        Xda = xr.DataArray(X[None], dims=("omega", "wave_direction", "radiating_dof"),
+                           coords={"omega": [w], "wave_direction": betas, "radiating_dof": dofs})
+        f = cpt.post_pro.far_field_mean_drift_force(Xda, data)
+        diag = lambda v: np.real(np.diagonal(f[v].values[0]))          # noqa: E731  β_k = β_l
+        fx, fy, mz = diag("drift_force_surge"), diag("drift_force_sway"), diag("drift_force_yaw")
+        xr_, yr_ = float(reference_point[0]), float(reference_point[1])
+        out[iw, :, 0], out[iw, :, 1] = fx, fy
+        out[iw, :, 5] = mz - (xr_ * fy - yr_ * fx)
+        out[iw, :, 2:5] = 0.0
+    return out
 
 
 def _block_diag(blocks):
@@ -427,7 +533,7 @@ def _augment(ds, specs, hulls, *, rho, g):
 
 def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=1000.0, g=9.81,
           lid=True, symmetry="auto", infinite_frequency=True, cache_dir=None, cache=True,
-          progress=True, n_threads=None, deep_water_kh=None):
+          progress=True, n_threads=None, deep_water_kh=None, drift=None, drift_inertia=None):
     """Radiation and diffraction of a layout of rigid bodies, all solved together.
 
     Parameters
@@ -449,6 +555,11 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
     cache_dir, cache : where the NetCDF results are kept; ``cache=False`` always solves.
     progress : tqdm progress bar over the frequencies.
     n_threads : threads per solve (None: capytaine's default, all cores).
+    drift : None, or "fixed" / "free": also the far-field mean drift ``mean_drift`` of a single
+        body (:func:`_far_field_drift`), with the body held ("fixed") or freely floating ("free",
+        which needs ``drift_inertia`` = {"mass": kg, "com": [x, y, z] m, "inertia": 3×3 kg m²
+        about the CoM}). A layout of several bodies is refused: the far field gives the total
+        force on all of them, not each body's.
 
     Returns
     -------
@@ -470,6 +581,25 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
     g = _check_positive("g", g)
     if deep_water_kh is not None:
         deep_water_kh = _check_positive("deep_water_kh", deep_water_kh)
+    if drift not in (None, *DRIFT_MOTIONS):
+        raise ValueError(f"drift = {drift!r}: expected None, 'fixed' or 'free'.")
+    if drift is not None and len(specs) != 1:
+        raise ValueError(f"drift = {drift!r} with {len(specs)} bodies: capytaine's far-field mean "
+                         "drift is the total force on all bodies together, not each body's; solve "
+                         "the drift of one body at a time (or leave drift unset)")
+    if drift == "free":
+        try:
+            drift_inertia = {"mass": _check_positive("drift_inertia['mass']", drift_inertia["mass"]),
+                             "com": [float(v) for v in drift_inertia["com"]],
+                             "inertia": np.asarray(drift_inertia["inertia"], float).tolist()}
+        except (TypeError, KeyError) as e:
+            raise ValueError(f"drift = 'free' needs drift_inertia = {{'mass': kg, 'com': [x, y, z], "
+                             f"'inertia': 3x3 about the CoM}}; got {drift_inertia!r} ({e})") from None
+        if len(drift_inertia["com"]) != 3 or np.shape(drift_inertia["inertia"]) != (3, 3):
+            raise ValueError(f"drift_inertia: com must have 3 coordinates and inertia be 3x3; got "
+                             f"{drift_inertia!r}")
+    elif drift_inertia is not None:
+        raise ValueError(f"drift_inertia is only for drift = 'free' (drift = {drift!r})")
     if symmetry not in ("auto", "xOz", "rotation", "none", None, False):
         raise ValueError(f"symmetry = {symmetry!r}: expected 'auto', 'xOz', 'rotation' or 'none'.")
     symmetry = "none" if symmetry in (None, False) else symmetry
@@ -483,6 +613,8 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
                 "wave_directions": [float(b) for b in directions],
                 "water_depth": water_depth, "rho": rho, "g": g, "dx": dx, "lid": bool(lid),
                 "symmetry": symmetry, "infinite_frequency": bool(infinite_frequency)}
+    if drift is not None:              # only then: the cache keys of every other solve unchanged
+        settings["drift"] = {"motions": drift, "inertia": drift_inertia, "n_theta": DRIFT_N_THETA}
     deep_from = math.inf  # the lowest ω solved in deep water
     if deep_water_kh is not None and math.isfinite(water_depth):
         settings["deep_water_kh"] = deep_water_kh
@@ -507,7 +639,8 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
     split = deep_water_kh is not None and math.isfinite(water_depth)
     depths = [np.inf if split and w >= deep_from else water_depth for w in all_w]
     solver, results = _solve_problems(body, all_w, directions, water_depth=depths, rho=rho,
-                                      g=g, progress=progress, n_threads=n_threads)
+                                      g=g, progress=progress, n_threads=n_threads,
+                                      keep_details=drift is not None)
     # capytaine warns that a layout body has no unique rotation centre while it fills its
     # `rotation_center` coordinate; we drop that coordinate for `reference_point(body, axis)`.
     cpt_log = logging.getLogger("capytaine.bodies.bodies")
@@ -530,6 +663,19 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
     finally:
         cpt_log.setLevel(level)
     ds = _augment(ds, specs, hulls, rho=rho, g=g)
+    if drift is not None:
+        D = _far_field_drift(ds, results, directions, motions=drift, inertia=drift_inertia,
+                             reference_point=specs[0]["reference_point"], rho=rho, g=g)
+        ds["mean_drift"] = xr.DataArray(
+            D, dims=("omega", "wave_direction", "influenced_dof"),
+            coords={"influenced_dof": [f"{specs[0]['name']}__{m}" for m in geo.MODES]},
+            attrs={"units": "N/m^2 (forces), N m/m^2 (moments): mean force per unit wave "
+                            "amplitude squared, at the body's reference_point",
+                   "method": "far field (capytaine.post_pro.far_field_mean_drift_force, Kochin "
+                             f"functions on {DRIFT_N_THETA} directions)",
+                   "motions": drift if drift == "fixed" else
+                   f"free: {json.dumps(drift_inertia)}",
+                   "dofs": ", ".join(f"{specs[0]['name']}__{m}" for m in ("Surge", "Sway", "Yaw"))})
     _check_finite(ds)
     n_hull = body.mesh.nb_faces
     n_lid = 0 if body.lid_mesh is None else body.lid_mesh.nb_faces

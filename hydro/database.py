@@ -20,6 +20,16 @@ Data variables (dims in this order)
     hydrostatic_stiffness (influenced_dof, radiating_dof)    as the source gives it (attrs say)
     waterplane_stiffness (influenced_dof, radiating_dof)     only the linear water-plane terms
     displaced_volume (body) m^3; center_of_buoyancy (body, axis) m; reference_point (body, axis) m
+    mean_drift (omega, wave_direction, influenced_dof)       optional, real: the mean (second-order)
+        wave drift force per unit wave amplitude squared, D_i(omega, beta): a regular wave of
+        amplitude a, frequency omega and heading beta pushes dof i with the steady force
+        F_i = D_i a^2 (N/m^2 for translations, N m/m^2 for rotations), along +x/+y/+z (about
+        the axes for moments) at the body's reference_point, inertial axes. It depends on the
+        body's first-order motions: the attrs say which (``motions``: "fixed" = diffraction only,
+        or "free" = the bodies freely floating with the inertia the attrs name), how (``method``:
+        "far field" (momentum, Maruo/Newman: surge, sway, yaw only) or "near field" (pressure
+        integration)) and which dofs it gives (``dofs``, comma-separated dof labels: the others
+        are 0, not computed)
 Attributes
     rho (kg/m^3), g (m/s^2), water_depth (m, inf = deep), convention = "exp(-i omega t)",
     source, and provenance strings.
@@ -61,6 +71,7 @@ OPTIONAL = {
     "froude_krylov": EXCITATION_DIMS,
     "diffraction": EXCITATION_DIMS,
     "hydrostatic_stiffness": MATRIX_DIMS,
+    "mean_drift": EXCITATION_DIMS,
 }
 REQUIRED_ATTRS = ("rho", "g", "water_depth")
 
@@ -168,6 +179,11 @@ def validate(db: xr.Dataset, bodies=None, *, sym_rtol: float = 0.05,
     if not np.iscomplexobj(db["excitation"].values):
         raise ValueError("variable 'excitation' must be complex; if it was read from NetCDF with a "
                          "'complex' dim, open it with hydro.database.open_database.")
+    if "mean_drift" in db and np.iscomplexobj(db["mean_drift"].values):
+        raise ValueError("variable 'mean_drift' must be real (the mean force per unit amplitude "
+                         "squared, N/m^2); a complex one is a transfer function of two headings "
+                         "or frequencies (a QTF): keep its real part at beta_1 = beta_2 only if "
+                         "its imaginary part is round-off.")
     if bodies is not None:
         _check_bodies(db, [bodies] if isinstance(bodies, str) else list(bodies))
     _check_finite(db, om)
@@ -554,7 +570,8 @@ def from_capytaine(ds: xr.Dataset, body_names=None, *, source=None) -> xr.Datase
     from a ``cpt.export_dataset`` NetCDF (the split ``complex`` dim is rejoined here). Steps:
     transpose to (omega, influenced_dof, radiating_dof); omega = inf → ``added_mass_inf``, omega = 0
     → ``added_mass_zero``; ``excitation = Froude_Krylov_force + diffraction_force``; the rotation
-    centres → ``reference_point``; ``displaced_volume``, ``center_of_buoyancy``,
+    centres → ``reference_point``; ``mean_drift`` (``hydro.bem.solve(drift=…)``) carried;
+    ``displaced_volume``, ``center_of_buoyancy``,
     ``waterplane_stiffness``, ``hydrostatic_stiffness`` are carried when present (the project's BEM
     generator ``mfm hydro`` writes them with the schema names). A single body's bare dof names
     ("Heave") get the body name (capytaine's ``body`` coordinate, else `body_names`, else "body0").
@@ -646,6 +663,9 @@ def from_capytaine(ds: xr.Dataset, body_names=None, *, source=None) -> xr.Datase
         df = freq(vec(ds["diffraction_force"]).drop_vars(drop, errors="ignore")).astype(complex)
         out["froude_krylov"], out["diffraction"] = fk, df
         out["excitation"] = fk + df
+    if "mean_drift" in ds:
+        out["mean_drift"] = freq(vec(ds["mean_drift"]).drop_vars(drop, errors="ignore")).astype(float)
+        out["mean_drift"].attrs.update(ds["mean_drift"].attrs)
     for name in ("waterplane_stiffness", "hydrostatic_stiffness"):
         if name in ds:
             out[name] = mat(ds[name]).drop_vars(drop, errors="ignore").astype(float)

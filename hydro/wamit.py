@@ -1,4 +1,5 @@
-"""Reader of WAMIT output (.1, .3, .hst, .out) into the internal hydro database.
+"""Reader of WAMIT output (.1, .3, .hst, .out, and the mean drift .8 / .9) into the internal
+hydro database.
 
 Non-dimensionalisation (WAMIT user manual, "Definitions of nondimensional quantities"), with
 L = ULEN and k, m set by the modes (translations 1–3, rotations 4–6 of each body):
@@ -7,6 +8,17 @@ L = ULEN and k, m set by the modes (translations 1–3, rotations 4–6 of each 
                                                               translations / mixed / both rotations
     X_i  = rho g a L^m X̄_i,     m = 2 (force), 3 (moment)   (a: wave amplitude, here 1 m)
     C_ij = rho g L^k C̄_ij,      k = 2, 3, 4 for 0, 1, 2 rotational modes among (i, j)
+    D_i  = rho g L^k D̄_i,       k = 1 (force), 2 (moment)   (mean drift per unit amplitude²:
+                                                              F_i = rho g a² L^k D̄_i)
+
+Mean drift (WAMIT manual, numeric output files .8 "momentum" (far field: surge, sway, yaw only;
+the force on all bodies together) and .9 "pressure" (near field, every mode of every body)): rows
+``PER BETA1 BETA2 I Mod Pha Re Im``, the mean force of the bichromatic pair of headings β1, β2
+(degrees) at one frequency. Only the rows with β1 = β2 are read (the unidirectional mean drift,
+real: its Im is round-off); they become ``mean_drift`` (omega, wave_direction, influenced_dof),
+N/m² and N m/m², the mean force on the body (WAMIT's sign: along the mode's axis) with the
+motions WAMIT solved for (freely floating or fixed: the .out's run, recorded in the attrs as
+"as in the WAMIT run"). Modes a file does not give are 0 (the attrs list the given ones).
 
 Period conventions of the .1 file: period −1 is the zero-frequency limit (A_0, "Wave period =
 infinite" in the .out), period 0 the infinite-frequency limit (A_inf, "Wave period = zero"); the
@@ -58,9 +70,10 @@ def _paths(stem_or_paths):
         paths = {k.lstrip("."): Path(v) for k, v in stem_or_paths.items()}
     else:
         stem = Path(stem_or_paths)
-        if stem.suffix in (".1", ".3", ".hst", ".out"):
+        if stem.suffix in (".1", ".3", ".hst", ".out", ".8", ".9"):
             stem = stem.with_suffix("")
-        paths = {ext: stem.with_name(stem.name + "." + ext) for ext in ("1", "3", "hst", "out")}
+        paths = {ext: stem.with_name(stem.name + "." + ext)
+                 for ext in ("1", "3", "hst", "out", "8", "9")}
     for ext in ("1", "out"):
         if ext not in paths or not paths[ext].is_file():
             raise FileNotFoundError(f"WAMIT file .{ext} not found ({paths.get(ext)}); read_wamit needs "
@@ -162,16 +175,22 @@ def _k_matrix(n):
 
 
 def read_wamit(stem_or_paths, rho: float = 1000.0, g: float = 9.81, body_names=None, *,
-               first_column: str = "period") -> xr.Dataset:
+               first_column: str = "period", drift: str | None = "auto") -> xr.Dataset:
     """Read WAMIT .1/.3/.hst/.out files into the internal database (see module docstring).
 
     stem_or_paths: path stem ("…/rm3") or one of the files, or a dict {"1": path, "3": …,
-    "hst": …, "out": …}. .3 and .hst are optional (then no excitation / stiffness variables).
+    "hst": …, "out": …, "8": …, "9": …}. .3, .hst, .8 and .9 are optional (then no excitation /
+    stiffness / mean drift variables).
+    drift: which mean drift file becomes ``mean_drift``: "auto" (the .8 of a single body when
+    present, being the far field's converged value in surge, sway and yaw; else the .9),
+    "momentum" (.8), "pressure" (.9), or None (none read).
     rho (kg/m³) is used unless the .out states it; g (m/s²) is taken from the .out when given
     there (a mismatch with `g` raises). body_names: one name per body, default "body0", ….
     """
     if first_column not in ("period", "omega"):
         raise ValueError(f"first_column={first_column!r}; accepted: 'period', 'omega'.")
+    if drift not in DRIFT_CHOICES:
+        raise ValueError(f"drift={drift!r}; accepted: {DRIFT_CHOICES}.")
     paths = _paths(stem_or_paths)
     info = parse_out(paths["out"])
     if info["rho"] is not None:
@@ -304,6 +323,21 @@ def read_wamit(stem_or_paths, rho: float = 1000.0, g: float = 9.81, body_names=N
             "water-plane terms only (C33, C34, C35, C44, C55, C45 about the body origin); "
             "rho g V (z_B - z_G) removed from C44/C55, C46/C56 dropped")
 
+    # ---- .8 / .9: mean drift
+    ext = _drift_file(paths, drift, nb)
+    if ext is not None:
+        D, given = _read_drift(paths[ext], omega_of, omega, n, nb, rho, g, L,
+                               None if "3" not in paths else heads)
+        if "wave_direction" not in ds.coords:
+            ds = ds.assign_coords(wave_direction=np.deg2rad(D["heads"]))
+        ds["mean_drift"] = (("omega", "wave_direction", "influenced_dof"), D["values"])
+        ds["mean_drift"].attrs.update({
+            "units": "N/m^2 (forces), N m/m^2 (moments): mean force per unit wave amplitude squared",
+            "method": ("far field (WAMIT .8, momentum conservation)" if ext == "8" else
+                       "near field (WAMIT .9, pressure integration)"),
+            "motions": "as in the WAMIT run (see its .out: freely floating or fixed)",
+            "dofs": ", ".join(labels[i] for i in given), "file": str(paths[ext])})
+
     ds.attrs = {
         "rho": float(rho), "g": float(g), "water_depth": float(info["water_depth"]),
         "convention": CONVENTION, "source": "hydro.wamit.read_wamit",
@@ -315,6 +349,67 @@ def read_wamit(stem_or_paths, rho: float = 1000.0, g: float = 9.81, body_names=N
         "date_read": datetime.now(timezone.utc).isoformat(timespec="seconds"),
     }
     return ds
+
+
+DRIFT_CHOICES = ("auto", "momentum", "pressure", None)
+
+
+def _drift_file(paths, drift, nb):
+    """The extension ("8", "9") of the mean drift file to read, or None."""
+    if drift is None:
+        return None
+    if drift == "momentum" or (drift == "auto" and "8" in paths and nb == 1):
+        if "8" not in paths:
+            raise FileNotFoundError(f"drift='momentum' needs the WAMIT .8 file beside the .1 "
+                                    f"({paths['1'].with_suffix('.8')}): not found")
+        if nb != 1:
+            raise ValueError(f"drift='momentum': {paths['8']} holds the far-field drift of all "
+                             f"{nb} bodies together, which cannot be split among them; use "
+                             "drift='pressure' (the .9, per body)")
+        return "8"
+    if drift == "pressure" and "9" not in paths:
+        raise FileNotFoundError(f"drift='pressure' needs the WAMIT .9 file beside the .1 "
+                                f"({paths['1'].with_suffix('.9')}): not found")
+    return "9" if "9" in paths else None
+
+
+def _read_drift(path, omega_of, omega, n, nb, rho, g, L, heads):
+    """``mean_drift`` values (n_ω, n_β, n) and the dof modes given, from a WAMIT .8 or .9 file
+    (rows PER BETA1 BETA2 I Mod Pha Re Im; D_i = rho g L^k Re, k = 1 force, 2 moment)."""
+    raw, lines = _rows(path, 8, lines=True)
+    r = np.array([x[:8] for x in raw])
+    same = np.isclose(r[:, 1], r[:, 2], atol=1e-9)
+    if not same.any():
+        raise ValueError(f"{path}: no rows with BETA1 = BETA2 (the unidirectional mean drift); "
+                         "rerun WAMIT with the mean drift of each heading with itself")
+    r, lines = r[same], [ln for ln, s_ in zip(lines, same) if s_]
+    om = omega_of(r[:, 0])
+    uo = np.unique(om)
+    if uo.shape != omega.shape or not np.allclose(uo, omega, rtol=1e-6):
+        raise ValueError(f"{path}: its {uo.size} frequencies ({uo.min():.6g}…{uo.max():.6g} rad/s) "
+                         f"differ from the {omega.size} of the .1 file ({omega.min():.6g}…"
+                         f"{omega.max():.6g} rad/s): re-export both from one run")
+    h = np.unique(r[:, 1])
+    if heads is not None and not (h.shape == heads.shape and np.allclose(h, heads, atol=1e-6)):
+        raise ValueError(f"{path}: its headings {h.tolist()} degrees differ from those of the .3 "
+                         f"file ({np.asarray(heads).tolist()}): re-export both from one run")
+    im = r[:, 3].astype(int) - 1
+    if im.min() < 0 or im.max() >= n:
+        bad = int(np.argmax((im < 0) | (im >= n)))
+        raise ValueError(f"{path}, line {lines[bad]}: mode {im[bad] + 1} is outside 1…{n} "
+                         f"(6 modes × {nb} bodies); generalised modes are not supported")
+    _check_complete(path, r[:, 0] + 1j * r[:, 1], im[:, None], "modes", lines)
+    scale = max(1.0, float(np.max(np.abs(r[:, 6]))))
+    if np.any(np.abs(r[:, 7]) > 1e-3 * scale):
+        k = int(np.argmax(np.abs(r[:, 7])))
+        raise ValueError(f"{path}, line {lines[k]}: Im = {r[k, 7]!r} at BETA1 = BETA2 (the mean "
+                         f"drift is real; the largest Re is {scale:g}): the file is damaged")
+    D = np.zeros((len(omega), len(h), n))
+    io = np.searchsorted(omega, om * (1 - 1e-9))
+    ih = np.searchsorted(h, r[:, 1])
+    rot = (im % 6) >= 3
+    D[io, ih, im] = r[:, 6] * rho * g * L ** (1 + rot.astype(int))
+    return {"values": D, "heads": h}, sorted(set(int(i) for i in im))
 
 
 def _rows_fast(path, ncol_min):

@@ -41,6 +41,9 @@ and the BEM settings in ``[hydro.bem]`` (every key checked, unknown keys are err
     rho = 1000.0                # kg/m³; default [hydro] rho, else 1000
     g = 9.81                    # m/s²; default [hydro] g, else [model] gravity
     equilibrium_check = true    # refuse a hull that cannot float its body (below); default true
+    drift = "free"              # also the far-field mean drift (database variable mean_drift) of
+                                #   the one wet body: "fixed" (held) or "free" (freely floating
+                                #   with its config mass, com, inertia); default: none
     notes = "..."               # free text
 
 Before any solve, ``mfm hydro`` checks each mesh hull (:func:`check_hulls`): closed below the water
@@ -76,7 +79,8 @@ from ..errors import ConfigError
 
 BEM_KEYS = {"omega_min", "omega_max", "n_omega", "omega", "headings_deg", "water_depth", "dx",
             "lid", "symmetry", "infinite_frequency", "rho", "g", "deep_water_kh", "notes",
-            "equilibrium_check"}
+            "equilibrium_check", "drift"}
+DRIFTS = ("fixed", "free")
 GEOMETRY_KEYS = {"shape", "radius", "draft", "base", "knuckle_radius", "profile", "origin",
                  "reference_point", "file", "dx"}
 SYMMETRIES = ("auto", "xOz", "rotation", "none")
@@ -227,10 +231,17 @@ def bem_settings(raw: dict | None, *, hydro: dict | None = None, gravity: float 
                               "frequency is already solved in deep water; remove the key or give "
                               "a finite water_depth")
     _bool(raw.get("equilibrium_check", True), f"{w}.equilibrium_check")
+    drift = raw.get("drift", False)
+    if drift is not False and drift not in DRIFTS:
+        raise ConfigError(f"{w}.drift: {drift!r}; accepted: \"fixed\" (the body held), \"free\" "
+                          "(freely floating with its config mass and inertia), or false / absent "
+                          "(no mean drift)")
     record = {k: raw[k] for k in sorted(raw)}
     kwargs = {"omega": omega, "dx": dx, "wave_directions": [math.radians(b) for b in headings],
               "water_depth": depth, "rho": rho, "g": g, "lid": lid, "symmetry": sym,
               "infinite_frequency": inf, "deep_water_kh": deep_kh}
+    if drift:          # only then, so that the up-to-date key of every other database is unchanged
+        kwargs["drift"] = drift
     return {"kwargs": kwargs, "record": record, "headings_deg": headings,
             "equilibrium_check": raw.get("equilibrium_check", True)}
 
@@ -551,7 +562,24 @@ def config_bem_inputs(config_path, overrides=None):
                             overrides=overrides)
     out = (Path(os.path.normpath(config_path.parent / hydro["database"]))
            if hydro.get("database") else None)
-    return body_specs(config_path, raw, bodies), settings["kwargs"], out
+    specs = body_specs(config_path, raw, bodies)
+    return specs, _drift_inertia(settings["kwargs"], specs, bodies), out
+
+
+def _drift_inertia(kw, specs, bodies) -> dict:
+    """`kw` (hydro.bem.solve's arguments) with ``drift_inertia`` added for ``drift = "free"``: the
+    one wet body's config mass, com and inertia (its own, as a freely floating body)."""
+    if kw.get("drift"):
+        if len(specs) != 1:
+            raise ConfigError(f"hydro.bem.drift: {kw['drift']!r} with {len(specs)} wet bodies "
+                              f"({[s['name'] for s in specs]}): capytaine's far-field mean drift "
+                              "is the total force on all bodies, not each body's; it is computed "
+                              "for a config with one wet body")
+        if kw["drift"] == "free":
+            b = next(b for b in bodies if b.name == specs[0]["name"])
+            kw["drift_inertia"] = {"mass": float(b.mass), "com": [float(v) for v in b.com],
+                                   "inertia": np.asarray(b.inertia, float).tolist()}
+    return kw
 
 
 def _code_version() -> str:
@@ -749,6 +777,7 @@ def generate(config_path, *, out=None, force=False, progress=True, n_threads=Non
                             overrides=overrides)
     specs = body_specs(config_path, raw, bodies)
     kw = settings["kwargs"]
+    _drift_inertia(kw, specs, bodies)
     config_sha = hashlib.sha256(text.encode()).hexdigest()
     # the up-to-date stamp: what the BEM's answer depends on (the hulls, STL files by content, and
     # the solver's resolved arguments), not the rest of the config or the code's version

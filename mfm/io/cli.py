@@ -267,6 +267,13 @@ def cmd_info(args):
             print(f"  {name}: displaced volume {spec.volume[k]:.6g} m³ (ρV {spec.rho * spec.volume[k]:.6g}"
                   f" kg against the body's mass {b.mass:.6g} kg), centre of buoyancy "
                   f"{np.round(cob, 4).tolist()} m against its CoM {np.round(b.com, 4).tolist()} m")
+        if "mean_drift" in spec.db:
+            md = spec.db["mean_drift"].attrs
+            use = getattr(spec, "drift", "off")
+            print(f"  mean wave drift: {md.get('method', '?')}, motions {md.get('motions', '?')}, "
+                  f"dofs {md.get('dofs', '?')}; " + (f"applied ([hydro] drift = {use!r})"
+                                                    if use != "off" else "not applied ([hydro] "
+                                                    "drift = \"mean\" or \"newman\" would)"))
         issues = known_data_issues(model.hydro.source)
         print("  known data issues (not warned at load; every computation uses the symmetric "
               "part of A, B, A∞):" if issues else "  no known data issues")

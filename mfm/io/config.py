@@ -51,8 +51,9 @@ from ..mechanics.tree import (JOINT_KINDS, PLANAR_DOFS, ROOT_DOFS, BodySpec, Joi
 # the tables of loads (moorings, ptos, ...) come from the load registry (mfm.loads.registry)
 TOP_KEYS = {"model", "bodies", "hydro"} | set(LOAD_TABLES)
 HYDRO_KEYS = {"database", "names", "body_coupling", "added_mass_inf", "rho", "g", "bem", "notes",
-              "hydrostatics", "drag_flow"}
+              "hydrostatics", "drag_flow", "drift"}
 HYDROSTATICS = ("linear", "nonlinear")
+DRIFTS = ("off", "mean", "newman")
 BODY_HYDRO_KEYS = {"body", "drag_coefficient", "drag_area", "notes"}
 MODEL_KEYS = {"name", "gravity", "description"}
 BODY_KEYS = {"name", "mass", "com", "inertia", "principal_inertia", "radii_of_gyration", "parent",
@@ -188,7 +189,12 @@ def _parse_hydro(raw, source):
            "added_mass_inf": raw.get("added_mass_inf", "consistent"),
            "rho": raw.get("rho"), "g": raw.get("g"), "bem": raw.get("bem"),
            "hydrostatics": raw.get("hydrostatics", "linear"),
-           "drag_flow": raw.get("drag_flow", "body")}
+           "drag_flow": raw.get("drag_flow", "body"),
+           "drift": raw.get("drift", "off")}
+    if out["drift"] not in DRIFTS:
+        raise ConfigError(f"hydro.drift: {out['drift']!r}; accepted: {list(DRIFTS)} (mean: the "
+                          "constant mean wave drift force; newman: its slow drift in irregular "
+                          "seas by Newman's approximation; both need the database's mean_drift)")
     if out["drag_flow"] not in ("body", "relative"):
         raise ConfigError(f"hydro.drag_flow: {out['drag_flow']!r}; accepted: 'body' (quadratic "
                           "drag on each reference point's velocity) or 'relative' (on its "

@@ -27,6 +27,11 @@ Cummins equation for all hydro bodies together:
   ``[hydro] drag_flow = "relative"`` on its velocity relative to the incident wave's flow there
   (:func:`hydro.wetted.particle_velocity`; no current); it is not linearised in the frequency
   domain (zero slope at rest).
+- Mean wave drift (``[hydro] drift = "mean" | "newman"``, :mod:`hydro.drift`): the second-order
+  drift force from the database's ``mean_drift``, a table on the excitation's grid
+  (``drift_values``) applied at the reference points like the excitation (and ramped as it is);
+  recorded as ``drift_force``. Time domain only: the frequency domain and the equilibrium do not
+  see it (a mean force: its static offset is for a mooring's equilibrium to take, not yet done).
 
 In the frequency domain the same load gives, about q₀, the impedance −ω² Hᵀ(A(ω) − A∞)H
 − iω HᵀB(ω)H of its radiation strategy (A∞ H itself is in the mass, from ``mass``) and the wave
@@ -150,6 +155,8 @@ class Water(Load):
     hulls: object = None
     # the incident flow of drag on the relative velocity (Flow), or None: drag on ξ̇ alone
     flow: object = None
+    # the wave drift force (n, 6K) on the excitation's grid ([hydro] drift), or None: none
+    drift_values: jnp.ndarray | None = None
     reads_sea: ClassVar[bool] = True
 
     # the older names, kept for code that reads them
@@ -225,11 +232,14 @@ class Water(Load):
             # once a recorded sample: evaluate hands them to reaction_loads and diagnostics)
             buoy, fk = self.hulls.loads(g, kin, t) if hull is None else hull
             exc = exc + fk
-        return dict(excitation=exc[rows], radiation=rad,
-                    hydrostatic=-(self.C_wp[rows] @ xi),
-                    drag=-(self.drag[k, np.minimum(a, 2)] * (a < 3)) * jnp.abs(vr) * vr,
-                    added_mass_bias=-(self.A_inf[rows][:, mv] @ hbias[mv]),
-                    buoyancy=buoy[rows]), zd, v, hbias
+        out = dict(excitation=exc[rows], radiation=rad,
+                   hydrostatic=-(self.C_wp[rows] @ xi),
+                   drag=-(self.drag[k, np.minimum(a, 2)] * (a < 3)) * jnp.abs(vr) * vr,
+                   added_mass_bias=-(self.A_inf[rows][:, mv] @ hbias[mv]),
+                   buoyancy=buoy[rows])
+        if self.drift_values is not None:
+            out["drift"] = self._series(self.drift_values, t)[rows]
+        return out, zd, v, hbias
 
     def _buoyancy(self, kin):
         """ρgV ẑ at each centre of buoyancy: as loads at r_k (6K,) and the CoB lever (K, 3)."""
@@ -291,8 +301,11 @@ class Water(Load):
         H, _, _ = self.geometry.h_matrix(kin)
         comps["added_mass"] = -(self.A_inf @ (H @ ctx.qdd + hbias))
         comps.pop("added_mass_bias")
-        return {"eta": self._series(self.eta_values, ctx.t), "xi": self.geometry.xi(kin),
-                "hydro_force": jnp.stack([comps[c] for c in HYDRO_COMPONENTS])}
+        out = {"eta": self._series(self.eta_values, ctx.t), "xi": self.geometry.xi(kin),
+               "hydro_force": jnp.stack([comps[c] for c in HYDRO_COMPONENTS])}
+        if self.drift_values is not None:
+            out["drift_force"] = comps["drift"]
+        return out
 
     def outputs(self):
         return {"coords": {"hydro_dof": list(self.dofs), "component": list(HYDRO_COMPONENTS)},
@@ -302,7 +315,11 @@ class Water(Load):
                                         "inertial axes", "units": "m or rad"}),
                 "hydro_force": (("component", "hydro_dof"),
                                 {"long_name": "hydrodynamic loads on each body's reference point, "
-                                 "inertial axes", "units": "N or N m"})}
+                                 "inertial axes", "units": "N or N m"}),
+                **({} if self.drift_values is None else {"drift_force": (("hydro_dof",), {
+                    "long_name": "wave drift force on each body's reference point, inertial axes "
+                                 "(not in hydro_force)", "units": "N or N m",
+                    "drift": self.spec.drift if self.spec is not None else ""})})}
 
     def batch_outputs(self, save_every, n_saved):
         # (n_saved,), or (B, n_saved) for the water of many cases (build_water_batch)
@@ -361,6 +378,8 @@ class Water(Load):
 
         still = eqx.tree_at(lambda w: (w.exc_values, w.eta_values, w.rad),
                             self, (zeros(self.exc_values), zeros(self.eta_values), NoRadiation()))
+        if self.drift_values is not None:
+            still = dataclasses.replace(still, drift_values=zeros(self.drift_values))
         if self.hulls is not None:
             still = dataclasses.replace(still, hulls=self.hulls.still())
         if self.flow is not None:
@@ -486,16 +505,22 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
 
         flow = Flow(wave=still_water() if comps is None else WaveField.of(comps),
                     ramp=jnp.asarray(float(ramp)))
+    drift = None
+    if wave_drift(spec):
+        from hydro.drift import drift_time_series
+
+        drift = f64(drift_time_series(spec.database(), comps, t_grid, mode=spec.drift,
+                                      reference_points=spec.ref0, ramp_duration=ramp))
     return Water(geometry=geometry, A_inf=f64(rad.added_mass_inf(spec)), C_wp=f64(C_wp),
                  buoyancy=f64(buoyancy), d_cob=f64(spec.d_cob),
                  drag=f64(spec.drag), exc_t0=f64(t0), exc_step=f64(step), exc_values=f64(exc),
                  eta_values=f64(eta), rad=rad, dofs=spec.dofs, added_mass=added_mass, spec=spec,
-                 grid_m=int(m), moving=spec.moving, hulls=hulls, flow=flow)
+                 grid_m=int(m), moving=spec.moving, hulls=hulls, flow=flow, drift_values=drift)
 
 
 # the attributes that put a spec above linear potential flow (set by load_hydro_spec only when
 # asked, so that every other spec keeps its content key)
-ABOVE_LINEAR = ("hulls", "hydrostatics", "drag_flow")
+ABOVE_LINEAR = ("hulls", "hydrostatics", "drag_flow", "drift")
 
 
 def linear_spec(spec):
@@ -515,6 +540,11 @@ def linear_spec(spec):
 def relative_drag(spec) -> bool:
     """Whether the spec's drag acts on the velocity relative to the flow (``[hydro] drag_flow``)."""
     return getattr(spec, "drag_flow", "body") == "relative"
+
+
+def wave_drift(spec) -> bool:
+    """Whether the spec's water adds the wave drift force (``[hydro] drift``)."""
+    return getattr(spec, "drift", "off") != "off"
 
 
 def nonlinear(spec) -> bool:
@@ -687,6 +717,10 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
             "simulate_batch: the nonlinear level ([hydro] hydrostatics = \"nonlinear\") and drag "
             "on the relative flow ([hydro] drag_flow = \"relative\") are not batched yet; run "
             "their cases with mfm.simulate, or load the model without them for the batch")
+    if wave_drift(spec):
+        raise NotImplementedError(
+            f"simulate_batch: the wave drift force ([hydro] drift = {spec.drift!r}) is not "
+            "batched yet; run its cases with mfm.simulate, or load the model without it")
     B = len(seas)
     dts = np.broadcast_to(np.asarray(dts, dtype=float), (B,))
     ramps = np.broadcast_to(np.asarray(ramps, dtype=float), (B,))
@@ -846,6 +880,14 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
     if options.get("drag_flow", "body") == "relative":
         # set only when asked: every other spec keeps its content key (fingerprint) as before
         spec.drag_flow = "relative"
+    if options.get("drift", "off") != "off":
+        if "mean_drift" not in db:
+            raise ConfigError(
+                f"hydro.drift: {options['drift']!r} needs the database's mean_drift (the mean drift "
+                f"force per unit wave amplitude squared), which {str(path)!r} does not have: make "
+                "it with `mfm hydro` and [hydro.bem] drift = \"free\" (one wet body), or give "
+                "WAMIT output with its .8/.9 files; or remove hydro.drift")
+        spec.drift = options["drift"]       # set only when asked (the spec's content key)
     return spec
 
 

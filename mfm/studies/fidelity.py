@@ -59,15 +59,16 @@ LINEAR_LEVELS = ("spectral", "linear", "fast", "full")
 
 def above_linear(model: Model) -> bool:
     """Whether ``model``'s water is above linear potential flow (nonlinear hydrostatics and
-    Froude–Krylov, or drag on the relative flow)."""
-    from ..loads.water import nonlinear, relative_drag
+    Froude–Krylov, drag on the relative flow, or the second-order wave drift force)."""
+    from ..loads.water import nonlinear, relative_drag, wave_drift
 
-    return model.hydro is not None and (nonlinear(model.hydro) or relative_drag(model.hydro))
+    return model.hydro is not None and (nonlinear(model.hydro) or relative_drag(model.hydro)
+                                        or wave_drift(model.hydro))
 
 
 def linear_water(model: Model) -> Model:
-    """``model`` with the linear water: its spec without the nonlinear level's hulls and with
-    drag on the body's velocity (the same database, bodies and options; the radiation's fits and
+    """``model`` with the linear water: its spec without the nonlinear level's hulls and the wave
+    drift, with drag on the body's velocity (the same database, bodies and options; the radiation's fits and
     kernels shared, as they do not depend on either)."""
     import dataclasses
 

@@ -1,0 +1,123 @@
+"""Mean and slow wave drift forces from a database's ``mean_drift`` (hydro.database).
+
+The database gives D_i(ω, β), the mean force on dof i per unit wave amplitude squared (N/m²,
+N m/m²) at the body's reference point, inertial axes. For the wave components (a_j, ω_j, φ_j,
+β_j) of a sea (:class:`hydro.waves.WaveComponents`), with D_j = D(ω_j, β_j) interpolated linearly
+in ω and then in β (a real table: no phase to wind):
+
+``mode="mean"``: the constant mean drift  F = r(t) Σ_j D_j a_j²  (a regular wave: D a² exactly).
+
+``mode="newman"``: Newman's (1974) approximation of the slowly varying drift force:
+
+    F(t) = r(t) Re[ S₊(t) conj(S(t)) ],   S(t) = Σ_j s_j √|D_j| c_j e^{−iω_j t},
+    S₊(t) = Σ_j sgn(D_j) s_j √|D_j| c_j e^{−iω_j t}
+
+with c_j = a_j e^{iφ_j} and s_j = e^{i k_j (x_r cos β_j + y_r sin β_j)} the wave's phase at
+the body's reference point (x_r, y_r). It keeps the difference-frequency terms ω_j − ω_l only
+(Re[e^{−i(ω_j − ω_l)t}]), with the full quadratic transfer function T_jl replaced by
+sgn(D_j) √(|D_j| |D_l|) (Newman: T_jl ≈ ½(T_jj + T_ll) ≈ √(T_jj T_ll) near the diagonal). Its
+time average is Σ_j D_j a_j², the mean drift of the spectrum (cross terms average out over the
+record: to the sampling error of a finite record).
+
+Limits (say them where the force is used): valid for the slow drift of soft-moored bodies whose
+natural periods (surge, sway, yaw on the moorings) are long against the wave periods, so that
+only the QTF near its diagonal (small ω_j − ω_l) matters; no sum-frequency terms (springing,
+ringing of stiff systems); D is that of the body at rest at its mean heading (its offset and yaw
+do not change the coefficients: no wave-drift damping) and of the motions the database's drift
+was computed with (``mean_drift.attrs["motions"]``: fixed, or freely floating with a given
+inertia), not the model's own motions; with directional spreading, pairs of components of
+different headings take the same sgn(D_j) √(|D_j| |D_l|) (the bidirectional QTF is not known);
+no current.
+
+r(t) is the start-up ramp of :func:`hydro.waves.ramp`, applied to the force as the excitation's
+is applied to the excitation (so a ramped regular wave's drift rises over the ramp to D a²).
+"""
+from __future__ import annotations
+
+
+import numpy as np
+import xarray as xr
+
+from .excitation import GRID_RTOL, _bracket, _heading_table, _map_headings
+from .waves import WaveComponents, _harmonic_sum, ramp
+
+MODES = ("mean", "newman")
+
+
+class DriftTable:
+    """D(ω, β) (n_ω, n_β, n_dof) of a database sorted for interpolation, the heading grid closed
+    around the circle where the database covers it (as :class:`hydro.excitation.ExcitationTable`)."""
+
+    def __init__(self, db: xr.Dataset, dofs=None):
+        if "mean_drift" not in db:
+            raise KeyError(
+                "the hydro database has no 'mean_drift' (the mean drift force per unit wave "
+                "amplitude squared); make it with `mfm hydro` and [hydro.bem] drift = \"free\" or "
+                "\"fixed\" (one wet body), or read WAMIT output with its .8/.9 beside the .out; "
+                "or leave [hydro] drift unset")
+        da = db["mean_drift"].transpose("omega", "wave_direction", "influenced_dof")
+        da = da.sortby("omega").sortby("wave_direction")
+        if dofs is not None:
+            da = da.sel(influenced_dof=list(dofs))
+        self.labels = [str(d) for d in da["influenced_dof"].values]
+        self.omega = np.asarray(da["omega"].values, float)
+        beta = np.asarray(da["wave_direction"].values, float)
+        self.beta, self.D, self.periodic = _heading_table(beta, np.asarray(da.values, float), None)
+        self.attrs = dict(da.attrs)
+
+    def at(self, comps: WaveComponents) -> np.ndarray:
+        """D_j (n_comp, n_dof) at the components; 0 for a component outside the ω grid (those the
+        excitation has already dropped as carrying a negligible part of the energy, or refused:
+        :func:`hydro.excitation.excitation_time_series` runs first)."""
+        w = np.asarray(comps.omega, float)
+        lo, hi = self.omega[0], self.omega[-1]
+        inside = (w >= lo * (1 - GRID_RTOL)) & (w <= hi * (1 + GRID_RTOL))
+        b = _map_headings(self.beta, self.periodic, np.asarray(comps.heading, float), inside)
+        i0, i1, sw = _bracket(self.omega, np.clip(w, lo, hi))
+        k0, k1, sb = _bracket(self.beta, b)
+        sw, sb = sw[:, None], sb[:, None]
+        at_k = lambda k: (1 - sw) * self.D[i0, k] + sw * self.D[i1, k]   # noqa: E731
+        D = (1 - sb) * at_k(k0) + sb * at_k(k1)
+        return np.where(inside[:, None], D, 0.0)
+
+
+def drift_time_series(db: xr.Dataset, comps: WaveComponents, t, *, mode: str,
+                      reference_points=None, ramp_duration: float = 0.0, dofs=None) -> np.ndarray:
+    """The drift force (len(t), n_dof) of the module docstring on the database's dofs.
+
+    reference_points: (n_body, 3) the bodies' reference points (the wave's phase there, Newman's
+    envelope; default the database's ``reference_point``), one per 6 dofs in order.
+    """
+    if mode not in MODES:
+        raise ValueError(f"drift mode {mode!r}; accepted: {list(MODES)} (mean: the constant mean "
+                         "drift; newman: Newman's slow drift)")
+    t = np.asarray(t, float)
+    table = DriftTable(db, dofs)
+    n_dof = len(table.labels)
+    if comps is None or len(comps.omega) == 0:
+        return np.zeros((t.shape[0], n_dof))
+    D = table.at(comps)                                                    # (J, n_dof)
+    a = np.asarray(comps.amplitude, float)
+    if mode == "mean":
+        out = np.broadcast_to((D * (a * a)[:, None]).sum(0), (t.shape[0], n_dof)).copy()
+    else:
+        if reference_points is None:
+            reference_points = np.asarray(db["reference_point"].values, float)
+        ref = np.repeat(np.asarray(reference_points, float)[:, :2], 6, axis=0)[:n_dof]  # per dof
+        k, beta = np.asarray(comps.wavenumber, float), np.asarray(comps.heading, float)
+        s = np.exp(1j * (np.multiply.outer(k * np.cos(beta), ref[:, 0])
+                         + np.multiply.outer(k * np.sin(beta), ref[:, 1])))        # (J, n_dof)
+        c = comps.complex_amplitude[:, None] * s * np.sqrt(np.abs(D))
+        w = np.asarray(comps.omega, float)
+        # S = Re + i Im, with Im Σ c e^{−iωt} = Re Σ (−i c) e^{−iωt}
+        S_re, S_im = _harmonic_sum(w, c, t), _harmonic_sum(w, -1j * c, t)
+        cp = np.sign(D) * c
+        P_re, P_im = _harmonic_sum(w, cp, t), _harmonic_sum(w, -1j * cp, t)
+        out = P_re * S_re + P_im * S_im                                    # Re[S₊ conj(S)]
+    return out * ramp(t, ramp_duration)[:, None] if ramp_duration else out
+
+
+def mean_drift_of(db: xr.Dataset, comps: WaveComponents, dofs=None) -> np.ndarray:
+    """Σ_j D(ω_j, β_j) a_j² (n_dof,): the mean drift force of the components (N, N m)."""
+    D = DriftTable(db, dofs).at(comps)
+    return (D * np.asarray(comps.amplitude, float)[:, None] ** 2).sum(0)
