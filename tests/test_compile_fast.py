@@ -6,12 +6,9 @@ import os
 import subprocess
 import sys
 import textwrap
-import warnings
 
-import numpy as np
 import pytest
 
-import hydro
 import mfm
 from conftest import CONFIGS, ROOT
 
