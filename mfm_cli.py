@@ -115,6 +115,10 @@ def build_parser():
     p.add_argument("--initial-velocity", action="append", metavar="NAME=VALUE",
                    help="initial rate (m/s or rad/s), repeatable")
     p.add_argument("--save-every", type=_count(1), default=1, help="keep every k-th step")
+    p.add_argument("--fast-compile", action="store_true",
+                   help="compile the run at XLA's lowest optimisation level: a cheaper first "
+                        "answer (about a third of the compilation), slower steps, other last bits "
+                        "(mfm.simulate's compile='fast')")
     p.add_argument("--wave", choices=["regular", "jonswap"], help="sea state (default: still water)")
     p.add_argument("--height", type=POSITIVE, help="regular wave height H, m")
     p.add_argument("--period", type=POSITIVE, help="regular wave period T, s")

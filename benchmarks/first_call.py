@@ -1,7 +1,8 @@
 """Issue 34's first-answer rows: what a new user waits for, each in a fresh process (not a test).
 
     python benchmarks/first_call.py [--only rm3 rm3_cached m4 m4_cached wu_yuan wu_yuan_fd
-                                     wu_yuan_fd_cached optimize optimize_cached yardstick]
+                                     wu_yuan_fd_cached optimize optimize_cached yardstick
+                                     rm3_fast]
 
 - ``rm3``: the README's first command (``mfm simulate configs/rm3.toml ...``, the run without the
   install), compilation and fit caches empty (fresh folders). Goal (issue 55) ≤ 5 CPU s.
@@ -20,6 +21,8 @@
 - ``optimize``: ``mfm.optimize`` of Stansby & Li (configs/stansby_li.toml), its two PTO dampings
   (floatB, floatC: 0 to 4e9 N m s/rad), one sea (JONSWAP H_s 2 m, T_p 9 s, γ 3.3), empty caches;
   ``optimize_cached``: the same in a second fresh process. Goals (issue 55) ≤ 12 and ≤ 2 CPU s.
+- ``rm3_fast``: the README's first command with ``--fast-compile`` (``compile="fast"``: every
+  program of the run at XLA's lowest optimisation level), empty caches. Not run unless named.
 - ``yardstick``: a fixed piece of jax work in a fresh process (import jax, trace and compile a
   fixed program: 8 RK4 steps of a 12-state nonlinear oscillator chain, unrolled, XLA's default
   options, no cache): machines differ more than their cores say, so every row is also printed as
@@ -242,6 +245,12 @@ def main(argv=None):
             if "rm3_cached" in a.only:
                 row("RM3, the same in a process after one that filled the caches", cli, cmd[1:],
                     "rm3", "1.5 CPU s")
+        if "rm3_fast" in a.only:
+            line = next(ln for ln in (ROOT / "README.md").read_text().splitlines()
+                        if "mfm simulate configs/rm3.toml" in ln)
+            cmd = line.split("&&")[-1].strip().split()
+            row("RM3, the README's first command with --fast-compile, empty caches",
+                ROOT / "mfm_cli.py", [*cmd[1:], "--fast-compile"], "rm3fast")
         if "m4" in a.only or "m4_cached" in a.only:
             (tmp / "m4.py").write_text(M4)
             row("M4 134 simulate with defaults (120 s at dt 0.006 s), empty caches", "m4.py", [],

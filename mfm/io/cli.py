@@ -379,7 +379,8 @@ def cmd_simulate(args):
                           q0=_pairs(args.initial, "--initial"),
                           qd0=_pairs(args.initial_velocity, "--initial-velocity"),
                           save_every=args.save_every, ramp=args.ramp, radiation=args.radiation,
-                          progress=args.progress)
+                          progress=args.progress,
+                          compile="fast" if getattr(args, "fast_compile", False) else "default")
     except SimulationError as e:
         # keep what was computed: the run up to the last finite sample, marked incomplete
         if e.dataset is not None:

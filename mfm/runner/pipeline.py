@@ -34,7 +34,7 @@ def _strong(tree):
 
 
 def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t0,
-                recording: Recording = EVERY, chunked: bool = False):
+                recording: Recording = EVERY, chunked: bool = False, fast: bool = False):
     """Start a recorded run and compile its programs, here and now; returns ``run(bar)``, which
     makes the run and gives what ``recording`` keeps of each saved step (numpy or jax arrays,
     the initial state first). Compiling before ``run`` lets :func:`~.simulation.simulate` do it
@@ -51,7 +51,11 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
     Other runs make their outputs after the loop in the same program (one program to compile
     instead of two), and a large memory (a convolution's history) makes them inside the loop: the
     whole run in one program, or with ``chunked`` in chunks of one
-    (:func:`~.progress.run_chunked`). The same numbers every way."""
+    (:func:`~.progress.run_chunked`). The same numbers every way.
+
+    ``fast``: every program of the run compiled as a program run once is
+    (:func:`mfm.runner.xla.once_options`: XLA's lowest optimisation level), for ``simulate``'s
+    ``compile="fast"``: other last bits than the default's (no fused multiply–adds)."""
     began = time.perf_counter()
     z0 = initial_states(model, loads)
     q0, qd0 = jnp.asarray(q0, jnp.float64), jnp.asarray(qd0, jnp.float64)
@@ -67,7 +71,7 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
         # after the loop (rollout_impl), or inside it for a large memory
         opts = dict(n_steps=n_steps, integrator=integrator, save_every=save_every,
                     record=recording)
-        whole = _programs.program(rollout_jit, "rollout", start_args, opts)
+        whole = _programs.program(rollout_jit, "rollout", start_args, opts, once=fast)
         # compiled on a daemon thread while this one waits: a Ctrl-C ends the process at once
         # (mfm.runner.threads)
         wait(whole.compile, *start_args)
@@ -91,14 +95,14 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
     # the chunk's programs compile on other threads from the start's shapes while this one
     # compiles and runs the start: XLA compiles without the GIL, so on several cores they
     # overlap. All come from disk where an earlier process traced them (mfm.runner.programs)
-    start = _programs.program(start_jit, "rollout_start", start_args, start_kw)
+    start = _programs.program(start_jit, "rollout_start", start_args, start_kw, once=fast)
     # the carry strongly typed, however the start was made (a saved program keeps no weak types),
     # so that the chunk is one program, one key (the same dtypes: the same numbers)
     shapes = jax.tree_util.tree_map(lambda a: jax.ShapeDtypeStruct(a.shape, a.dtype),
                                     start.shapes(*start_args)[0])
 
     def compiled(fn, name, args, kw):
-        made = _programs.program(fn, name, args, kw)
+        made = _programs.program(fn, name, args, kw, once=fast)
         made.compile(*args)
         return made
 

@@ -33,7 +33,8 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
              q0=None, qd0=None, loads=None, save_every: int = 1, t0: float = 0.0,
              ramp: float = 0.0, radiation: str = "auto", memory: float | None = None,
              state_space_options: dict | None = None, check_stability: bool = True,
-             added_mass: str = "lhs", progress: bool | dict = False) -> xr.Dataset:
+             added_mass: str = "lhs", progress: bool | dict = False,
+             compile: str = "default") -> xr.Dataset:
     """Simulate a model in the time domain.
 
     Parameters
@@ -73,6 +74,16 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
         options (e.g. ``{"delay": 5}``: shown only once the run has taken 5 s). The run is then
         made in 20 to 100 chunks of one compiled function, with the bar updated between them;
         the results are the same to the last bit.
+    compile: ``"default"`` (XLA's optimised programs) or ``"fast"``: every program of the run
+        compiled at XLA's lowest optimisation level, as the checks' linearisation is
+        (:func:`mfm.runner.xla.once_options`), for a first look at a short run: its compilation
+        about a third of the CPU (RM3's README run, caches empty: 11–16 → 5.4 CPU s on 2 cores;
+        benchmarks/RESULTS.md, issue 55), its steps up to ~3× slower once compiled, and its
+        numbers not the default's to the last bit (XLA's default fuses a·b + c into one rounded
+        operation, the lowest level does not: ~1e-16 relative per operation, grown by the
+        dynamics over a run). Recorded in the result's attribute ``compile``. Where ``XLA_FLAGS``
+        sets XLA's level, or with ``MFM_FAST_COMPILE=off``, the programs are compiled as
+        those settings say.
 
     Returns an :class:`xarray.Dataset` with ``q``, ``qd``, ``qdd`` (time, coordinate),
     ``body_position`` (time, body, axis) CoM in inertial axes, ``body_rotation`` (time, body, angle)
@@ -99,6 +110,11 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     ramp = finite_number(ramp, "ramp", nonnegative=True)
     memory = finite_number(memory, "memory", positive=True, allow_none=True)
     progress = progress_options(progress)
+    if compile not in ("default", "fast"):
+        raise ValueError(f"compile={compile!r}; accepted: 'default' (XLA's optimised programs) or "
+                         "'fast' (its lowest optimisation level: a cheaper first compilation, "
+                         "slower steps, other last bits)")
+    fast = compile == "fast"
     n_steps = int(round(duration / dt))
     if n_steps < 1:
         raise ValueError(f"duration = {duration} s is shorter than one step dt = {dt} s")
@@ -162,7 +178,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
         phase(bar, "compiling")
         run = prepare_run(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
                           save_every=save_every, t0=t0, recording=OUTPUTS,
-                          chunked=bar is not None)
+                          chunked=bar is not None, fast=fast)
         if check_stability:
             phase(bar, "linearising at q0 for the checks")
             ahead.result()
@@ -189,7 +205,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                 phase(bar, "compiling")
                 run = prepare_run(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ,
                                   loads=loads, save_every=save_every, t0=t0, recording=OUTPUTS,
-                                  chunked=bar is not None)
+                                  chunked=bar is not None, fast=fast)
     except BaseException:
         if bar is not None:
             bar.close()
@@ -206,6 +222,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                     complete="true", ramp_s=ramp, memory_s=memory,
                     sea="still water" if sea is None else repr(sea),
                     sea_label="still water" if sea is None else str(sea), radiation_choice=choice,
+                    compile=compile,
                     no_restoring=", ".join(free) if check_stability else "not checked",
                     **judged)
     finite = np.isfinite(q).all(axis=1) & np.isfinite(qd).all(axis=1)
