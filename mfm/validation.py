@@ -67,6 +67,15 @@ def body_ref(table, key, where, names):
     return table[key]
 
 
+def element_name(table, where, default):
+    """A config element's ``name`` (``default`` where it has none): a non-empty string, else a
+    ConfigError naming the key and the value."""
+    name = table.get("name", default)
+    if not isinstance(name, str) or not name:
+        raise ConfigError(f"{where}.name: {name!r} is not a non-empty string")
+    return name
+
+
 # ------------------------------------------------------------------------------- arguments
 def finite_number(value, what, *, positive=False, nonnegative=False, allow_none=False):
     """A finite float, with a message naming the argument when it is not."""

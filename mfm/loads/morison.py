@@ -50,7 +50,7 @@ from ..backend import device_array
 from ..errors import ConfigError
 from ..mechanics import se3
 from ..mechanics.points import BodyPoints
-from ..validation import body_ref, number, tables, vector
+from ..validation import body_ref, element_name, number, tables, vector
 from .base import FrequencyTerms, Load, LoadOutput
 
 KEYS = {"name", "body", "point", "from", "to", "segments", "cd", "diameter", "area", "ca",
@@ -206,9 +206,8 @@ class MorisonElements(Load):
         out = []
         for i, (where, t) in enumerate(tables(raw, "morison", KEYS)):
             body = body_ref(t, "body", where, names)
-            item = {"where": where, "body": body, "name": t.get("name", f"{body}_morison{i}")}
-            if not isinstance(item["name"], str) or not item["name"]:
-                raise ConfigError(f"{where}.name: {item['name']!r} is not a non-empty string")
+            item = {"where": where, "body": body,
+                    "name": element_name(t, where, f"{body}_morison{i}")}
             strip = "from" in t or "to" in t
             if strip == ("point" in t):
                 raise ConfigError(f"{where}: give either point = [x, y, z] (a point element) or "

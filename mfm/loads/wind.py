@@ -44,7 +44,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..validation import body_ref, number, tables, vector
+from ..validation import body_ref, element_name, number, tables, vector
 from ..backend import device_array
 from ..mechanics.points import BodyPoints, h_matrix_at
 from ..errors import ConfigError
@@ -224,9 +224,7 @@ class WindThrust(Load):
         out = []
         for i, (where, t) in enumerate(tables(raw, "wind_thrust", KEYS)):
             body = body_ref(t, "body", where, names)
-            item = {"where": where, "body": body, "name": t.get("name", f"{body}_wind{i}")}
-            if not isinstance(item["name"], str) or not item["name"]:
-                raise ConfigError(f"{where}.name: {item['name']!r} is not a non-empty string")
+            item = {"where": where, "body": body, "name": element_name(t, where, f"{body}_wind{i}")}
             for key, what in (("hub", "the hub [x, y, z] (m, inertial at q = 0)"),
                               ("rotor_radius", "the rotor radius (m, > 0), e.g. 63 for the NREL 5 MW"),
                               ("wind_speed", "the mean wind speed at the hub (m/s, ≥ 0)")):
