@@ -76,6 +76,16 @@ def element_name(table, where, default):
     return name
 
 
+def unique_names(items, kind):
+    """Refuse two ``items`` (parsed elements with ``name`` and ``where``) of one name, naming the
+    config table ``kind``."""
+    seen = [t["name"] for t in items]
+    for t in items:
+        if seen.count(t["name"]) > 1:
+            raise ConfigError(f"{t['where']}.name: {t['name']!r} names two [[{kind}]] entries; "
+                              "names must be unique")
+
+
 # ------------------------------------------------------------------------------- arguments
 def finite_number(value, what, *, positive=False, nonnegative=False, allow_none=False):
     """A finite float, with a message naming the argument when it is not."""

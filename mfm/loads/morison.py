@@ -50,7 +50,8 @@ from ..backend import device_array
 from ..errors import ConfigError
 from ..mechanics import se3
 from ..mechanics.points import BodyPoints
-from ..validation import body_ref, element_name, number, tables, vector
+from ..validation import (body_ref, element_name, number, tables, unique_names,
+                          vector)
 from .base import FrequencyTerms, Load, LoadOutput
 
 KEYS = {"name", "body", "point", "from", "to", "segments", "cd", "diameter", "area", "ca",
@@ -266,11 +267,7 @@ class MorisonElements(Load):
                                   "volume (m³ for a point, m³ per metre for a strip) or a "
                                   "strip's diameter")
             out.append(item)
-        seen = [t["name"] for t in out]
-        for t in out:
-            if seen.count(t["name"]) > 1:
-                raise ConfigError(f"{t['where']}.name: {t['name']!r} names two [[morison]] "
-                                  "entries; names must be unique")
+        unique_names(out, "morison")
         return out
 
     @classmethod

@@ -44,7 +44,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..validation import body_ref, element_name, number, tables, vector
+from ..validation import (body_ref, element_name, number, tables, unique_names,
+                          vector)
 from ..backend import device_array
 from ..mechanics.points import BodyPoints, h_matrix_at
 from ..errors import ConfigError
@@ -257,11 +258,7 @@ class WindThrust(Load):
                                       "leave the key out (bundled NREL 5 MW table)")
                 item["ct"] = v
             out.append(item)
-        seen = [t["name"] for t in out]
-        for t in out:
-            if seen.count(t["name"]) > 1:
-                raise ConfigError(f"{t['where']}.name: {t['name']!r} names two [[wind_thrust]] "
-                                  "entries; names must be unique")
+        unique_names(out, "wind_thrust")
         return out
 
     @classmethod
