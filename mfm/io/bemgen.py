@@ -445,8 +445,8 @@ def check_hulls(specs, bodies, raw, settings) -> None:
             mesh_names = [n for n in wet if spec_of[n]["shape"] == "mesh"]
             n0 = mesh_names[0]
             sp = spec_of[n0]
-            hint = (f"Set origin's z so that the mesh floats at its draft (origin is added to the "
-                    f"file's coordinates; z = 0 is the still-water line).")
+            hint = ("Set origin's z so that the mesh floats at its draft (origin is added to the "
+                    "file's coordinates; z = 0 is the still-water line).")
             alt = centred_hint(n0) if len(wet) == 1 else None
             if alt is not None and abs(alt[1] - mass) <= EQUILIBRIUM_VOLUME_TOL * mass:
                 o = alt[0]
