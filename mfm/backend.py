@@ -121,8 +121,6 @@ def switched_off(setting: str | None) -> bool:
     return (setting or "").strip().lower() in OFF_VALUES
 
 
-
-
 def device_array(x, dtype=None):
     """``x`` (numbers, a list or a numpy array) as a jax array of its numpy dtype (or ``dtype``),
     put on the device as it is: ``jax.device_put(np.asarray(x, dtype))``. The same values and

@@ -493,7 +493,6 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
         eta = np.asarray(elevation(comps, t_grid, ramp_duration=ramp)).reshape(-1)
     geometry = BodyPoints(body_index=spec.body_index, d_ref=device_array(spec.d_ref),
                           ref0=device_array(spec.ref0))
-    f64 = _f64
     C_wp, buoyancy, hulls, flow = spec.C_wp, spec.rho * spec.g * spec.volume, None, None
     comps = None if sea is None else sea.components(water_depth=spec.water_depth, g=spec.g)
     if nonlinear(spec):
@@ -509,12 +508,12 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
     if wave_drift(spec):
         from hydro.drift import drift_time_series
 
-        drift = f64(drift_time_series(spec.database(), comps, t_grid, mode=spec.drift,
+        drift = _f64(drift_time_series(spec.database(), comps, t_grid, mode=spec.drift,
                                       reference_points=spec.ref0, ramp_duration=ramp))
-    return Water(geometry=geometry, A_inf=f64(rad.added_mass_inf(spec)), C_wp=f64(C_wp),
-                 buoyancy=f64(buoyancy), d_cob=f64(spec.d_cob),
-                 drag=f64(spec.drag), exc_t0=f64(t0), exc_step=f64(step), exc_values=f64(exc),
-                 eta_values=f64(eta), rad=rad, dofs=spec.dofs, added_mass=added_mass, spec=spec,
+    return Water(geometry=geometry, A_inf=_f64(rad.added_mass_inf(spec)), C_wp=_f64(C_wp),
+                 buoyancy=_f64(buoyancy), d_cob=_f64(spec.d_cob),
+                 drag=_f64(spec.drag), exc_t0=_f64(t0), exc_step=_f64(step),
+                 exc_values=_f64(exc), eta_values=_f64(eta), rad=rad, dofs=spec.dofs, added_mass=added_mass, spec=spec,
                  grid_m=int(m), moving=spec.moving, hulls=hulls, flow=flow, drift_values=drift)
 
 
@@ -761,10 +760,10 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
                     ramp=ramps.copy(), n_grid=n_grid, one_heading=table.beta.shape[0] == 1)
     geometry = BodyPoints(body_index=spec.body_index, d_ref=device_array(spec.d_ref),
                           ref0=device_array(spec.ref0))
-    f64 = _f64
-    water = Water(geometry=geometry, A_inf=f64(rad.added_mass_inf(spec)), C_wp=f64(spec.C_wp),
-                  buoyancy=f64(spec.rho * spec.g * spec.volume), d_cob=f64(spec.d_cob),
-                  drag=f64(spec.drag), exc_t0=f64(t0), exc_step=steps.copy(),
+    water = Water(geometry=geometry, A_inf=_f64(rad.added_mass_inf(spec)),
+                  C_wp=_f64(spec.C_wp),
+                  buoyancy=_f64(spec.rho * spec.g * spec.volume), d_cob=_f64(spec.d_cob),
+                  drag=_f64(spec.drag), exc_t0=_f64(t0), exc_step=steps.copy(),
                   exc_values=None, eta_values=None, rad=rad, dofs=spec.dofs,
                   added_mass=added_mass, spec=spec, grid_m=int(m), moving=spec.moving)
     batched = jax.tree_util.tree_map(lambda _: False, water)

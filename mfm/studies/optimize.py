@@ -246,10 +246,10 @@ def _run(P, u, scale):
     compiled objective is the host's program (:meth:`mfm.host.Host.program`; the runner's: from
     disk where an earlier process traced it, so that a later process neither traces nor lowers
     it: Stansby & Li's two dampings, ~4 s of CPU of a cached first optimum). Its arguments are
-    put on the device as numpy (``jax.device_put``): ``jnp.asarray`` of a new shape compiles a
-    small program of its own."""
-    args = (P.pb, jax.device_put(np.asarray(u, np.float64)), P.lo_j, P.hi_j, P.lim_j,
-            jax.device_put(np.asarray(scale, np.float64)))
+    put on the device as numpy (:func:`mfm.backend.device_array`): ``jnp.asarray`` of a new
+    shape compiles a small program of its own."""
+    args = (P.pb, device_array(u, np.float64), P.lo_j, P.hi_j, P.lim_j,
+            device_array(scale, np.float64))
     static = dict(objective=P.objective_fn, spec=P.spec, forward=P.forward)
     out, J, r = host.current().program(_evaluate, "optimize_evaluate", args, static)(*args)
     return np.asarray(out), np.asarray(J), jax.tree_util.tree_map(np.asarray, r)
