@@ -122,6 +122,42 @@ def test_the_key_changes_with_whatever_changes_the_program(monkeypatch):
     assert _programs.key("f", (1.0,), {}) != _programs.key("f", (np.float64(1.0),), {})
 
 
+def test_a_module_imported_after_the_first_key_keys_only_settings_off_its_code(monkeypatch,
+                                                                             tmp_path):
+    # M4 134's checks' linearisation was keyed twice in one process: the radiation fit's check
+    # (mfm.frequency.fitcheck) is imported between its two calls, and its settings at their
+    # defaults changed the key. A module imported late now keys what differs from its code.
+    import importlib.util
+
+    monkeypatch.setattr(_programs, "_DEFAULTS", {})
+    args = (jnp.zeros(3),)
+    _programs.key("f", args, {})                  # the process's first key, if none was made
+    k0 = _programs.key("f", args, {})
+    src = tmp_path / "late_probe.py"
+    src.write_text("TOLERANCE = 0.05\nBAND = (0.5, 2.0)\nBYTES = 2 * 2**30\n"
+                   "PICKED = 64 if len('ab') > 5 else 12\nTWICE = 1\nTWICE = 2\n")
+    spec = importlib.util.spec_from_file_location("mfm._late_probe", src)
+    late = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, "mfm._late_probe", late)
+    spec.loader.exec_module(late)
+    # constants only: a condition or a second assignment is no default (it stays keyed)
+    assert _programs._literal_defaults(late) == {"TOLERANCE": 0.05, "BAND": (0.5, 2.0),
+                                                 "BYTES": 2**31}
+    keyed = [s for s in _programs._settings() if s.startswith("mfm._late_probe.")]
+    assert keyed == ["mfm._late_probe.PICKED=12", "mfm._late_probe.TWICE=2"]
+    del late.PICKED, late.TWICE
+    assert _programs.key("f", args, {}) == k0     # at its code's values: the same program
+    for name, value in [("TOLERANCE", 0.1), ("BAND", (0.5, 3.0)), ("BYTES", 2.0**31)]:
+        before = getattr(late, name)
+        monkeypatch.setattr(late, name, value)    # another value (2.0**31: another type)
+        assert _programs.key("f", args, {}) != k0, name
+        monkeypatch.setattr(late, name, before)
+    assert _programs.key("f", args, {}) == k0
+    # a module imported before the first key keeps all of its settings in the key
+    assert _programs._EARLY is not None and "mfm.runner.programs" in _programs._EARLY
+    assert any(s.startswith("mfm.runner.xla.") for s in _programs._settings())
+
+
 def test_what_the_key_cannot_name_takes_the_ordinary_path(monkeypatch, tmp_path):
     import equinox as eqx
 

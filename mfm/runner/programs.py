@@ -30,6 +30,7 @@ path.
 from __future__ import annotations
 
 import dataclasses
+import dis
 import enum
 import functools
 import hashlib
@@ -204,19 +205,71 @@ def _settings() -> list:
     """mfm's and hydro's module-level settings as they are now (upper-case names holding
     numbers, strings or tuples of them, e.g. ``record.DEFERRED_RECORD_MEMORY``): a trace may read
     them, and a program made under other values is another program (a test that changes one
-    must not be given the program made before)."""
+    must not be given the program made before).
+
+    A module imported after this process's first key (the radiation fit's check, imported by
+    the checks between two programs of one run) gives only the settings that differ from what its
+    code assigns (:func:`_literal_defaults`; a default is in the source hash already): with all of
+    them, the same program was keyed twice in one process, before the import and after it (the
+    checks' linearisation of M4 134: traced and lowered twice)."""
+    global _EARLY
     simple = (bool, int, float, str, type(None))
     out = []
-    for mod_name, mod in sorted(sys.modules.items()):
-        if mod is None or mod_name.split(".")[0] not in ("mfm", "hydro"):
-            continue
+    modules = [(n, m) for n, m in sorted(sys.modules.items())
+               if m is not None and n.split(".")[0] in ("mfm", "hydro")]
+    if _EARLY is None:
+        _EARLY = frozenset(n for n, _ in modules)
+    for mod_name, mod in modules:
+        defaults = None if mod_name in _EARLY else _defaults_of(mod_name, mod)
         for attr, value in sorted(vars(mod).items()):
             if f"{mod_name}.{attr}" in _WHERE:
                 continue
             if attr.isupper() and (isinstance(value, simple) or isinstance(value, tuple) and all(
                     isinstance(v, simple) for v in value)):
+                if defaults is not None and attr in defaults and _same(defaults[attr], value):
+                    continue
                 out.append(f"{mod_name}.{attr}={value!r}")
     return out
+
+
+_EARLY: frozenset | None = None      # the mfm and hydro modules imported at the first key
+_DEFAULTS: dict = {}
+
+
+def _same(a, b) -> bool:
+    return type(a) is type(b) and a == b
+
+
+def _defaults_of(mod_name: str, mod) -> dict:
+    with _LOCK:
+        found = _DEFAULTS.get(mod_name)
+    if found is None:
+        found = _literal_defaults(mod)
+        with _LOCK:
+            _DEFAULTS[mod_name] = found
+    return found
+
+
+def _literal_defaults(mod) -> dict:
+    """``{NAME: value}`` of each upper-case name a module's top level assigns once, from a
+    constant (``X = 0.05``, ``X = (0.5, 2.0)``, ``X = 2 * 2**30``: the compiler folds them into one
+    constant), read from its code object (the ``.pyc``). A name assigned otherwise (an
+    expression, a condition, an import, twice) is not a default here, and stays in the key."""
+    try:
+        code = mod.__spec__.loader.get_code(mod.__name__)
+    except Exception:        # no loader, no source: every setting of the module stays keyed
+        return {}
+    if code is None:
+        return {}
+    stores, found, prev = {}, {}, None
+    for ins in dis.get_instructions(code):
+        if ins.opname in ("STORE_NAME", "STORE_GLOBAL") and ins.argval.isupper():
+            stores[ins.argval] = stores.get(ins.argval, 0) + 1
+            if (prev is not None and prev.opname in ("LOAD_CONST", "LOAD_SMALL_INT")
+                    and not prev.is_jump_target and not ins.is_jump_target):
+                found[ins.argval] = prev.argval
+        prev = ins
+    return {k: v for k, v in found.items() if stores[k] == 1}
 
 
 # settings that say where the caches are, not what a program is: a warm cache copied to another
