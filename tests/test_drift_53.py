@@ -459,3 +459,52 @@ def test_newman_through_the_water_is_the_hydro_series():
     got = res["drift_force"].values
     np.testing.assert_allclose(got, F, rtol=0, atol=1e-10 * np.abs(F).max())
     assert np.ptp(got[t > 2.0, 0]) > 0.1 * np.abs(got[t > 2.0, 0]).mean()     # it varies
+
+
+def test_equilibrium_in_a_sea_is_the_mean_offset(tmp_path):
+    """mfm.equilibrium(model, sea=...) balances the mean drift force sum_j D_j a_j^2 at rest: the
+    moored cylinder's surge offset is D a^2 / k to round-off (a linear spring; the water at rest
+    has no surge stiffness), whether [hydro] drift is on or off; the time domain's mean offset
+    is the same D a^2 / k (test_regular_wave_mean_drift_force_and_offset, 1e-3). A JONSWAP's is
+    its components' sum over k. Still water (no sea) leaves it at rest; a database without
+    mean_drift is refused, naming it; a model without water says so."""
+    import hydro
+    import mfm
+    from hydro.drift import mean_drift_of
+
+    a, w, k = 0.2, 2.5, 2.0e4
+    D = float(_drift_db()["mean_drift"].sel(omega=w, wave_direction=0.0,
+                                            influenced_dof="cylinder__Surge"))
+    sea = hydro.Regular(height=2 * a, period=2 * np.pi / w)
+    for drift in ("off", "mean"):
+        model = _moored_cylinder(drift, k=k)
+        q0, info = mfm.equilibrium(model, sea=sea)
+        assert q0[0] == pytest.approx(D * a * a / k, rel=1e-9), drift
+        assert q0[0] > 0                                       # pushed along the waves
+        assert abs(mfm.equilibrium(model)[0][0]) < 1e-12
+    jonswap = hydro.Jonswap(hs=0.5, tp=2 * np.pi / 2.6, omega_range=(2.05, 3.45), seed=2)
+    with pytest.warns(hydro.waves.SeaStateWarning, match="omega_range"):
+        comps = jonswap.components()
+        q0, _ = mfm.equilibrium(_moored_cylinder("off", k=k), sea=jonswap)
+    total = float(mean_drift_of(_drift_db(), comps)[0])
+    assert total > 0 and q0[0] == pytest.approx(total / k, rel=1e-9)
+    bare = tmp_path / "no_drift.nc"
+    from hydro.database import to_netcdf
+    from hydro.prepare import open_any_database
+
+    to_netcdf(open_any_database(CYLINDER).drop_vars("mean_drift"), bare)
+    model2 = mfm.load({"model": {"name": "moored cylinder", "gravity": 9.81},
+                       "bodies": [{"name": "cylinder", "mass": 1000.0 * np.pi * 8.0,
+                                   "com": [0.0, 0.0, 0.0], "principal_inertia": [1e5, 1e5, 1e4],
+                                   "joint": {"type": "free", "dofs": ["surge"],
+                                             "stiffness": [k]}}],
+                       "hydro": {"database": str(bare)}})
+    with pytest.raises(ValueError, match=r"mfm.equilibrium\(sea=...\) needs the database's "
+                                         r"mean_drift .*no_drift.nc"):
+        mfm.equilibrium(model2, sea=sea)
+    dry = mfm.load({"model": {"name": "dry", "gravity": 9.81},
+                    "bodies": [{"name": "b", "mass": 1.0, "com": [0.0, 0.0, 0.0],
+                                "principal_inertia": [1.0, 1.0, 1.0],
+                                "joint": {"type": "free", "dofs": ["surge"], "stiffness": [1.0]}}]})
+    with pytest.raises(ValueError, match=r"has no water \(\[hydro\]\)"):
+        mfm.equilibrium(dry, sea=sea)

@@ -143,17 +143,36 @@ def compile_jet(model: Model, loads, q):
 
 
 # ------------------------------------------------------------------------------- equilibrium
-def equilibrium(model: Model, q_guess=None, *, loads=None, tol: float = 1e-10, max_iter: int = 50):
+def equilibrium(model: Model, q_guess=None, *, loads=None, sea=None, tol: float = 1e-10,
+                max_iter: int = 50):
     """Static equilibrium q₀ with Q(q₀, 0) = 0 (Newton with the jax Jacobian; least squares where
     nothing restores a coordinate, which then stays at its guess), under the model's own loads and
     ``loads`` (e.g. a :class:`~mfm.loads.JointLoad` preload).
+
+    ``sea`` (a :mod:`hydro` sea state): the mean position in that sea, under the mean wave drift
+    force F̄ = Σ_j D(ω_j, β_j) a_j² of the database's ``mean_drift`` besides the loads at rest
+    (:meth:`~mfm.loads.water.Water.in_mean_drift`): a moored body's mean offset, about which
+    :func:`linear_system` can linearise. The first-order wave forces average to zero there; the
+    slow drift's oscillation (Newman) and the nonlinear level's own mean wave force are not in it.
 
     Returns (q₀, info) with info = dict(residual, iterations, free: coordinates without
     stiffness). Raises ValueError when no equilibrium is found (a body that cannot float freely
     sinks or capsizes), naming the residual by coordinate.
     """
     model = check_model(model)
-    return _equilibrium(model, system_loads(model, loads), q_guess, tol, max_iter)
+    lds = system_loads(model, loads)
+    if sea is not None:
+        lds = _in_mean_drift(lds, sea)
+    return _equilibrium(model, lds, q_guess, tol, max_iter)
+
+
+def _in_mean_drift(loads, sea) -> tuple:
+    from ..loads.water import Water
+
+    if not any(isinstance(ld, Water) for ld in loads):
+        raise ValueError("mfm.equilibrium(sea=...): the model has no water ([hydro]) to carry a "
+                         "mean wave drift force; leave sea out for the equilibrium at rest")
+    return tuple(ld.in_mean_drift(sea) if isinstance(ld, Water) else ld for ld in loads)
 
 
 def _equilibrium(model, loads, q_guess=None, tol=1e-10, max_iter=50):

@@ -30,8 +30,10 @@ Cummins equation for all hydro bodies together:
 - Mean wave drift (``[hydro] drift = "mean" | "newman"``, :mod:`hydro.drift`): the second-order
   drift force from the database's ``mean_drift``, a table on the excitation's grid
   (``drift_values``) applied at the reference points like the excitation (and ramped as it is);
-  recorded as ``drift_force``. Time domain only: the frequency domain and the equilibrium do not
-  see it (a mean force: its static offset is for a mooring's equilibrium to take, not yet done).
+  recorded as ``drift_force``. The equilibrium in a sea (``mfm.equilibrium(model, sea=)``) takes
+  its mean Σ_j D(ω_j, β_j) a_j² as a constant load (:meth:`Water.in_mean_drift`): a moored
+  body's mean offset. The frequency domain does not see it (a mean force: linearise about that
+  equilibrium).
 
 In the frequency domain the same load gives, about q₀, the impedance −ω² Hᵀ(A(ω) − A∞)H
 − iω HᵀB(ω)H of its radiation strategy (A∞ H itself is in the mass, from ``mass``) and the wave
@@ -157,6 +159,9 @@ class Water(Load):
     flow: object = None
     # the wave drift force (n, 6K) on the excitation's grid ([hydro] drift), or None: none
     drift_values: jnp.ndarray | None = None
+    # the mean drift force (6K,) the water keeps at rest (in_mean_drift: the equilibrium in a sea),
+    # or None: still water has none
+    drift_at_rest: jnp.ndarray | None = None
     reads_sea: ClassVar[bool] = True
 
     # the older names, kept for code that reads them
@@ -380,11 +385,40 @@ class Water(Load):
                             self, (zeros(self.exc_values), zeros(self.eta_values), NoRadiation()))
         if self.drift_values is not None:
             still = dataclasses.replace(still, drift_values=zeros(self.drift_values))
+        if self.drift_at_rest is not None:
+            # the mean drift of in_mean_drift, a constant table (two equal rows: every t reads it)
+            mean = np.asarray(self.drift_at_rest, np.float64)
+            still = dataclasses.replace(still, drift_values=device_array(
+                np.broadcast_to(mean, (2,) + mean.shape).copy()))
         if self.hulls is not None:
             still = dataclasses.replace(still, hulls=self.hulls.still())
         if self.flow is not None:
             still = dataclasses.replace(still, flow=self.flow.still())
         return still
+
+    def in_mean_drift(self, sea) -> "Water":
+        """This water holding, at rest, the mean wave drift force of ``sea``,
+
+            F̄_i = Σ_j D_i(ω_j, β_j) a_j²      (N, N m; inertial axes at the reference points),
+
+        D the database's ``mean_drift`` (interpolated as the time domain's drift is,
+        :class:`hydro.drift.DriftTable`) and a_j the components' amplitudes: what
+        ``[hydro] drift = "mean"`` applies in a run after its ramp, and Newman's slow drift's
+        mean. Its :meth:`static_load` carries F̄, so the equilibrium of a model with this water
+        is the mean position in that sea (a moored body's mean offset); the waves' first-order
+        forces average to zero there. Whatever ``[hydro] drift`` says (the question is the
+        mean offset); a database without ``mean_drift`` is refused, naming how to make one."""
+        from hydro.drift import mean_drift_of
+
+        spec = self.spec
+        db = spec.database()
+        require_mean_drift(db, spec.source, "mfm.equilibrium(sea=...)")
+        comps = sea.components(water_depth=spec.water_depth, g=spec.g)
+        mean = np.asarray(mean_drift_of(db, comps), np.float64)
+        if mean.shape != (self.A_inf.shape[0],):
+            raise ValueError(f"mfm.equilibrium(sea=...): the database's mean drift has "
+                             f"{mean.shape[0]} dofs, the water {self.A_inf.shape[0]}")
+        return dataclasses.replace(self, drift_at_rest=mean)
 
     def _frequency_coefficients(self, kin0, omega, heading, options, excitation=True):
         """(A(ω) − A∞, B(ω), X(ω, β) or None, H₀) of ``options["radiation"]``: (n_ω, 6K, 6K),
@@ -539,6 +573,17 @@ def linear_spec(spec):
 def relative_drag(spec) -> bool:
     """Whether the spec's drag acts on the velocity relative to the flow (``[hydro] drag_flow``)."""
     return getattr(spec, "drag_flow", "body") == "relative"
+
+
+def require_mean_drift(db, path, what: str, *, error=ValueError, fix: str = "") -> None:
+    """Refuse a database without ``mean_drift`` for ``what`` (one check behind the config's
+    ``[hydro] drift`` and the equilibrium in a sea), naming the file and how to make one."""
+    if "mean_drift" not in db:
+        raise error(
+            f"{what} needs the database's mean_drift (the mean drift force per unit wave amplitude "
+            f"squared), which {str(path)!r} does not have: make it with `mfm hydro` and "
+            "[hydro.bem] drift = \"free\" (one wet body), or give WAMIT output with its .8/.9 "
+            f"files{fix}")
 
 
 def wave_drift(spec) -> bool:
@@ -880,12 +925,8 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
         # set only when asked: every other spec keeps its content key (fingerprint) as before
         spec.drag_flow = "relative"
     if options.get("drift", "off") != "off":
-        if "mean_drift" not in db:
-            raise ConfigError(
-                f"hydro.drift: {options['drift']!r} needs the database's mean_drift (the mean drift "
-                f"force per unit wave amplitude squared), which {str(path)!r} does not have: make "
-                "it with `mfm hydro` and [hydro.bem] drift = \"free\" (one wet body), or give "
-                "WAMIT output with its .8/.9 files; or remove hydro.drift")
+        require_mean_drift(db, path, f"hydro.drift: {options['drift']!r}", error=ConfigError,
+                           fix="; or remove hydro.drift")
         spec.drift = options["drift"]       # set only when asked (the spec's content key)
     return spec
 
