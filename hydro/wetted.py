@@ -107,35 +107,38 @@ def triangles(vertices, faces) -> np.ndarray:
 def closed_volume(tri) -> float:
     """Σ a·(b×c)/6 over the triangles: the volume a closed surface encloses (> 0 for outward
     normals)."""
-    T = np.asarray(tri, float)
-    return float(np.einsum("ij,ij->i", T[:, 0], np.cross(T[:, 1], T[:, 2])).sum() / 6.0)
+    from .meshfiles import closed_volume as vol
+
+    return vol(tri)
 
 
-def check_hull(tri, *, what: str) -> None:
-    """Refuse a hull that is not a closed, outward-facing surface: every edge shared by two
-    triangles run in opposite directions, and a positive enclosed volume. (A nonlinear level cuts
-    the hull anywhere: a hole or a face turned inward changes the force wherever it gets wet.)"""
+def check_hull(tri, *, what: str, fix: str | None = None) -> None:
+    """Refuse a hull that is not a closed, outward-facing surface: every edge shared by exactly
+    two triangles run in opposite directions, and a positive enclosed volume. (A nonlinear level
+    cuts the hull anywhere: a hole or a face turned inward changes the force wherever it gets
+    wet.) Errors start with ``what``, give the number of bad edges and a sample of them (m), and
+    the fix; ``fix`` replaces the open hull's (a mesh file's choices)."""
+    from .meshfiles import edge_report, edges_text
+
     T = np.asarray(tri, float)
     if T.ndim != 3 or T.shape[1:] != (3, 3) or not len(T):
         raise ValueError(f"{what}: no triangles; give a closed hull mesh (vertices and faces)")
-    scale = float(np.ptp(T.reshape(-1, 3), axis=0).max())
-    key = np.round(T.reshape(-1, 3) / (1e-9 * scale)).astype(np.int64)
-    _, idx = np.unique(key, axis=0, return_inverse=True)
-    idx = idx.reshape(-1, 3)
-    a, b = idx.reshape(-1), np.roll(idx, -1, axis=1).reshape(-1)
-    directed = a * (idx.max() + 1) + b
-    reverse = b * (idx.max() + 1) + a
-    d_set, counts = np.unique(directed, return_counts=True)
-    if np.any(counts > 1):
-        raise ValueError(f"{what}: {int((counts > 1).sum())} edge(s) run the same way in two "
-                         "triangles: the faces are not ordered consistently (some normals point "
-                         "inward); reorder them for outward normals")
-    missing = ~np.isin(reverse, d_set)
-    if np.any(missing):
-        p = T.reshape(-1, 3)[np.flatnonzero(missing)[0]]
-        raise ValueError(f"{what}: {int(missing.sum())} edge(s) belong to one triangle only (the "
-                         f"first at ({p[0]:.4g}, {p[1]:.4g}, {p[2]:.4g}) m): the hull is open; a "
-                         "nonlinear level needs the whole closed hull, above the water line too")
+    rep = edge_report(T)
+    if len(rep["non_manifold"]):
+        E = rep["non_manifold"]
+        raise ValueError(f"{what}: {len(E)} non-manifold edge(s), shared by three or more "
+                         f"triangles ({edges_text(E)}): duplicated or crossing panels; a hull is "
+                         "one closed surface: remove the extra panels")
+    if len(rep["open"]):
+        E = rep["open"]
+        raise ValueError(f"{what}: {len(E)} edge(s) belong to one triangle only ({edges_text(E)}): "
+                         "the hull is open; " + (fix or "a nonlinear level needs the whole closed "
+                                                 "hull, above the water line too"))
+    if len(rep["flipped"]):
+        E = rep["flipped"]
+        raise ValueError(f"{what}: {len(E)} edge(s) run the same way in two triangles "
+                         f"({edges_text(E)}): the faces are not ordered consistently (some "
+                         "normals point inward); reorder them for outward normals")
     vol = closed_volume(T)
     if vol <= 0:
         raise ValueError(f"{what}: enclosed volume {vol:.6g} m³ ≤ 0: the normals point inward; "
@@ -253,11 +256,15 @@ def _wet_pieces(V, S):
     area_n = 0.5 * _cross(V[1] - V[0], V[2] - V[0])                       # (3, n): A n̂
     n_hat = area_n / _norm(area_n.T)[None]
 
+    parity = [jnp.ones_like(S[0])]
+
     def swap(i, j):
-        # a compare-swap of the sorting network: after it S[i] ≤ S[j]
+        # a compare-swap of the sorting network: after it S[i] ≤ S[j]; a swap turns the
+        # vertices' order (parity −1)
         c = S[j] < S[i]
         V[i], V[j] = jnp.where(c, V[j], V[i]), jnp.where(c, V[i], V[j])
         S[i], S[j] = jnp.where(c, S[j], S[i]), jnp.where(c, S[i], S[j])
+        parity[0] = jnp.where(c, -parity[0], parity[0])
 
     swap(0, 1)
     swap(1, 2)
@@ -281,7 +288,12 @@ def _wet_pieces(V, S):
     weights = ((one | two | all3).astype(v0.dtype), two.astype(v0.dtype))
     areas, mids = [], []
     for (a, b, c), wk in zip((first, second), weights):
-        areas.append(0.5 * _norm(_cross(b - a, c - a).T) * wk)             # (n,)
+        # each piece runs as its sorted parent does (v0 v1 v2; v0 p12 p02 keeps that turn): its
+        # area is its signed area along the parent's normal times the sort's parity. Smooth where
+        # a piece is degenerate (a vertex on the surface: a quadrilateral's second half, zero at
+        # rest, grows linearly with the motion), where |·| has no derivative and the safe norm's
+        # is 0: the stiffness at rest lost that piece's growth
+        areas.append(0.5 * jnp.sum(_cross(b - a, c - a) * n_hat, axis=0) * parity[0] * wk)
         mids.extend(((a + b) / 2, (b + c) / 2, (c + a) / 2))
     return jnp.stack(areas)[:, None], jnp.concatenate(mids, axis=1), n_hat
 
@@ -469,12 +481,15 @@ def _face_grid(corner, u, v, nu: int, nv: int):
 
 HULL_SHAPES = {"sphere": ("radius",), "cylinder": ("radius", "bottom", "top"),
                "box": ("length", "beam", "bottom", "top"), "revolution": ("profile",),
-               "geometry": ("top",)}
-HULL_KEYS = {"shape", "center", "panel_size", "notes"} | {k for v in HULL_SHAPES.values() for k in v}
+               "geometry": ()}
+HULL_KEYS = ({"shape", "center", "panel_size", "notes", "top"}
+             | {k for v in HULL_SHAPES.values() for k in v})
+# a hull from a mesh file (``mesh = "path"`` in place of ``shape``): its keys
+HULL_MESH_KEYS = {"mesh", "center", "freeboard", "notes"}
 
 
-def hull_mesh(spec: dict, *, where: str = "hull", geometry: dict | None = None
-              ) -> tuple[np.ndarray, np.ndarray]:
+def hull_mesh(spec: dict, *, where: str = "hull", geometry: dict | None = None,
+              base=None, read_files: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """A closed hull (vertices (V, 3) m, faces (F, 4) or (F, 3), outward) from a plain dict, the
     ``[bodies.hull]`` table of a config, in the config's axes at rest:
 
@@ -489,20 +504,36 @@ def hull_mesh(spec: dict, *, where: str = "hull", geometry: dict | None = None
     - ``shape = "geometry"``: the body's BEM hull (``geometry``, its :mod:`hydro.geometry` spec:
       cylinder, hemisphere, sphere or revolution) closed above the water line by a vertical wall
       up to a deck at ``top`` (m above still water): the wetted hull the database was made from,
-      with a freeboard. ``center`` is the spec's origin.
+      with a freeboard. ``center`` is the spec's origin. A geometry of ``shape = "mesh"``: its
+      ``file`` translated by its ``origin`` (as ``mfm hydro`` places it), used as it is when the
+      file is the closed hull, and closed by :func:`hydro.meshfiles.extrude_waterline` up to
+      ``top`` when it is the wetted surface only (open at z = 0; a lid in the plane z = 0
+      replaced).
+    - ``mesh = "path"`` (in place of ``shape``): a mesh file (:func:`hydro.meshfiles.read_mesh`:
+      WAMIT .gdf, NEMOH .dat, STL), relative to ``base``, its origin placed at ``center``: the
+      closed hull; or the wetted surface only with ``freeboard`` (m), closed as above up to
+      z = freeboard. Checked closed, manifold and outward (:func:`check_hull`) with errors that
+      name the file.
 
     ``center`` [x, y, z] m (default the origin); ``panel_size`` m (default a sixteenth of the hull's
     smallest dimension): panels no larger, so that the wave pressure's quadrature and a curved
-    hull's facets converge (volumes as O(panel_size²)). ``where`` names the table in errors."""
+    hull's facets converge (volumes as O(panel_size²)). ``where`` names the table in errors.
+    ``base``: the folder relative mesh paths are read from (the config's; None: the working
+    directory); ``read_files`` False checks the table's keys only and returns None (a config given
+    as a dict, whose folder is known only when it loads)."""
     if not isinstance(spec, dict):
         raise ValueError(f"{where}: expected a table such as {{ shape = \"cylinder\", radius = 3.0, "
                          "bottom = -5.0, top = 2.0 }}")
+    if "mesh" in spec:
+        return _hull_of_file(spec, where, base, read_files)
     bad = sorted(set(spec) - HULL_KEYS)
     if bad:
-        raise ValueError(f"{where}: unknown key(s) {bad}; accepted keys: {sorted(HULL_KEYS)}")
+        raise ValueError(f"{where}: unknown key(s) {bad}; accepted keys: {sorted(HULL_KEYS)} "
+                         f"(a hull from a mesh file: {sorted(HULL_MESH_KEYS)})")
     shape = spec.get("shape")
     if shape not in HULL_SHAPES:
-        raise ValueError(f"{where}.shape: {shape!r}; accepted: {sorted(HULL_SHAPES)}")
+        raise ValueError(f"{where}.shape: {shape!r}; accepted: {sorted(HULL_SHAPES)}, or "
+                         "mesh = \"<file>\" in place of shape (WAMIT .gdf, NEMOH .dat, STL)")
     missing = [k for k in HULL_SHAPES[shape] if k not in spec]
     if missing:
         raise ValueError(f"{where}: shape {shape!r} needs {missing}")
@@ -523,8 +554,10 @@ def hull_mesh(spec: dict, *, where: str = "hull", geometry: dict | None = None
     if not np.all(np.isfinite(center)):
         raise ValueError(f"{where}.center: {c!r}; give finite [x, y, z] in m")
     if shape == "geometry":
-        return _hull_of_geometry(spec, geometry, where, number("top", True),
-                                 number("panel_size", True) if "panel_size" in spec else None)
+        return _hull_of_geometry(spec, geometry, where,
+                                 number("top", True) if "top" in spec else None,
+                                 number("panel_size", True) if "panel_size" in spec else None,
+                                 base, read_files)
     if shape in ("cylinder", "box"):
         bottom, top = number("bottom"), number("top")
         if not bottom < top:
@@ -593,9 +626,107 @@ def hull_mesh(spec: dict, *, where: str = "hull", geometry: dict | None = None
     return V + center, F
 
 
-def _hull_of_geometry(spec, geometry, where, top, dx):
+def _as_vertices_faces(T):
+    """Triangles (n, 3, 3) as (vertices (3n, 3), faces (n, 3)): :func:`hull_mesh`'s return."""
+    T = np.asarray(T, float)
+    return T.reshape(-1, 3), np.arange(3 * len(T)).reshape(-1, 3)
+
+
+def _hull_of_file(spec, where, base, read_files):
+    """:func:`hull_mesh` of ``mesh = "path"``: the file's triangles placed at ``center``, closed
+    by its side continued up to ``freeboard`` when the file is the wetted surface only."""
+    import os
+    from pathlib import Path
+
+    from .meshfiles import FORMATS
+
+    if "shape" in spec:
+        raise ValueError(f"{where}: give shape or mesh, not both (shape {spec['shape']!r}, mesh "
+                         f"{spec['mesh']!r})")
+    bad = sorted(set(spec) - HULL_MESH_KEYS)
+    if bad:
+        raise ValueError(f"{where}: key(s) {bad} do not go with mesh (a mesh file's hull); "
+                         f"accepted with mesh: {sorted(HULL_MESH_KEYS)}")
+    f = spec["mesh"]
+    if not isinstance(f, (str, os.PathLike)) or not os.fspath(f):
+        raise ValueError(f"{where}.mesh: {f!r}; give the path of a mesh file (relative to the "
+                         "config's folder): WAMIT .gdf, NEMOH .dat or STL")
+    c = spec.get("center", [0.0, 0.0, 0.0])
+    try:
+        center = np.asarray(c, dtype=float).reshape(3)
+    except (TypeError, ValueError):
+        raise ValueError(f"{where}.center: {c!r}; give [x, y, z] in m (where the file's origin "
+                         "goes, the config's axes at rest)") from None
+    if not np.all(np.isfinite(center)):
+        raise ValueError(f"{where}.center: {c!r}; give finite [x, y, z] in m")
+    fb = spec.get("freeboard")
+    if fb is not None and (isinstance(fb, bool) or not isinstance(fb, (int, float))
+                           or not math.isfinite(fb) or fb <= 0):
+        raise ValueError(f"{where}.freeboard: {fb!r}; give a positive height in m (the deck "
+                         "above still water of a mesh that stops at its water line)")
+    path = Path(f)
+    if path.suffix.lower() not in FORMATS:
+        raise ValueError(f"{where}.mesh {os.fspath(f)!r}: suffix {path.suffix!r} is not a mesh "
+                         f"format read here; accepted: {sorted(FORMATS)} (WAMIT .gdf, NEMOH .dat, "
+                         "STL); convert other formats (e.g. with meshio or trimesh) to STL")
+    if not read_files:
+        return None
+    if not path.is_absolute() and base is not None:
+        path = Path(base) / path
+    what = f"{where}.mesh {os.fspath(f)!r}"
+    return _as_vertices_faces(_closed_mesh_hull(path, center, fb, what, "freeboard"))
+
+
+def _closed_mesh_hull(path, offset, freeboard, what, key):
+    """The triangles of mesh file ``path`` translated by ``offset``, closed up to ``freeboard``
+    (the key ``key`` names it) when the file is the wetted surface only, and checked
+    (:func:`check_hull`): errors start with ``what`` (body, table, file)."""
+    from .meshfiles import edge_report, extrude_waterline, read_mesh
+
+    try:
+        T = read_mesh(path) + np.asarray(offset, float)
+    except FileNotFoundError:
+        raise ValueError(f"{what}: file {str(path)!r} not found (relative paths are read from the "
+                         "config's folder)") from None
+    except ValueError as e:
+        raise ValueError(f"{what}: {e}") from None
+    size = float(np.ptp(T.reshape(-1, 3), axis=0).max())
+    tol = 1e-6 * size
+    zmax = float(T[..., 2].max())
+    lid = np.all(np.abs(T[..., 2]) <= tol, axis=1)     # panels in the water plane z = 0
+    if freeboard is not None:
+        if zmax > tol:
+            raise ValueError(f"{what}: the mesh reaches z = {zmax:.4g} m above still water, so it "
+                             f"is not the wetted surface only; leave {key} out (a closed hull "
+                             "has its own deck) or give the mesh cut at its water line")
+        # a lid in the water plane (a BEM mesh closed at z = 0) is replaced by the wall and deck
+        if not np.any(~lid) or not len(edge_report(T[~lid])["rim"]):
+            raise ValueError(f"{what}: no open water line to continue up to {key} = "
+                             f"{freeboard:g} m (the mesh does not pierce z = 0)")
+        try:
+            T = extrude_waterline(T[~lid], freeboard)
+        except ValueError as e:
+            raise ValueError(f"{what}: {e}") from None
+    elif zmax <= tol and float(T[..., 2].min()) < -tol and np.any(lid):
+        raise ValueError(f"{what}: closed by a lid at the still-water line (its top is z = 0): "
+                         "no freeboard, so a heave or a wave would wet a deck that is not the "
+                         f"hull's; give the whole hull, or give {key} (m) to continue its side "
+                         "vertically above the water line in place of the lid")
+    check_hull(T, what=what, fix=(
+        "the nonlinear level needs the whole closed hull, above the water line too: give a mesh "
+        f"of the whole hull, or, for a mesh that stops at its water line z = 0, {key} = <m> to "
+        "continue its side vertically up to a deck, or an analytic shape (sphere, cylinder, box, "
+        "revolution)"))
+    return T
+
+
+def _hull_of_geometry(spec, geometry, where, top, dx, base=None, read_files=True):
     """:func:`hull_mesh` of ``shape = "geometry"``: the body's hydro.geometry meridian (from its
-    water line down to its keel) under a wall and a deck at ``top``."""
+    water line down to its keel) under a wall and a deck at ``top``; a mesh geometry's file,
+    closed up to ``top`` when it is the wetted surface only (:func:`_closed_mesh_hull`)."""
+    import os
+    from pathlib import Path
+
     from .geometry import meridian, normalize_spec
 
     if geometry is None:
@@ -605,13 +736,32 @@ def _hull_of_geometry(spec, geometry, where, top, dx):
     if "center" in spec:
         raise ValueError(f"{where}.center: shape 'geometry' is placed at its geometry's origin; "
                          "leave center out")
+    if geometry.get("shape") == "mesh":
+        if "panel_size" in spec:
+            raise ValueError(f"{where}.panel_size: the body's geometry is a mesh file, whose "
+                             "panels are its own; leave panel_size out")
+        f = geometry.get("file")
+        if not isinstance(f, (str, os.PathLike)):
+            raise ValueError(f"{where}: its body's geometry.file: {f!r}; give a mesh file's path")
+        if not read_files:
+            return None
+        path = Path(f)
+        if not path.is_absolute() and base is not None:
+            path = Path(base) / path
+        try:
+            g = normalize_spec({"name": "hull", **geometry, "file": str(path)})
+        except (ValueError, TypeError) as e:
+            raise ValueError(f"{where}: its body's geometry: {e}") from None
+        return _as_vertices_faces(_closed_mesh_hull(
+            path, g["origin"], top, f"{where} (shape 'geometry': the body's mesh file {f!r})",
+            "top"))
+    if top is None:
+        raise ValueError(f"{where}: shape 'geometry' needs ['top'] (m above still water: the "
+                         "deck over the body's geometry)")
     try:
         g = normalize_spec({"name": "hull", **geometry})
     except (ValueError, TypeError) as e:
         raise ValueError(f"{where}: its body's geometry: {e}") from None
-    if g["shape"] == "mesh":
-        raise ValueError(f"{where}: shape 'geometry' revolves a body of revolution, and this "
-                         "body's geometry is a mesh file; give the hull's own shape")
     prof0 = meridian(g, 1e9)     # the spec's corners; refined below
     size = min(2 * float(prof0[:, 0].max()), float(np.ptp(prof0[:, 1])) + top)
     dx = size / 16 if dx is None else dx

@@ -295,8 +295,12 @@ def parse_config(data: dict, source: str = "<config>") -> tuple[dict, list[BodyS
             geometry = raw.get("geometry")
             if isinstance(geometry, dict):
                 geometry = {"origin": [float(com[0]), float(com[1]), 0.0], **geometry}
+            # a mesh file is read from the config's folder; a config given as a dict or text
+            # learns its folder (mfm.load's base) when it loads: its table's keys only, here
+            from_file = not source.startswith("<")
             try:
-                hull_mesh(raw["hull"], where=f"{where}.hull", geometry=geometry)
+                hull_mesh(raw["hull"], where=f"{where}.hull", geometry=geometry,
+                          base=Path(source).parent if from_file else None, read_files=from_file)
             except ValueError as e:
                 raise ConfigError(str(e)) from None
             extra["hull"] = dict(raw["hull"])

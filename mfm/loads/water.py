@@ -920,7 +920,7 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
                      body_coupling=coupling, added_mass_inf=options.get("added_mass_inf", "consistent"),
                      source=str(path), moving=moving)
     if options.get("hydrostatics", "linear") == "nonlinear":
-        attach_hulls(spec, [by_name[name] for name, _, _ in wet])
+        attach_hulls(spec, [by_name[name] for name, _, _ in wet], config_dir)
     if options.get("drag_flow", "body") == "relative":
         # set only when asked: every other spec keeps its content key (fingerprint) as before
         spec.drag_flow = "relative"
@@ -939,12 +939,14 @@ HULL_VOLUME_RTOL = 0.03
 HULL_COB_RTOL = 0.03
 
 
-def attach_hulls(spec, bodies) -> None:
+def attach_hulls(spec, bodies, config_dir=None) -> None:
     """Give ``spec`` (its bodies ``bodies``, config BodySpecs in the spec's order) the nonlinear
-    level: each body's closed hull (``[bodies.hull]``, :func:`hydro.wetted.hull_mesh`), checked
-    closed and outward, its still-water volume and centre of buoyancy against the database's
+    level: each body's closed hull (``[bodies.hull]``, :func:`hydro.wetted.hull_mesh`: an analytic
+    shape, the body's geometry, or a mesh file read from ``config_dir``), checked closed,
+    manifold and outward, its still-water volume and centre of buoyancy against the database's
     (:data:`HULL_VOLUME_RTOL`, :data:`HULL_COB_RTOL` of V^{1/3}): ``spec.hulls`` (triangles at
-    rest, inertial axes) and ``spec.hydrostatics = "nonlinear"``."""
+    rest, inertial axes) and ``spec.hydrostatics = "nonlinear"``. Every path (shape, geometry,
+    mesh) passes the same checks here."""
     from hydro.wetted import check_hull, hull_mesh, submerged_volume, triangles
 
     from ..errors import ConfigError
@@ -959,8 +961,19 @@ def attach_hulls(spec, bodies) -> None:
                 "each wet body's instantaneous wetted hull, so each needs its closed hull, above "
                 "the water line too: a [bodies.hull] table such as { shape = \"cylinder\", "
                 "radius = 3.0, bottom = -5.0, top = 2.0 } (shapes: sphere, cylinder, box, "
-                "revolution)")
-        V, F = hull_mesh(b.extra["hull"], where=where, geometry=b.extra.get("hull_geometry"))
+                "revolution, geometry), or { mesh = \"hull.stl\" } (a mesh file of the closed "
+                "hull: WAMIT .gdf, NEMOH .dat, STL)")
+        h = b.extra["hull"]
+        if "mesh" in h:
+            where = f"{where}.mesh {h['mesh']!r}"
+        elif h.get("shape") == "geometry" and (b.extra.get("hull_geometry") or {}).get("shape") \
+                == "mesh":
+            where = f"{where} (the body's mesh file {b.extra['hull_geometry'].get('file')!r})"
+        try:
+            V, F = hull_mesh(h, where=f"bodies ({b.name!r}).hull",
+                             geometry=b.extra.get("hull_geometry"), base=config_dir)
+        except ValueError as e:
+            raise ConfigError(str(e)) from None
         T = triangles(V, F)
         try:
             check_hull(T, what=where)
