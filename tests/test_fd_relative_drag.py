@@ -87,25 +87,26 @@ def test_the_equivalent_coefficient_against_closed_forms_and_quadrature():
     iso3 = fd.vector_coefficient(D, s**2 * np.eye(3))
     np.testing.assert_allclose(iso3, D * 8 / 3 * math.sqrt(2 / math.pi) * s * np.eye(3),
                                rtol=1e-12, atol=1e-15)
-    # anisotropic, rotated by 0.5 rad in the x–z plane
+    # anisotropic (axis ratios 3 and 50), rotated by 0.5 rad in the x–z plane
     c, sn = math.cos(0.5), math.sin(0.5)
     Q = np.array([[c, 0, -sn], [0, 1, 0], [sn, 0, c]])
-    lam = np.array([0.3**2, 0.0, 0.1**2])
-    cov = Q @ np.diag(lam) @ Q.T
-    C = fd.vector_coefficient(D, cov)
+    for s1, s2 in ((0.3, 0.1), (0.5, 0.01)):
+        lam = np.array([s1**2, 0.0, s2**2])
+        C = fd.vector_coefficient(D, Q @ np.diag(lam) @ Q.T)
 
-    def expect(i, j):
-        def f(y2, y1):
-            w = Q @ np.array([y1, 0.0, y2])
-            m = np.linalg.norm(w)
-            J = m * (i == j) + (w[i] * w[j] / m if m > 0 else 0.0)
-            dens = np.exp(-0.5 * (y1**2 / lam[0] + y2**2 / lam[2])) / (2 * math.pi * math.sqrt(lam[0] * lam[2]))
-            return J * dens
-        return scipy.integrate.dblquad(f, -9 * 0.3, 9 * 0.3, -9 * 0.1, 9 * 0.1,
-                                       epsabs=1e-12, epsrel=1e-10)[0]
+        def expect(i, j):
+            def f(y2, y1):
+                w = Q @ np.array([y1, 0.0, y2])
+                m = np.linalg.norm(w)
+                J = m * (i == j) + (w[i] * w[j] / m if m > 0 else 0.0)
+                return J * np.exp(-0.5 * (y1**2 / lam[0] + y2**2 / lam[2])) / (
+                    2 * math.pi * math.sqrt(lam[0] * lam[2]))
+            return scipy.integrate.dblquad(f, -9 * s1, 9 * s1, -9 * s2, 9 * s2,
+                                           epsabs=1e-13, epsrel=1e-10)[0]
 
-    for i, j in ((0, 0), (2, 2), (0, 2), (1, 1)):
-        np.testing.assert_allclose(C[i, j], D * expect(i, j), rtol=1e-8, atol=1e-10)
+        for i, j in ((0, 0), (2, 2), (0, 2), (1, 1)):
+            np.testing.assert_allclose(C[i, j], D * expect(i, j), rtol=1e-8,
+                                       atol=1e-10 * np.abs(C).max())
     group = fd.QuadraticDrag(rows=np.zeros((1, 3, 1)), project=np.eye(3)[None],
                              drag=np.array([[1.0, 2.0, 3.0]]), kind="axis",
                              positions=np.zeros((1, 3)), labels=("p",))
@@ -204,7 +205,9 @@ def test_the_morison_inertia_excitation_of_a_vertical_cylinder():
     heave gets none (the flow along the member is not Morison's). A member through the surface
     (to z = +2 m, a segment boundary at z = 0) takes the flow up to the mean surface only. The
     drag's slope at rest is 0: with C_D ≠ 0 mfm.frequency_response is the inertia part alone,
-    the same as with C_D = 0 (to round-off)."""
+    the same as with C_D = 0 (to round-off). Held in surge, the joint's surge reaction changes by
+    −F_x, the closed form's midpoint sum (the element's body loads; 1e-8: the difference of two
+    reactions that each carry the hull's much larger wave force)."""
     from mfm.frequency.rest import linear_system
 
     D_c, ca, beta = 0.6, 1.0, math.radians(30.0)
@@ -225,11 +228,20 @@ def test_the_morison_inertia_excitation_of_a_vertical_cylinder():
         surge, heave = (list(m.coordinates).index(f"sphere.{d}") for d in ("surge", "heave"))
         np.testing.assert_allclose(F[:, surge], ref, rtol=1e-5)
         assert np.all(np.abs(F[:, heave]) <= 1e-12 * np.abs(ref).max())
-    dry = copy.deepcopy(el)
-    dry["cd"] = 0.0
-    a = mfm.frequency_response(m, w)            # the sphere's database has heading 0 only
-    b = mfm.frequency_response(_sphere(morison=[dry]), w)
+    # held in surge (free in heave only), the joint takes the element's surge force: its
+    # reaction changes by −F_x, the midpoint sum of the closed form at heading 0 (the body
+    # loads of frequency_terms); the drag (C_D ≠ 0) changes nothing per unit amplitude
+    n = 24
+    el = dict(el, to=[0.0, 0.0, -1.0], segments=n)
+    a = mfm.frequency_response(_sphere(HEAVE, morison=[el]), w)   # the database: heading 0 only
+    b = mfm.frequency_response(_sphere(HEAVE, morison=[dict(el, cd=0.0)]), w)
     np.testing.assert_allclose(a.rao.values, b.rao.values, rtol=1e-12, atol=1e-15)
+    c = mfm.frequency_response(_sphere(HEAVE), w)
+    z = -10.0 + 9.0 * (np.arange(n) + 0.5) / n
+    ref = (rho * (1 + ca) * math.pi * D_c**2 / 4 * (-1j * w) * w
+           * np.sum(np.exp(k[:, None] * z[None]), axis=1) * 9.0 / n)
+    np.testing.assert_allclose(a.joint_force_rao.values[:, 0, 0] - c.joint_force_rao.values[:, 0, 0],
+                               -ref, rtol=1e-8)
 
 
 def _plate_model(joint, cd):

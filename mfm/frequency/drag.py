@@ -13,13 +13,9 @@ lemma for a zero-mean Gaussian w of covariance Σ):
     C = diag(D_a √(8/π) σ_a),   σ_a² = Σ_aa                       (a drag per axis, |w_a| w_a)
 
 — per axis Borgman's c_eq = D √(8/π) σ (E[|w| w · w]/E[w²] for a scalar Gaussian), which
-:mod:`mfm.studies.design` takes on the body's own velocity. The vector form: with w = L z
-(L Lᵀ = Σ, z standard normal in the rank r of Σ), E[J(w)] = E[ρ] · mean over the unit sphere
-S^{r−1} of J(L n) (J homogeneous of degree 1, ρ = |z| chi-distributed with r degrees of freedom:
-E[ρ] = √2 Γ((r+1)/2)/Γ(r/2)); the sphere's mean by exact points for r = 1 (n = ±1: Borgman's
-√(8/π) σ along the flow), the trapezoidal rule on the circle for r = 2 and Gauss–Legendre in
-cos θ times the trapezoidal rule in φ for r = 3 (J(Ln) smooth where Σ has full rank r: both
-converge geometrically).
+:mod:`mfm.studies.design` takes on the body's own velocity. The vector form is diagonal in Σ's
+eigenbasis, each entry a one-dimensional Laplace integral (:func:`vector_coefficient`): along a
+one-dimensional flow Borgman's √(8/π) σ, across it E|w| = √(2/π) σ.
 
 Put in the equation of motion (x(t) = Re[x̂ e^{−iωt}], per unit complex wave amplitude,
 Z(ω) x̂ = F(ω) of :mod:`mfm.frequency.response`), C w = C P û − C R q̇ gives
@@ -46,54 +42,47 @@ from ..loads.base import QuadraticDrag
 BORGMAN = math.sqrt(8.0 / math.pi)
 # the fixed point: stopped once max|ΔC| ≤ TOL · max|C| or after MAX_ITERATIONS
 TOL, MAX_ITERATIONS = 1e-10, 200
-# eigenvalues of Σ below RANK_TOL × the largest count as 0 (a flow along fewer axes: w = L z in
-# the rank of Σ; a direction of relative variance 1e-10 changes C by ~1e-5 of itself at most)
+# eigenvalues of Σ below RANK_TOL × the largest count as 0: the round-off of a flow along fewer
+# axes (a direction of relative variance 1e-10 changes C by ~1e-5 of itself at most)
 RANK_TOL = 1e-10
-# quadrature on the unit circle (r = 2) and sphere (r = 3): geometric convergence for a smooth
-# J(Ln); 256 and 48 × 96 points leave < 1e-12 for axis ratios of Σ down to ~1e-2 (tests)
-N_CIRCLE, N_THETA, N_PHI = 256, 48, 96
-
-
-def _sphere_mean_J(L, r):
-    """The mean over the unit sphere S^{r−1} of J(L n) = |Ln| I + (Ln)(Ln)ᵀ/|Ln|, L (3, r)."""
-    if r == 1:
-        n = np.array([[1.0], [-1.0]])
-        wts = np.array([0.5, 0.5])
-    elif r == 2:
-        phi = 2 * np.pi * np.arange(N_CIRCLE) / N_CIRCLE
-        n = np.stack([np.cos(phi), np.sin(phi)], axis=1)
-        wts = np.full(N_CIRCLE, 1.0 / N_CIRCLE)
-    else:
-        c, wc = np.polynomial.legendre.leggauss(N_THETA)         # cos θ on [−1, 1]
-        phi = 2 * np.pi * np.arange(N_PHI) / N_PHI
-        s = np.sqrt(1 - c**2)
-        n = np.stack([(s[:, None] * np.cos(phi)).ravel(), (s[:, None] * np.sin(phi)).ravel(),
-                      np.repeat(c, N_PHI)], axis=1)
-        wts = (np.repeat(wc, N_PHI) / (2 * N_PHI))                # sums to 1: the mean
-    w = n @ L.T                                                   # (N, 3)
-    m = np.linalg.norm(w, axis=1)
-    inv = np.where(m > 0, 1.0 / np.where(m > 0, m, 1.0), 0.0)
-    J = m[:, None, None] * np.eye(3) + w[:, :, None] * w[:, None, :] * inv[:, None, None]
-    return np.einsum("n,nab->ab", wts, J)
-
-
-def chi_mean(r: int) -> float:
-    """E[|z|] for z standard normal in r dimensions: √2 Γ((r+1)/2)/Γ(r/2)."""
-    return math.sqrt(2.0) * math.exp(math.lgamma((r + 1) / 2) - math.lgamma(r / 2))
+# the Laplace integrals of vector_coefficient: the trapezoidal rule in τ = ln s on [−80, 100]
+# (s in units of 1/(2 λ_max)) with step 0.25: the integrands decay as e^{−|τ|/2} at both ends
+# (below e^{−36} at the ends for every kept eigenvalue ≥ RANK_TOL λ_max) and are analytic in a
+# strip of half-width π, so the rule's error is ~e^{−2π²/h}: round-off, at any axis ratio
+_TAU = np.arange(-80.0, 100.0 + 0.125, 0.25)
+_H = 0.25
 
 
 def vector_coefficient(D, cov):
-    """C = D E[|w| I + w wᵀ/|w|] (3, 3) for a zero-mean Gaussian w of covariance ``cov`` (3, 3)
-    (module docstring); 0 for a w that is 0."""
+    """C = D E[|w| I + w wᵀ/|w|] (3, 3) for a zero-mean Gaussian w of covariance ``cov`` (3, 3);
+    0 for a w that is 0.
+
+    In Σ's eigenbasis (w = V y, y_i independent of variance λ_i) the expectation is diagonal (y_i
+    → −y_i leaves the density unchanged): C = D V diag(E|y| + E[y_i²/|y|]) Vᵀ, each a Laplace
+    integral from |y| = (2√π)⁻¹ ∫₀^∞ (1 − e^{−s|y|²}) s^{−3/2} ds,
+    1/|y| = π^{−1/2} ∫₀^∞ e^{−s|y|²} s^{−1/2} ds and E[e^{−s|y|²}] = Π_k (1 + 2sλ_k)^{−1/2}:
+
+        E|y| = (2√π)⁻¹ ∫₀^∞ [1 − Π_k (1 + 2sλ_k)^{−1/2}] s^{−3/2} ds,
+        E[y_i²/|y|] = π^{−1/2} ∫₀^∞ λ_i (1 + 2sλ_i)^{−1} Π_k (1 + 2sλ_k)^{−1/2} s^{−1/2} ds,
+
+    by the trapezoidal rule in ln s (round-off at any axis ratio). Along a one-dimensional flow of
+    σ: D √(8/π) σ (Borgman's), across it D √(2/π) σ."""
     cov = 0.5 * (np.asarray(cov, dtype=float) + np.asarray(cov, dtype=float).T)
     lam, V = np.linalg.eigh(cov)
     top = lam.max()
     if not top > 0:
         return np.zeros((3, 3))
-    keep = lam > RANK_TOL * top
-    L = V[:, keep] * np.sqrt(lam[keep])[None]
-    r = int(keep.sum())
-    return float(D) * chi_mean(r) * _sphere_mean_J(L, r)
+    # in units where 2 λ_max = 1 (|y| then scales back by √(2 λ_max))
+    lam = np.where(lam > RANK_TOL * top, lam, 0.0) / (2 * top)
+    sv = np.exp(_TAU)[:, None]
+    log_f = np.log1p(2.0 * sv * lam[None])                            # (n_τ, 3)
+    prod = np.exp(-0.5 * np.sum(log_f, axis=1))                       # E[e^{−s|y|²}]
+    one_minus = -np.expm1(-0.5 * np.sum(log_f, axis=1))               # 1 − Π, no cancellation
+    mean_norm = _H * np.sum(one_minus * np.exp(-0.5 * _TAU)) / (2 * math.sqrt(math.pi))
+    mean_sq = _H * np.sum(lam[None] * np.exp(-log_f) * (prod * np.exp(0.5 * _TAU))[:, None],
+                          axis=0) / math.sqrt(math.pi)
+    d = math.sqrt(2 * top) * (mean_norm + mean_sq)
+    return float(D) * (V * d[None]) @ V.T
 
 
 def coefficients(group: QuadraticDrag, cov):

@@ -29,8 +29,23 @@ The sea comes through :meth:`MorisonElements.for_run` (every component of the ru
 headings, spreading), ramped as the water's excitation is; still water leaves the drag on the
 element's own velocity. ρ, g and the water depth are the model's ``[hydro]`` (a ``[[morison]]``
 without one is refused). Linearised at rest (equilibrium, natural frequencies) the load is its
-added mass (the drag has zero slope at rest); a frequency response to waves and the linear and
-spectral levels refuse it (its wave force is not there yet): use :func:`mfm.simulate`.
+added mass (the drag has zero slope at rest).
+
+**In the frequency domain.** The inertia term's linear part is a wave force per unit complex
+amplitude (:meth:`MorisonElements.frequency_terms`),
+
+    F(ω, β) = Σ_p H_pᵀ ρ (1 + C_A) V_p (I − e_p e_pᵀ) (−iω) û_p(ω, β),
+
+û the linear particle velocity at the point's rest position (:func:`hydro.wetted.velocity_transfer`;
+0 above the mean surface), the added mass ρ C_A V already on the mass side: so
+:func:`mfm.frequency_response` takes the element, with its drag's zero slope (a response per unit
+amplitude has no sea to linearise on: with C_D ≠ 0 it is the inertia part alone, as with C_D = 0).
+:func:`mfm.spectral_response` (and ``mfm.sweep(level="spectral")``) adds the drag linearised
+stochastically on the relative normal flow of each sea, per point (:meth:`quadratic_drag`,
+:mod:`mfm.frequency.drag`: ½ ρ C_D A |w_n| w_n ≈ C w_n, C = ½ ρ C_D A E[|w| I + w wᵀ/|w|] of the
+Gaussian w_n, iterated to a fixed point): damping C on the point's normal velocity, excitation C
+û_n. The linear level (:func:`mfm.linear_response`) still refuses it (no time-domain realisation
+there): use :func:`mfm.simulate`.
 ``simulate_batch`` takes it for seas of as many components (their wave arrays stack on the case
 axis; others are refused by :func:`mfm.loads.assembly.stack_cases`).
 

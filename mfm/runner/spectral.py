@@ -39,6 +39,7 @@ damping, less where radiation and PTO damping do.
 from __future__ import annotations
 
 import time as _time
+import warnings
 
 import numpy as np
 import xarray as xr
@@ -67,9 +68,13 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
     ``pto_power_mean`` (pto) the expected mean power of each joint damper and hydraulic piston
     (W; a piston's rate ẇ = G q̇ linearised at q₀, :meth:`~mfm.loads.base.Load.linear_dampers`),
     ``equilibrium`` (coordinate); with ``t`` also ``q``, ``qd`` (time, coordinate), ``pto_power``
-    (time, pto) = c (G q̇)² (W) and ``eta`` (time) the elevation at the origin (m). Attributes:
-    provenance, the sea, ``level = "spectral"``, ``n_components`` and the wall time. The one-sea
-    case of :func:`spectral_sweep`.
+    (time, pto) = c (G q̇)² (W) and ``eta`` (time) the elevation at the origin (m). With drag on
+    the relative flow (``[hydro] drag_flow = "relative"``, ``[[morison]]`` elements: module
+    docstring) also ``drag_damping`` (drag_point, flow_axis, flow_axis_col) each point's
+    equivalent damping C (N s/m) and ``relative_flow_rms`` (drag_point, flow_axis) the standard
+    deviation of its relative flow (m/s), and the attributes ``drag_iterations``, ``drag_change``
+    (the fixed point's). Attributes: provenance, the sea, ``level = "spectral"``,
+    ``n_components`` and the wall time. The one-sea case of :func:`spectral_sweep`.
     """
     model = check_model(model)
     if model.hydro is None:
@@ -194,8 +199,10 @@ def spectral_sweep(model: Model, seas, *, t=None, q0=None, loads=None,
     piston (W; as :func:`spectral_response`),
     ``n_components`` (case), ``equilibrium`` (coordinate); with ``t`` also ``time`` (case, step),
     ``q``, ``qd`` (case, step, coordinate), ``pto_power`` (case, step, pto) and ``eta`` (case,
-    step). Attributes: provenance, ``level = "spectral"``, the seas, ``n_frequencies_solved`` (the
-    union), the wall times of the RAO solve and of the whole call.
+    step); with drag on the relative flow ``drag_damping`` (case, drag_point, flow_axis,
+    flow_axis_col) and ``relative_flow_rms`` (case, drag_point, flow_axis), each sea linearised on
+    its own (module docstring). Attributes: provenance, ``level = "spectral"``, the seas,
+    ``n_frequencies_solved`` (the union), the wall times of the RAO solve and of the whole call.
     """
     start = _time.perf_counter()
     if model.hydro is None:
@@ -266,7 +273,7 @@ def _drag_raos(model, sys, comps_list, options, groups):
     "sigma" (B, P, 3), "iterations" (B,), "change" (B,)})."""
     from hydro.wetted import velocity_transfer
 
-    from ..frequency.drag import linearise
+    from ..frequency.drag import TOL, linearise
     from ..frequency.response import _system
 
     n = model.n_coordinates
@@ -283,6 +290,11 @@ def _drag_raos(model, sys, comps_list, options, groups):
         U = [velocity_transfer(g.positions, cm.omega, cm.wavenumber, cm.heading, depth)
              for g in groups]
         lin = linearise(groups, Zu[idx], Fu[idx], cm.omega, cm.amplitude, U)
+        if lin.change > TOL:
+            warnings.warn(f"case {i}: the stochastic drag linearisation's fixed point did not "
+                          f"converge in {lin.iterations} iterations (last relative change of C "
+                          f"{lin.change:.3g} > {TOL:g}); its answer is the last iterate",
+                          RuntimeWarning, stacklevel=3)
         xs.append(lin.x)
         C.append(lin.C)
         sigma.append(lin.sigma)
