@@ -165,7 +165,8 @@ def test_the_fixed_point_against_scipy_s_scalar_root():
     equation c = D √(8/π) σ(c), σ(c)² = Σ_j ½ a_j² |û_z + iω_j x_j(c)|²,
     x_j(c) = (F_j + c û_z)/(Z_j − iω_j c); scipy's brentq root against the spectral level's
     coefficient and its heave standard deviation, 1e-8 (the root's and the iteration's tolerances).
-    The drag (C_D 4) takes 13 % off the heave standard deviation here (it is not small)."""
+    The drag (C_D 4) takes 13 % off the heave standard deviation here (it is not small). A sweep
+    of two seas gives each its own coefficient, the single responses' (1e-12)."""
     from mfm.frequency.rest import linear_system
     from mfm.frequency.response import _system
 
@@ -194,6 +195,14 @@ def test_the_fixed_point_against_scipy_s_scalar_root():
     free = math.sqrt(np.sum(half * np.abs(F / Z)**2))
     print(f"heave rms with the drag {rms:.4f}, without {free:.4f}")
     assert rms < 0.9 * free, (rms, free)
+    # a sweep linearises each sea on its own: its cases are the single responses
+    other = hydro.Jonswap(hs=2.0, tp=3.5, seed=5, n_components=60, omega_range=(1.0, 6.0))
+    sw = mfm.sweep(m, [sea, other], level="spectral")
+    for i, s in enumerate((sea, other)):
+        one = ds if i == 0 else mfm.spectral_response(m, s)
+        np.testing.assert_allclose(sw.drag_damping.values[i], one.drag_damping.values, rtol=1e-12)
+        np.testing.assert_allclose(sw.q_rms.values[i], one.q_rms.values, rtol=1e-12)
+    assert sw.drag_damping.values[1, 0, 2, 2] > 1.05 * sw.drag_damping.values[0, 0, 2, 2]
 
 
 # ------------------------------------------------------------------------------ Morison elements
