@@ -234,6 +234,37 @@ def particle_acceleration(wave: WaveField, points, t):
     return jnp.where(wet[..., None], a, 0.0)
 
 
+def velocity_transfer(points, omega, wavenumber, heading, water_depth: float) -> np.ndarray:
+    """The linear particle velocity per unit complex wave amplitude at fixed ``points`` (P, 3)
+    (inertial, at rest) for components (ω_j, k_j, β_j) (n,): û (n, P, 3) complex with
+    u(t) = Re[c û e^{−iωt}] for a component of complex amplitude c = a e^{iφ} (the hydro
+    databases' convention; :func:`particle_velocity` of that component to first order in a):
+
+        û_h = ω f_h(z) e^{ik(x cos β + y sin β)} (cos β, sin β),
+        û_z = −i ω f_v(z) e^{ik(x cos β + y sin β)},
+
+    f_h = cosh k(z + h)/sinh k h, f_v = sinh k(z + h)/sinh k h (e^{kz} both in deep water), at the
+    rest depth z (the stretching is second order); 0 at a point above the mean surface (dry at
+    rest). The acceleration's is −iω û. numpy (the frequency domain's host side)."""
+    p = np.asarray(points, dtype=float).reshape(-1, 3)
+    w = np.asarray(omega, dtype=float).reshape(-1, 1)
+    k = np.asarray(wavenumber, dtype=float).reshape(-1, 1)
+    b = np.asarray(heading, dtype=float).reshape(-1, 1)
+    x, y, z = p[None, :, 0], p[None, :, 1], np.minimum(p[None, :, 2], 0.0)
+    h = float(water_depth)
+    if math.isinf(h):
+        fh = fv = np.exp(k * z)
+    else:
+        zc = np.clip(z, -h, 0.0)
+        e, d = np.exp(k * zc), 1 - np.exp(-2 * k * h)
+        fh = e * (1 + np.exp(-2 * k * (zc + h))) / d
+        fv = e * (1 - np.exp(-2 * k * (zc + h))) / d
+    ph = w * np.exp(1j * k * (x * np.cos(b) + y * np.sin(b)))
+    wet = (p[None, :, 2] <= 0.0)
+    u = np.stack([ph * fh * np.cos(b), ph * fh * np.sin(b), -1j * ph * fv], axis=-1)
+    return np.where(wet[..., None], u, 0.0)
+
+
 # ------------------------------------------------------------------------------------- the cut
 def _norm(v):
     """|v| over the last axis with a derivative at v = 0 (0 there, not 0/0: an absent piece of

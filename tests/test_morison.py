@@ -229,9 +229,9 @@ def test_from_python_it_is_the_config_s_load():
         MorisonElements.create(m, "sphere", start=el["from"], end=el["to"], cd=1.0, area=1.0)
 
 
-def test_a_model_without_water_and_the_frequency_domain_refuse_it():
+def test_a_model_without_water_refuses_it_and_the_frequency_domain_takes_it():
     """[[morison]] without [hydro] names the table to add; a frequency response to waves and the
-    spectral level name mfm.simulate (the wave force is not in the frequency domain), while the linearisation at rest
+    spectral level take the element (its wave force), while the linearisation at rest
     takes the element's added mass ρ C_A V on its point's translations (to round-off) and no
     damping or stiffness (the drag's slope at rest is 0)."""
     cfg = tomllib.loads((CONFIGS / "double_pendulum.toml").read_text())
@@ -242,10 +242,10 @@ def test_a_model_without_water_and_the_frequency_domain_refuse_it():
         mfm.load(cfg, base=CONFIGS)
     m = _model({"body": "sphere", "point": [0.0, 0.0, -0.3], "cd": 1.0, "area": 3.0,
                 "volume": 2.0, "ca": 0.5})
-    with pytest.raises(NotImplementedError, match=r"\[\[morison\]\].*mfm.simulate"):
-        mfm.frequency_response(m, np.array([1.0, 2.0]))
-    with pytest.raises(NotImplementedError, match=r"\[\[morison\]\].*mfm.simulate"):
-        mfm.spectral_response(m, hydro.Jonswap(hs=1.0, tp=6.0))
+    # a frequency response to waves takes the inertia term's wave force (tests/
+    # test_fd_relative_drag.py), the spectral level the drag's stochastic linearisation too
+    assert np.all(np.isfinite(mfm.frequency_response(m, np.array([1.0, 2.0])).rao.values))
+    assert "drag_damping" in mfm.spectral_response(m, hydro.Jonswap(hs=1.0, tp=6.0))
     # at rest the element is its added mass on its point's translations (the point is the
     # sphere's CoM: surge and heave, not pitch), its drag of zero slope, no stiffness
     from mfm.frequency.rest import linear_system

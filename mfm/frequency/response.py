@@ -14,7 +14,9 @@ With x(t) = Re[x̂ e^{−iωt}] (the hydro databases' convention):
     Z(ω) x̂ = F(ω),   Z(ω) = −ω² M − iω C + K + Σ Z_load(ω).
 
 x̂ per metre of wave amplitude is the RAO of every coordinate; bodies, hydro dofs, PTOs and named
-points follow from the same Jacobians. Quadratic drag has zero slope at rest (it drops out).
+points follow from the same Jacobians. Quadratic drag has zero slope at rest (it drops out here;
+:func:`mfm.spectral_response` linearises drag on the relative flow stochastically over a sea,
+:mod:`mfm.frequency.drag`).
 """
 from __future__ import annotations
 
@@ -50,11 +52,16 @@ def _terms(model, sys, omega, heading, options):
     return Z, F
 
 
-def _amplitudes(model, sys, omega, heading, options):
-    """x̂ (n_ω, n_q) per metre of wave amplitude: [−ω² M − iω C + K + Σ Z_load(ω)] x̂ = F(ω, β)."""
+def _system(model, sys, omega, heading, options):
+    """Z(ω) = −ω² M − iω C + K + Σ Z_load(ω) (n_ω, n_q, n_q) and F(ω, β) (n_ω, n_q)."""
     Zl, F = _terms(model, sys, omega, heading, options)
     w = omega[:, None, None]
-    Z = -w**2 * sys.M[None] - 1j * w * sys.C[None] + sys.K[None] + Zl
+    return -w**2 * sys.M[None] - 1j * w * sys.C[None] + sys.K[None] + Zl, F
+
+
+def _amplitudes(model, sys, omega, heading, options):
+    """x̂ (n_ω, n_q) per metre of wave amplitude: [−ω² M − iω C + K + Σ Z_load(ω)] x̂ = F(ω, β)."""
+    Z, F = _system(model, sys, omega, heading, options)
     return np.linalg.solve(Z, F[..., None])[..., 0]
 
 

@@ -118,6 +118,21 @@ class LinearHydro(NamedTuple):
     coefficients: Any
 
 
+class QuadraticDrag(NamedTuple):
+    """The quadratic drags a load puts on the flow past points, linearised about q₀
+    (:meth:`Load.quadratic_drag`, linearised by :mod:`mfm.frequency.drag`): ``rows`` R (P, 3, n_q) the points' velocity
+    v = R q̇ already projected (normal to a member), ``project`` P (P, 3, 3) the projector of the
+    flow, ``drag`` D: (P, 3) per inertial axis (``kind = "axis"``: D_a |w_a| w_a) or (P,) on the
+    vector (``kind = "vector"``: D |w| w), ``positions`` (P, 3) the points at rest (inertial),
+    ``labels`` (P,) names of the points (outputs)."""
+    rows: np.ndarray
+    project: np.ndarray
+    drag: np.ndarray
+    kind: str
+    positions: np.ndarray
+    labels: tuple
+
+
 class Load(eqx.Module):
     """Base class of every load: an immutable pytree (``equinox.Module``).
 
@@ -134,7 +149,9 @@ class Load(eqx.Module):
       (a load that is a PTO);
     - the linearisation: :meth:`static_load` (its part at rest; None: nothing static),
       :meth:`frequency_terms` with :meth:`frequency_body_loads` and :meth:`frequency_range`,
-      :meth:`frequency_outputs`, :meth:`linear_dampers` (a PTO's damping about q₀);
+      :meth:`frequency_outputs`, :meth:`linear_dampers` (a PTO's damping about q₀),
+      :meth:`quadratic_drag` (drag on the relative flow, for the spectral level's stochastic
+      linearisation);
     - words: :meth:`provenance`, :meth:`describe_nonfinite`.
 
     - a run: :meth:`for_run` (the load laid on a run's sea and time grid: wave tables at the
@@ -254,6 +271,14 @@ class Load(eqx.Module):
             "cannot include them; define frequency_body_loads, or call frequency_response with "
             "joint_reactions=False")
 
+    def quadratic_drag(self, model, kin0):
+        """The quadratic drags this load puts on the flow past points, about the kinematics
+        ``kin0`` of q₀, as a :class:`QuadraticDrag` (their velocity rows, the
+        flow's projector, the coefficients and the points at rest): what the spectral level
+        linearises stochastically on the relative flow (:mod:`mfm.frequency.drag`); None
+        (default): none (the drag must already be in :meth:`evaluate`, whose slope at rest is 0)."""
+        return None
+
     def frequency_range(self):
         """(ω_lo, ω_hi) rad/s where :meth:`frequency_terms` is defined, or None (everywhere)."""
         return None
@@ -286,4 +311,4 @@ OPTIONAL = ("n_states", "initial_state", "init_memory", "update_memory", "reacti
             "diagnostics", "outputs", "batch_outputs", "pto_records", "static_load",
             "frequency_terms", "frequency_body_loads", "frequency_range", "frequency_outputs",
             "linear_dampers", "provenance", "describe_nonfinite", "for_run", "host_view",
-            "linear_hydro")
+            "linear_hydro", "quadratic_drag")

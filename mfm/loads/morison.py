@@ -29,8 +29,23 @@ The sea comes through :meth:`MorisonElements.for_run` (every component of the ru
 headings, spreading), ramped as the water's excitation is; still water leaves the drag on the
 element's own velocity. ρ, g and the water depth are the model's ``[hydro]`` (a ``[[morison]]``
 without one is refused). Linearised at rest (equilibrium, natural frequencies) the load is its
-added mass (the drag has zero slope at rest); a frequency response to waves and the linear and
-spectral levels refuse it (its wave force is not there yet): use :func:`mfm.simulate`.
+added mass (the drag has zero slope at rest).
+
+**In the frequency domain.** The inertia term's linear part is a wave force per unit complex
+amplitude (:meth:`MorisonElements.frequency_terms`),
+
+    F(ω, β) = Σ_p H_pᵀ ρ (1 + C_A) V_p (I − e_p e_pᵀ) (−iω) û_p(ω, β),
+
+û the linear particle velocity at the point's rest position (:func:`hydro.wetted.velocity_transfer`;
+0 above the mean surface), the added mass ρ C_A V already on the mass side: so
+:func:`mfm.frequency_response` takes the element, with its drag's zero slope (a response per unit
+amplitude has no sea to linearise on: with C_D ≠ 0 it is the inertia part alone, as with C_D = 0).
+:func:`mfm.spectral_response` (and ``mfm.sweep(level="spectral")``) adds the drag linearised
+stochastically on the relative normal flow of each sea, per point (:meth:`quadratic_drag`,
+:mod:`mfm.frequency.drag`: ½ ρ C_D A |w_n| w_n ≈ C w_n, C = ½ ρ C_D A E[|w| I + w wᵀ/|w|] of the
+Gaussian w_n, iterated to a fixed point): damping C on the point's normal velocity, excitation C
+û_n. The linear level (:func:`mfm.linear_response`) still refuses it (no time-domain realisation
+there): use :func:`mfm.simulate`.
 ``simulate_batch`` takes it for seas of as many components (their wave arrays stack on the case
 axis; others are refused by :func:`mfm.loads.assembly.stack_cases`).
 
@@ -43,6 +58,7 @@ import dataclasses
 import math
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -52,7 +68,7 @@ from ..mechanics import se3
 from ..mechanics.points import BodyPoints
 from ..validation import (body_ref, element_name, number, tables, unique_names,
                           vector)
-from .base import FrequencyTerms, Load, LoadOutput
+from .base import FrequencyTerms, Load, LoadOutput, QuadraticDrag
 
 KEYS = {"name", "body", "point", "from", "to", "segments", "cd", "diameter", "area", "ca",
         "volume", "notes"}
@@ -163,17 +179,80 @@ class MorisonElements(Load):
 
         return dataclasses.replace(self, wave=still(self.wave))
 
+    def _rest(self, kin0):
+        """At q₀: H's translational rows (P, 3, n_q), the normal projector I − e eᵀ (P, 3, 3)
+        (I at a point element: e = 0) and the points' positions (P, 3), numpy."""
+        from ..mechanics.points import h_matrix_at
+
+        P = self.axis.shape[0]
+        H3 = np.asarray(h_matrix_at(self.points, kin0)).reshape(P, 6, -1)[:, :3]
+        R = np.asarray(self.points._frames(kin0)[1])
+        e = np.einsum("pab,pb->pa", R, np.asarray(self.axis))
+        Pn = np.eye(3)[None] - e[:, :, None] * e[:, None, :]
+        return H3, Pn, np.asarray(self.points.positions(kin0), dtype=float)
+
+    def _inertia_forces(self, kin0, omega, heading):
+        """The inertia term's linear wave force at each point per unit complex wave amplitude,
+        ρ (1 + C_A) V (I − e eᵀ) (−iω û) (n_ω, P, 3) (û: :func:`hydro.wetted.velocity_transfer`
+        at the rest position), with H₃ and the positions of :meth:`_rest`."""
+        from hydro.waves import wavenumber
+        from hydro.wetted import velocity_transfer
+
+        H3, Pn, pos = self._rest(kin0)
+        omega = np.asarray(omega, dtype=float)
+        depth = float(self.wave.water_depth)
+        u = velocity_transfer(pos, omega, wavenumber(omega, depth, self.g),
+                              np.full(omega.shape, float(heading)), depth)
+        f = np.einsum("p,pab,wpb->wpa", np.asarray(self.inertia), Pn,
+                      -1j * omega[:, None, None] * u)
+        return f, H3, pos
+
     def frequency_terms(self, model, q0, kin0, omega, heading, options):
-        # at rest the load is its added mass (in ``mass``) and a drag of zero slope; the wave
-        # force (the inertia term's linear part, the drag's stochastic linearisation) is not
-        # made here yet, so a response to waves is refused rather than given without it
-        if options.get("excitation", True):
-            raise NotImplementedError(
-                f"[[morison]] elements {list(self.names)}: their wave force is not in the "
-                "frequency domain yet (a frequency response, the spectral and linear levels); "
-                "run the sea with mfm.simulate (natural frequencies and the equilibrium take "
-                "their added mass)")
-        return FrequencyTerms()
+        """The wave force per unit amplitude about q₀: the inertia term's linear part
+
+            F(ω, β) = Σ_p H_pᵀ ρ (1 + C_A) V_p (I − e_p e_pᵀ) u̇̂_p(ω, β),   u̇̂ = −iω û,
+
+        û the flow's velocity at the point's rest position (0 above the mean surface), H_p its
+        translational rows (ρ C_A V's added mass is in the mass already). The drag's slope at
+        rest is 0: a frequency response per unit amplitude (no sea) leaves it out;
+        :func:`mfm.spectral_response` linearises it stochastically on the sea's relative flow
+        (:meth:`quadratic_drag`, :mod:`mfm.frequency.drag`)."""
+        if not options.get("excitation", True):
+            return FrequencyTerms()
+        f, H3, _ = self._inertia_forces(kin0, omega, heading)
+        return FrequencyTerms(force=np.einsum("pai,wpa->wi", H3, f))
+
+    def frequency_body_loads(self, model, q0, kin0, omega, heading, options, x):
+        """The inertia term's wave force of :meth:`frequency_terms` at the points, as body
+        wrenches (the map of :meth:`~mfm.mechanics.points.BodyPoints.to_body_wrench`, linear: real
+        and imaginary parts each); none without excitation."""
+        omega = np.asarray(omega, dtype=float)
+        if not options.get("excitation", True):
+            return np.zeros((len(omega), model.n_bodies, 6), dtype=complex)
+        f, _, _ = self._inertia_forces(kin0, omega, heading)
+        F = np.concatenate([f, np.zeros_like(f)], axis=2).reshape(len(omega), -1)   # (n_ω, 6P)
+        wrench = jax.vmap(lambda v: self.points.to_body_wrench(v, kin0, model.n_bodies))
+        return (np.asarray(wrench(jnp.asarray(F.real))) + 1j * np.asarray(wrench(jnp.asarray(F.imag))))
+
+    def quadratic_drag(self, model, kin0):
+        """The drag ½ ρ C_D A |w_n| w_n of every point with C_D A > 0, w_n = (I − e eᵀ)(u − v) at
+        its rest position, for the spectral level's stochastic linearisation on the relative
+        normal flow (:mod:`mfm.frequency.drag`, the vector form: |·| the length)."""
+        D = np.asarray(self.drag, dtype=float)
+        keep = np.flatnonzero(D > 0)
+        if keep.size == 0:
+            return None
+        H3, Pn, pos = self._rest(kin0)
+        el = np.asarray(self.element)
+        count = {}
+        labels = []
+        for p in range(len(D)):
+            i = count.get(el[p], 0)
+            count[el[p]] = i + 1
+            labels.append(f"{self.names[el[p]]}[{i}]" if self.names else f"morison[{p}]")
+        return QuadraticDrag(rows=np.einsum("pab,pbi->pai", Pn, H3)[keep], project=Pn[keep],
+                             drag=D[keep], kind="vector", positions=pos[keep],
+                             labels=tuple(labels[p] for p in keep))
 
     def host_view(self):
         # the names are the host's (outputs, provenance): loads that differ only in them share

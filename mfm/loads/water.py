@@ -61,7 +61,7 @@ from .. import host
 from ..backend import device_array
 from ..mechanics import se3
 from ..mechanics.points import BodyPoints, h_matrix_at
-from .base import FrequencyTerms, LinearHydro, Load, LoadOutput
+from .base import FrequencyTerms, LinearHydro, Load, LoadOutput, QuadraticDrag
 from .radiation import NoRadiation, grid_subdivisions, strategy, strategy_many
 
 MODES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
@@ -464,6 +464,21 @@ class Water(Load):
         if X is None:
             return FrequencyTerms(impedance=Z)
         return FrequencyTerms(impedance=Z, force=np.einsum("ai,wa->wi", H0, X))
+
+    def quadratic_drag(self, model, kin0):
+        """With ``[hydro] drag_flow = "relative"``: the drag −D_a |ξ̇_a − u_a| (ξ̇_a − u_a) per
+        inertial axis a at each reference point (at its rest position), for the spectral level's
+        stochastic linearisation (:mod:`mfm.frequency.drag`); None on the body's own velocity (the
+        spectral level leaves that drag out, as before; :func:`mfm.optimize` linearises it)."""
+        if self.flow is None:
+            return None
+        K = self.drag.shape[0]
+        H0 = np.asarray(h_matrix_at(self.geometry, kin0)).reshape(K, 6, -1)[:, :3]
+        pos = np.asarray(self.geometry.positions(kin0), dtype=float).reshape(K, 3)
+        labels = tuple(self.dofs[6 * k].rsplit("__", 1)[0] for k in range(K))
+        return QuadraticDrag(rows=H0, project=np.broadcast_to(np.eye(3), (K, 3, 3)).copy(),
+                             drag=np.asarray(self.drag, dtype=float), kind="axis",
+                             positions=pos, labels=labels)
 
     def frequency_body_loads(self, model, q0, kin0, omega, heading, options, x):
         """The wave and radiation-memory loads at the reference points,
