@@ -83,11 +83,12 @@ def _join_parts(outs, B):
 
 
 def _tables(waves, polar, g):
-    """The water's tables (exc (G, n, n_dof), eta (G, n)) of the cases ``g``, made on the device in
-    one call (:func:`_tables_jit`), from the thread that runs the cases: a part's tables are made
-    beside the other parts' work. (numpy's route, case by case, was as fast on 2 cores with only
-    the moved dofs' columns, 17.0 against 17.2 s per thread for 240 cases × 20,000 steps of
-    M4 134, and slower on 16, 2.3×: its Python loop holds the GIL.)"""
+    """The water's tables (exc (G, n, n_dof), eta (G, n), and a wave drift's (G, n, n_dof)) of the
+    cases ``g``, made on the device in one call (:func:`_tables_jit`), from the thread that runs
+    the cases: a part's tables are made beside the other parts' work. (numpy's route, case by
+    case, was as fast on 2 cores with only the moved dofs' columns, 17.0 against 17.2 s per
+    thread for 240 cases × 20,000 steps of M4 134, and slower on 16, 2.3×: its Python loop holds
+    the GIL.)"""
     return _tables_jit(jax.tree_util.tree_map(lambda a: jnp.asarray(a[g]), waves), polar)
 
 
@@ -95,7 +96,7 @@ def _tables(waves, polar, g):
 def _tables_jit(waves, polar):
     """The water's tables of a part's cases (a :class:`~mfm.loads.water.WaveSum` with a leading
     case axis; ``polar`` the excitation table's polar form, every case's), made on the device:
-    (exc (G, n, n_dof), eta (G, n))."""
+    (exc (G, n, n_dof), eta (G, n)) and, with a wave drift, its (G, n, n_dof)."""
     return jax.vmap(lambda w: w.tables(polar))(waves)
 
 
@@ -144,7 +145,11 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
 
     model: a :class:`Model`, or a sequence of Models of one topology (parameters differ, e.g.
         made with ``equinox.tree_at``; their ``hydro`` must be the same object).
-    seas: a sea state or a sequence of them (``hydro.waves``; None for still water).
+    seas: a sea state or a sequence of them (``hydro.waves``; None for still water). Seas of
+        different numbers of components share one structure (the shorter padded with
+        zero-amplitude components), above linear too: the nonlinear level's hulls, drag on the
+        relative flow and the wave drift take each case's own components (docs/nonlinear.md,
+        Batches); ``[[morison]]`` elements need seas of as many components.
     dt, ramp: s, a number or one per case. Every case runs ``n_steps`` steps (so a sweep at
         dt = T_p/200 over 100 T_p is one shape: 20,000 steps).
     radiation: "state_space" (default; its arrays have one shape whatever dt), "none", or
@@ -255,8 +260,8 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
             part = jax.tree_util.tree_map(lambda a: jnp.asarray(np.asarray(a)[g]), varying)
             if waves is None:
                 return part, None
-            exc, eta = _tables(waves, cases.polar, g)
-            return cases.with_tables(tuple(part), exc, eta), eta
+            tables = _tables(waves, cases.polar, g)       # exc, eta (and a drift's)
+            return cases.with_tables(tuple(part), *tables), tables[1]
 
         model_of = lambda g: model_view  # noqa: E731
         model_axis = None
