@@ -59,10 +59,13 @@ def _sphere_seas():
             hydro.Jonswap(hs=0.5, tp=4.5, n_components=4, seed=3), None]
 
 
-def _against_single_runs(model, seas, ramps, outputs, n_steps=40):
+def _against_single_runs(model, seas, ramps, outputs, n_steps=40, lanes=None):
     """simulate_batch of ``seas`` against mfm.simulate of each: q, qd and ``outputs`` within
-    TOL of each one's range over the cases. Returns the batch and the largest relative error."""
-    batch = mfm.simulate_batch(model, seas, n_steps=n_steps, ramp=ramps, outputs=outputs, **RUN)
+    TOL of each one's range over the cases. Returns the batch and the largest relative error.
+    ``lanes``: the cases advanced together by one vmapped loop (a GPU's default: all of them;
+    a CPU's: 1, the cases one after another in one compiled call)."""
+    batch = mfm.simulate_batch(model, seas, n_steps=n_steps, ramp=ramps, outputs=outputs,
+                               lanes=lanes, **RUN)
     singles = [mfm.simulate(model, sea, duration=n_steps * RUN["dt"], ramp=r,
                             check_stability=False, **RUN) for sea, r in zip(seas, ramps)]
     worst = 0.0
@@ -80,18 +83,20 @@ def test_the_nonlinear_level_in_a_batch_is_each_case_s_run():
     """[hydro] hydrostatics = "nonlinear": each case's hulls feel its own sea's wave pressure and
     its tables keep the diffraction (the database's excitation less the hulls' X_FK at its own
     components); q, qd and the recorded hydro_force (its excitation row holds the cut hull's
-    Froude–Krylov force) are each case's mfm.simulate to TOL. A second batch of other heights,
+    Froude–Krylov force) are each case's mfm.simulate to TOL, the cases vmapped together (a GPU's
+    form). A second batch of other heights,
     periods and ramps (as many components) runs on the first one's compilation."""
     model = _sphere(hydrostatics="nonlinear")
     seas = _sphere_seas()[:3]       # still water: test_a_padded_component_changes_nothing
-    batch, worst = _against_single_runs(model, seas, [1.0, 0.5, 1.5], ("hydro_force",))
+    # every case in one vmapped loop: the GPU's form
+    batch, worst = _against_single_runs(model, seas, [1.0, 0.5, 1.5], ("hydro_force",), lanes=3)
     assert batch.attrs["hydrostatics"] == "nonlinear"
     assert worst < 1e-11             # measured 4e-14: the runs are the same arithmetic
     before = TRACES["rollout"]
     other = [hydro.Regular(height=0.6, period=3.5), None,
              hydro.Jonswap(hs=0.3, tp=4.0, n_components=4, seed=5)]
     again = mfm.simulate_batch(model, other, n_steps=40, ramp=2.0, outputs=("hydro_force",),
-                               **RUN)
+                               lanes=3, **RUN)
     assert TRACES["rollout"] == before
     assert np.isfinite(again.q.values).all() and np.ptp(again.q.values[0, :, 1]) > 0.05
 
@@ -143,7 +148,8 @@ def test_drag_on_the_relative_flow_in_a_batch_is_each_case_s_run():
     model = _sphere(drag_flow="relative")
     seas = _sphere_seas()
     # still water (padded) against build_water's: test_a_padded_component_changes_nothing
-    batch, worst = _against_single_runs(model, [seas[1], seas[2]], [0.5, 1.5], ("hydro_force",))
+    batch, worst = _against_single_runs(model, [seas[1], seas[2]], [0.5, 1.5], ("hydro_force",),
+                                        lanes=2)
     assert batch.attrs["drag_flow"] == "relative"
     assert worst < 1e-11
 
