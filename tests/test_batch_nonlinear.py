@@ -177,3 +177,15 @@ def test_wave_drift_in_a_batch_is_each_case_s_run(mode):
     late = batch.time.values[0] >= 1.0
     np.testing.assert_allclose(batch.drift_force.values[0, late, 0], D * 0.2**2, rtol=1e-12)
     assert not np.any(batch.drift_force.values[3])
+
+
+def test_vary_loads_names_seas_of_different_counts():
+    """With vary_loads each case's loads are made alone (build_water: no padding): a relative
+    drag's flow of 1 and 4 components cannot stack, and the error names the leaf, its shapes and
+    what to do (without vary_loads the same seas run: the test above)."""
+    model = _sphere(drag_flow="relative")
+    seas = _sphere_seas()
+    with pytest.raises(ValueError, match=r"flow\.wave\.amplitude differ in shape \(\[\(1,\), "
+                                         r"\(4,\)\]\).*leave vary_loads out"):
+        mfm.simulate_batch(model, [seas[0], seas[2]], n_steps=10, threads=1,
+                           vary_loads=lambda i, loads: loads, **RUN)

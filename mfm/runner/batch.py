@@ -100,6 +100,27 @@ def _tables_jit(waves, polar):
     return jax.vmap(lambda w: w.tables(polar))(waves)
 
 
+def _stacked(items):
+    """Cases' pytrees of one structure (their loads, or models) stacked leaf by leaf on a leading
+    case axis. Leaves of different shapes are refused naming the leaf: with ``vary_loads`` each
+    case's loads are made alone, so a load that reads its sea's components at the time step (the
+    nonlinear level's hulls, the relative drag's flow, ``[[morison]]``) has as many as its sea."""
+    paths = jax.tree_util.tree_flatten_with_path(items[0])[0]
+    leaves = [jax.tree_util.tree_leaves(x) for x in items]
+    for j, (path, _) in enumerate(paths):
+        shapes = sorted({np.shape(lv[j]) for lv in leaves})
+        if len(shapes) > 1:
+            raise ValueError(
+                f"simulate_batch: the cases' {jax.tree_util.keystr(path)} differ in shape "
+                f"({shapes}); with vary_loads each case's loads are made alone, so a load that "
+                "reads the sea's components at the time step (the nonlinear level's hulls, drag on "
+                "the relative flow, [[morison]]) has as many as its sea: give the seas as many "
+                "components, leave vary_loads out (the water then pads its cases to one count), "
+                "or run the cases with mfm.simulate")
+    return jax.tree_util.tree_map(lambda *a: jnp.asarray(np.stack([np.asarray(x) for x in a])),
+                                  *items)
+
+
 def _whole(varying, shared):
     """A case's loads from its own leaves (``varying``, sliced by the loop over cases) and those
     every case shares (``shared``: None where the cases' loads were stacked whole)."""
@@ -159,7 +180,8 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
         (arrays only, e.g. ``equinox.tree_at`` on the water's ``drag`` for a drag-coefficient sweep,
         or on a wind load's speed): the cases stay one compiled, vmapped call. ``loads`` is the
         case's tuple (its water first, then the model's and the extra loads); the structure must
-        not change.
+        not change. Each case's loads are made alone (unpadded): above linear and with
+        ``[[morison]]``, seas of as many components.
     outputs: names of per-sample outputs to record as well (a load's diagnostics such as
         ``point_acceleration`` of the ``[[points]]``, or ``body_rotation``, ``joint_force``, ...:
         the names :func:`simulate` records); only what is named is computed and kept, as
@@ -286,8 +308,7 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
             raise ValueError("simulate_batch: the cases' loads differ in structure (with "
                              "radiation='convolution' the number of lags follows dt: give every "
                              "case the same dt and memory, or use radiation='state_space')")
-        stack = lambda items: jax.tree_util.tree_map(  # noqa: E731
-            lambda *a: jnp.asarray(np.stack([np.asarray(x) for x in a])), *items)
+        stack = _stacked
         varying, shared = [v[1] for v in views], None
         take = lambda g: (stack([varying[i] for i in g]), None)  # noqa: E731
         model_axis = 0 if len(models) > 1 else None
