@@ -126,7 +126,7 @@ def test_a_hull_from_the_body_s_geometry():
 def test_its_config_is_checked():
     """A nonlinear level without a hull names the body and the table to add; a hull that is not
     the database body's (radius 1.3 m for the 1 m sphere) gives both volumes; a bad level and a
-    bad hull key are refused; simulate_batch says the level is not batched."""
+    bad hull key are refused. (simulate_batch takes the level: tests/test_batch_nonlinear.py.)"""
     with pytest.raises(ConfigError, match=r"bodies \('sphere'\).hull: missing; .*\[bodies.hull\]"):
         _sphere(hull=False)
     with pytest.raises(ConfigError, match=r"displaces 4\.\d+ m³ .* the database body 'sphere' 2\.09"):
@@ -135,9 +135,6 @@ def test_its_config_is_checked():
         _sphere(hydrostatics="quadratic")
     with pytest.raises(ConfigError, match=r"hull: unknown key\(s\) \['radious'\]"):
         _sphere({"shape": "sphere", "radious": 1.0})
-    with pytest.raises(NotImplementedError, match="not batched yet"):
-        mfm.simulate_batch(_sphere(), [hydro.Regular(height=0.1, period=4.0)], dt=0.05,
-                           n_steps=10)
 
 
 def test_drag_on_the_relative_flow():

@@ -78,11 +78,11 @@ class CaseLoads:
     polar: tuple = ()
     waves_at: int = 0
 
-    def with_tables(self, loads: tuple, exc, eta) -> tuple:
+    def with_tables(self, loads: tuple, exc, eta, *more) -> tuple:
         """``loads`` (one case's, or a group's with the case axis) with the tables of ``waves``
-        put in the load they belong to."""
+        (exc, eta and, with a wave drift, its table) put in the load they belong to."""
         k = self.waves_at
-        return loads[:k] + (loads[k].with_tables(exc, eta),) + loads[k + 1:]
+        return loads[:k] + (loads[k].with_tables(exc, eta, *more),) + loads[k + 1:]
 
     def case(self, i: int) -> tuple:
         """Case i's loads, as :func:`carried_loads` makes them (the water's tables made on the
@@ -90,9 +90,9 @@ class CaseLoads:
         varying, shared = eqx.partition(self.loads, self.batched)
         loads = eqx.combine(jax.tree_util.tree_map(lambda a: a[i], varying), shared)
         if self.waves is not None and loads[self.waves_at].exc_values is None:
-            exc, eta = jax.tree_util.tree_map(lambda a: a[i], self.waves).tables_numpy(
+            tables = jax.tree_util.tree_map(lambda a: a[i], self.waves).tables_numpy(
                 tuple(np.asarray(a) for a in self.polar))
-            loads = self.with_tables(loads, exc, eta)
+            loads = self.with_tables(loads, *tables)
         return loads
 
     def with_eta(self, eta) -> "CaseLoads":

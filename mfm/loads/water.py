@@ -338,10 +338,12 @@ class Water(Load):
     def linear_hydro(self):
         return LinearHydro(self.spec, self.geometry, self.A_inf, self.drag, self._frequency_coefficients)
 
-    def with_tables(self, exc_values, eta_values):
+    def with_tables(self, exc_values, eta_values, drift_values=None):
         """This water with its excitation (n, 6K or the moved columns) and elevation (n,) tables
-        replaced: a batch's tables made on the device (:class:`WaveSum`)."""
-        return dataclasses.replace(self, exc_values=exc_values, eta_values=eta_values)
+        replaced, and its drift table (n, 6K) where given: a batch's tables made on the device
+        (:class:`WaveSum`)."""
+        out = dataclasses.replace(self, exc_values=exc_values, eta_values=eta_values)
+        return out if drift_values is None else dataclasses.replace(out, drift_values=drift_values)
 
     def provenance(self):
         out = {"added_mass": self.added_mass, **self.rad.provenance(),
@@ -683,6 +685,19 @@ class WaveSum(eqx.Module):
     # the excitation columns made (None: all); the others are 0. A run that records no output
     # of the water reads only the moved dofs' (Water._forces), so a batch makes those alone
     columns: tuple | None = eqx.field(static=True, default=None)
+    # the nonlinear level: the hulls' linear Froude–Krylov coefficients X_FK (n_c, n_dof), real
+    # and imaginary parts, taken out of the excitation's (its tables keep the diffraction, as
+    # build_water's); None: the linear level
+    fk_re: jnp.ndarray | None = None
+    fk_im: jnp.ndarray | None = None
+    # the wave drift force ([hydro] drift): "mean" (``drift_mean`` (n_dof,), Σ_j D_j a_j²) or
+    # "newman" (``drift_re``, ``drift_im`` (n_c, n_dof): c_j s_j √|D_j|, ``drift_sign``
+    # sgn D_j: hydro.drift's S and S₊); None: none
+    drift: str | None = eqx.field(static=True, default=None)
+    drift_mean: jnp.ndarray | None = None
+    drift_re: jnp.ndarray | None = None
+    drift_im: jnp.ndarray | None = None
+    drift_sign: jnp.ndarray | None = None
 
     def coefficients(self, polar, xp=jnp):
         """(c_re, c_im) (n_c, n_cols + 1): the excitation columns a e^{iφ} X(ω, β) (those of
@@ -695,16 +710,32 @@ class WaveSum(eqx.Module):
         X = polar_interpolation(xp, polar, self.i0, self.k0, self.k1, self.sw, self.sb,
                                 one_heading=self.one_heading)
         a = (self.amp_re + 1j * self.amp_im)[:, None]
-        c = xp.concatenate([a * X * self.active[:, None], a], axis=1)
+        if self.fk_re is None:
+            c = xp.concatenate([a * X * self.active[:, None], a], axis=1)
+        else:
+            # the nonlinear level: the tables keep the diffraction, X − X_FK (every component's
+            # X_FK, as froude_krylov_series: it is not the table's, so none is outside a grid)
+            fk = self.fk_re + 1j * self.fk_im
+            fk = fk if self.columns is None else fk[:, list(self.columns)]
+            c = xp.concatenate([a * (X * self.active[:, None] - fk), a], axis=1)
         return xp.real(c), xp.imag(c)
 
     def tables(self, polar):
-        """(exc (n_grid, n_dof), eta (n_grid,)) of one case, in jax: the uniform-grid form of
-        :func:`hydro.waves._harmonic_sum` (e^{−iω(t0 + (aK + b)h)} = e^{−iω b h} · e^{−iω(t0 + aKh)}:
-        sines and cosines of K × n_c and n_blocks × n_c phases, each from its own product ω·time,
-        then real matrix products), so the numbers equal build_water's numpy tables to
-        round-off."""
+        """(exc (n_grid, n_dof), eta (n_grid,)) of one case, in jax, and with a drift
+        (``drift``) its table (n_grid, n_dof) third: the uniform-grid form of
+        :func:`hydro.waves._harmonic_sum` (:meth:`_sums`), so the numbers equal build_water's
+        numpy tables to round-off."""
         c_re, c_im = self.coefficients(polar)
+        y = self._sums(c_re, c_im)
+        r = self._ramp()
+        out = (self._placed(jnp, y[:, :-1] * r[:, None], polar[0].shape[-1]), y[:, -1] * r)
+        return out if self.drift is None else out + (self._drift_table(r),)
+
+    def _sums(self, c_re, c_im):
+        """Re Σ_j c_j e^{−iω_j t_k} (n_grid, n_cols) for coefficients (n_c, n_cols), in jax: the
+        block form of :func:`hydro.waves._harmonic_sum` (e^{−iω(t0 + (aK + b)h)} = e^{−iω b h} ·
+        e^{−iω(t0 + aKh)}: sines and cosines of K × n_c and n_blocks × n_c phases, each from its
+        own product ω·time, then real matrix products)."""
         # blocks of 256 rows, as the numpy route (fewer rows per block make the sines and cosines
         # fewer, (K + n/K) × n_c, but the matrix products slower: K = √n measured 1.7–1.9× slower
         # for M4 134's 401 and 4,001 rows on one CPU core)
@@ -718,12 +749,31 @@ class WaveSum(eqx.Module):
         cr = c_re[None] * rr[:, :, None] - c_im[None] * ri[:, :, None]
         ci = c_re[None] * ri[:, :, None] + c_im[None] * rr[:, :, None]
         y = (jnp.einsum("bj,ajm->abm", ck, cr) + jnp.einsum("bj,ajm->abm", sk, ci))
-        y = y.reshape(nb * K, -1)[:n]
-        t = self.t0 + self.step * jnp.arange(n)
+        return y.reshape(nb * K, -1)[:n]
+
+    def _ramp(self):
+        """r(t_k) (n_grid,): :func:`hydro.waves.ramp` over ``ramp`` s (1 at 0), in jax."""
+        t = self.t0 + self.step * jnp.arange(self.n_grid)
         T = self.ramp
-        r = jnp.where(T > 0.0, jnp.where(t < 0.0, 0.0, 0.5 * (1.0 - jnp.cos(
+        return jnp.where(T > 0.0, jnp.where(t < 0.0, 0.0, 0.5 * (1.0 - jnp.cos(
             jnp.pi * jnp.clip(t, 0.0, T) / jnp.where(T > 0.0, T, 1.0)))), 1.0)
-        return self._placed(jnp, y[:, :-1] * r[:, None], polar[0].shape[-1]), y[:, -1] * r
+
+    def _drift_parts(self):
+        """Newman's four sums' coefficients (n_c, 4 n_dof), real and imaginary parts: S's c,
+        then −i c (Im S = Re Σ (−i c) e^{−iωt}), then S₊'s sgn(D) c and −i sgn(D) c."""
+        dr, di, sg = self.drift_re, self.drift_im, self.drift_sign
+        return ((dr, di, sg * dr, sg * di), (di, -dr, sg * di, -sg * dr))
+
+    def _drift_table(self, r):
+        """The drift force (n_grid, n_dof) of :func:`hydro.drift.drift_time_series`: r(t) Σ_j
+        D_j a_j² ("mean"), or r(t) Re[S₊(t) conj S(t)] = r (Re S₊ Re S + Im S₊ Im S)
+        ("newman")."""
+        if self.drift == "mean":
+            return r[:, None] * self.drift_mean[None, :]
+        re, im = self._drift_parts()
+        y = self._sums(jnp.concatenate(re, axis=1), jnp.concatenate(im, axis=1))
+        S_re, S_im, P_re, P_im = jnp.split(y, 4, axis=1)
+        return (P_re * S_re + P_im * S_im) * r[:, None]
 
     def _placed(self, xp, exc, n_dof):
         """The made columns in a table of every dof (the others 0)."""
@@ -738,15 +788,25 @@ class WaveSum(eqx.Module):
         return exc @ P
 
     def tables_numpy(self, polar):
-        """:meth:`tables` of one case on the host, by build_water's own numpy route (hydro.waves)."""
+        """:meth:`tables` of one case on the host, by build_water's own numpy route (hydro.waves,
+        hydro.drift)."""
         from hydro.waves import _harmonic_sum, ramp as ramp_fn
 
         c_re, c_im = self.coefficients(polar, xp=np)
         t = float(self.t0) + float(self.step) * np.arange(self.n_grid)
-        y = _harmonic_sum(np.asarray(self.omega), c_re + 1j * c_im, t)
+        w = np.asarray(self.omega)
+        y = _harmonic_sum(w, c_re + 1j * c_im, t)
+        r = ramp_fn(t, float(self.ramp)) if float(self.ramp) else np.ones_like(t)
         if float(self.ramp):
-            y = y * ramp_fn(t, float(self.ramp))[:, None]
-        return self._placed(np, y[:, :-1], np.shape(polar[0])[-1]), y[:, -1]
+            y = y * r[:, None]
+        out = (self._placed(np, y[:, :-1], np.shape(polar[0])[-1]), y[:, -1])
+        if self.drift is None:
+            return out
+        if self.drift == "mean":
+            return out + (r[:, None] * np.asarray(self.drift_mean)[None, :],)
+        re, im = (np.concatenate([np.asarray(x) for x in p], axis=1) for p in self._drift_parts())
+        S_re, S_im, P_re, P_im = np.split(_harmonic_sum(w, re + 1j * im, t), 4, axis=1)
+        return out + ((P_re * S_re + P_im * S_im) * r[:, None],)
 
 
 def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float = 0.0,
@@ -754,32 +814,32 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
                       state_space_options: dict | None = None, added_mass: str = "lhs",
                       stage_offsets=(0.0, 0.5, 1.0)):
     """The :class:`Water` of B cases at once (a batch's seas, time steps and ramps, each run
-    ``n_steps`` steps): ``(water, batched, waves, polar)``. The linear level only (the nonlinear
-    level's hulls: :func:`mfm.simulate` case by case). ``water`` is one Water whose fields that
-    differ between the cases carry a leading case axis (``batched``: a pytree of bools like it,
-    True on those fields), its tables left out (None): ``waves``, a :class:`WaveSum` with a
+    ``n_steps`` steps): ``(water, batched, waves, polar)``. ``water`` is one Water whose fields
+    that differ between the cases carry a leading case axis (``batched``: a pytree of bools like
+    it, True on those fields), its tables left out (None): ``waves``, a :class:`WaveSum` with a
     leading case axis, makes them (:meth:`WaveSum.tables`, on the device) with the excitation
     table's polar form ``polar`` (shared by every case). Case b's water, its
     tables made, is the one :func:`build_water` makes for ``seas[b]``, ``dts[b]``, ``ramps[b]``
-    to round-off (tests/test_batch_prepare.py).
+    to round-off (tests/test_batch_prepare.py, tests/test_batch_nonlinear.py).
+
+    Above linear, each case's water carries its own sea's components (B, n_c) where the time step
+    reads them: the nonlinear level's ``hulls.wave`` (the wave pressure on the cut hulls; the
+    tables then hold X − X_FK, X_FK the hulls' linear Froude–Krylov force at each case's
+    components, :func:`_froude_krylov_many`), the relative drag's ``flow.wave``, each with the
+    case's ramp; the wave drift's table (n, 6K) is made on the device with the others
+    (:meth:`WaveSum._drift_table`: r Σ_j D_j a_j², or Newman's r Re[S₊ S̄]), its coefficients from
+    :func:`_drift_coefficients`.
 
     What the cases share is made once: the radiation strategy for every distinct time step
     (:func:`~mfm.loads.radiation.strategy_many`: only its arrays that follow dt get a case axis)
     and X(ω, β) sorted once
     (:func:`excitation_table`), every case's wave components placed on it in one call; the
     interpolation of X at the components and the tables are the device's.
-    Cases with fewer wave components than the most are padded with zero coefficients (a term
-    0 · cos = 0 exactly). Raises ValueError when the cases' radiation differs in structure (a
+    Cases with fewer wave components than the most are padded with zero coefficients and zero
+    amplitudes (a term 0 · cos = 0 exactly; the wave fields' padding has a wavenumber of 1 rad/s,
+    so the depth decays stay finite), still water is all padding: one structure for the batch,
+    whatever its seas. Raises ValueError when the cases' radiation differs in structure (a
     convolution's number of lags follows dt)."""
-    if nonlinear(spec) or relative_drag(spec):
-        raise NotImplementedError(
-            "simulate_batch: the nonlinear level ([hydro] hydrostatics = \"nonlinear\") and drag "
-            "on the relative flow ([hydro] drag_flow = \"relative\") are not batched yet; run "
-            "their cases with mfm.simulate, or load the model without them for the batch")
-    if wave_drift(spec):
-        raise NotImplementedError(
-            f"simulate_batch: the wave drift force ([hydro] drift = {spec.drift!r}) is not "
-            "batched yet; run its cases with mfm.simulate, or load the model without it")
     B = len(seas)
     dts = np.broadcast_to(np.asarray(dts, dtype=float), (B,))
     ramps = np.broadcast_to(np.asarray(ramps, dtype=float), (B,))
@@ -816,20 +876,144 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
         arrays["active"][i, :n] = ~outside[j]
         for name, values in zip(("i0", "k0", "k1", "sw", "sb"), br):
             arrays[name][i, :n] = values[j]
+    above = _above_linear_batch(spec, comps, live, B, n_c, omega)
     waves = WaveSum(omega=omega, **arrays, t0=np.full(B, float(t0)), step=steps.copy(),
-                    ramp=ramps.copy(), n_grid=n_grid, one_heading=table.beta.shape[0] == 1)
+                    ramp=ramps.copy(), n_grid=n_grid, one_heading=table.beta.shape[0] == 1,
+                    **above["waves"])
     geometry = BodyPoints(body_index=spec.body_index, d_ref=device_array(spec.d_ref),
                           ref0=device_array(spec.ref0))
+    C_wp, buoyancy, hulls, flow = spec.C_wp, spec.rho * spec.g * spec.volume, None, None
+    field = above.get("field")
+    if nonlinear(spec):
+        # the hulls' pressure in place of the buoyancy, C_wp and the Froude–Krylov part (as
+        # build_water), each case's sea in its wave field
+        C_wp, buoyancy = np.zeros_like(C_wp), np.zeros_like(buoyancy)
+        hulls = dataclasses.replace(make_hulls(spec, None, 0.0), wave=field, ramp=ramps.copy())
+    if relative_drag(spec):
+        flow = Flow(wave=field, ramp=ramps.copy())
     water = Water(geometry=geometry, A_inf=_f64(rad.added_mass_inf(spec)),
-                  C_wp=_f64(spec.C_wp),
-                  buoyancy=_f64(spec.rho * spec.g * spec.volume), d_cob=_f64(spec.d_cob),
+                  C_wp=_f64(C_wp),
+                  buoyancy=_f64(buoyancy), d_cob=_f64(spec.d_cob),
                   drag=_f64(spec.drag), exc_t0=_f64(t0), exc_step=steps.copy(),
                   exc_values=None, eta_values=None, rad=rad, dofs=spec.dofs,
-                  added_mass=added_mass, spec=spec, grid_m=int(m), moving=spec.moving)
+                  added_mass=added_mass, spec=spec, grid_m=int(m), moving=spec.moving,
+                  hulls=hulls, flow=flow)
     batched = jax.tree_util.tree_map(lambda _: False, water)
     # what follows dt has the case axis whatever the values: one compilation for every batch
     batched = eqx.tree_at(lambda w: (w.exc_step, w.rad), batched, (True, rad_batched))
+    # so has each case's sea, where the water reads it at the time step (the hulls' wave
+    # pressure, the relative flow): a wave field (B, n_c) and the ramp (B,)
+    every = jax.tree_util.tree_map(lambda _: True, field)
+    if hulls is not None:
+        batched = eqx.tree_at(lambda w: (w.hulls.wave, w.hulls.ramp), batched, (every, True))
+    if flow is not None:
+        batched = eqx.tree_at(lambda w: (w.flow.wave, w.flow.ramp), batched, (every, True))
     return water, batched, waves, tuple(jnp.asarray(a) for a in table.polar)
+
+
+# components of the hulls' linear Froude–Krylov force made in one numpy call (the panels' midpoints
+# × components complex table: 2,600 facets × 6 midpoints × 64 components, 16 MB)
+FK_CHUNK = 64
+
+
+def _above_linear_batch(spec, comps, live, B: int, n_c: int, omega) -> dict:
+    """What the above-linear options add to a batch (``comps``: the components of the cases
+    ``live``, each padded to ``n_c`` with zero amplitudes, as :class:`WaveSum`'s; ``omega``
+    (B, n_c) its frequencies, 1 rad/s on the padding): ``"waves"``, the :class:`WaveSum` fields
+    (the hulls' X_FK of the nonlinear level; the drift's coefficients); ``"field"``, a
+    :class:`hydro.wetted.WaveField` (B, n_c) of each case's components for the hulls and the
+    relative flow (None when neither). A padded component has amplitude 0 and a wavenumber of
+    its 1 rad/s (finite, positive: the depth decays stay finite), so every term it adds to a sum
+    is 0 exactly."""
+    from hydro.waves import wavenumber
+    from hydro.wetted import WaveField
+
+    out = {"waves": {}, "field": None}
+    nd = len(spec.dofs)
+    if nonlinear(spec) or relative_drag(spec):
+        cols = {k: np.zeros((B, n_c)) for k in ("amplitude", "wavenumber", "heading", "phase")}
+        cols["wavenumber"][:] = wavenumber(1.0, spec.water_depth, spec.g)
+        for c, i in zip(comps, live):
+            n = len(c.omega)
+            for k in cols:
+                cols[k][i, :n] = np.asarray(getattr(c, k), float)
+        out["field"] = WaveField(cols["amplitude"], np.array(omega, float), cols["wavenumber"],
+                                 cols["heading"], cols["phase"], float(spec.water_depth))
+    if nonlinear(spec):
+        fk = np.zeros((B, n_c, nd), complex)
+        for c, i, X in zip(comps, live, _froude_krylov_many(spec, comps)):
+            fk[i, :len(c.omega)] = X
+        out["waves"].update(fk_re=fk.real.copy(), fk_im=fk.imag.copy())
+    if wave_drift(spec):
+        out["waves"].update(_drift_coefficients(spec, comps, live, B, n_c))
+    return out
+
+
+def _froude_krylov_many(spec, comps) -> list:
+    """Each case's X_FK (J_i, 6K) of :func:`froude_krylov_series` (the hulls at rest,
+    :func:`hydro.wetted.froude_krylov_linear` at each component's k and heading), the distinct
+    (k, β) of every case made once, :data:`FK_CHUNK` at a time."""
+    from hydro.wetted import froude_krylov_linear
+
+    counts = [len(c.omega) for c in comps]
+    if not sum(counts):
+        return [np.zeros((0, len(spec.dofs)), complex) for _ in comps]
+    kb = np.stack([np.concatenate([np.asarray(c.wavenumber, float) for c in comps]),
+                   np.concatenate([np.asarray(c.heading, float) for c in comps])], axis=1)
+    pairs, inverse = np.unique(kb, axis=0, return_inverse=True)
+    X = np.concatenate([
+        np.concatenate([froude_krylov_linear(T, spec.ref0[k], pairs[j:j + FK_CHUNK, 0],
+                                             pairs[j:j + FK_CHUNK, 1],
+                                             water_depth=spec.water_depth, rho=spec.rho,
+                                             g=spec.g)
+                        for k, T in enumerate(spec.hulls)], axis=1)
+        for j in range(0, len(pairs), FK_CHUNK)])
+    return np.split(X[np.asarray(inverse).reshape(-1)], np.cumsum(counts)[:-1])
+
+
+def drift_table(spec):
+    """The spec's mean drift D(ω, β) made ready for interpolation
+    (:class:`hydro.drift.DriftTable`), made once and kept with the spec's other caches."""
+    from hydro.drift import DriftTable
+
+    if "drift_table" not in spec._cache:
+        spec._cache["drift_table"] = DriftTable(spec.database())
+    return spec._cache["drift_table"]
+
+
+def _drift_coefficients(spec, comps, live, B: int, n_c: int) -> dict:
+    """The :class:`WaveSum` drift fields of the cases (:func:`hydro.drift.drift_time_series`'s
+    terms, the same numpy per case; D_j at every case's components in one interpolation):
+    "mean": Σ_j D_j a_j² (B, n_dof); "newman": c_j s_j √|D_j| and sgn D_j (B, n_c, n_dof), 0 on
+    the padding (and for still water)."""
+    import types
+
+    table = drift_table(spec)
+    nd = len(table.labels)
+    if nd != len(spec.dofs):
+        raise ValueError(f"hydro.drift: the database's mean_drift has {nd} dofs "
+                         f"{table.labels}, the water {len(spec.dofs)} {list(spec.dofs)}")
+    counts = [len(c.omega) for c in comps]
+    both = types.SimpleNamespace(
+        omega=np.concatenate([np.asarray(c.omega, float) for c in comps] + [np.zeros(0)]),
+        heading=np.concatenate([np.asarray(c.heading, float) for c in comps] + [np.zeros(0)]))
+    Ds = np.split(table.at(both), np.cumsum(counts)[:-1]) if comps else []
+    if spec.drift == "mean":
+        mean = np.zeros((B, nd))
+        for c, i, D in zip(comps, live, Ds):
+            a = np.asarray(c.amplitude, float)
+            mean[i] = (D * (a * a)[:, None]).sum(0)
+        return {"drift": "mean", "drift_mean": mean}
+    re, im, sign = (np.zeros((B, n_c, nd)) for _ in range(3))
+    ref = np.repeat(np.asarray(spec.ref0, float)[:, :2], 6, axis=0)[:nd]          # per dof
+    for c, i, D in zip(comps, live, Ds):
+        n = len(c.omega)
+        k, beta = np.asarray(c.wavenumber, float), np.asarray(c.heading, float)
+        s = np.exp(1j * (np.multiply.outer(k * np.cos(beta), ref[:, 0])
+                         + np.multiply.outer(k * np.sin(beta), ref[:, 1])))
+        cj = c.complex_amplitude[:, None] * s * np.sqrt(np.abs(D))
+        re[i, :n], im[i, :n], sign[i, :n] = cj.real, cj.imag, np.sign(D)
+    return {"drift": "newman", "drift_re": re, "drift_im": im, "drift_sign": sign}
 
 
 def _assignment_rows(by_name, wet):

@@ -83,11 +83,12 @@ def _join_parts(outs, B):
 
 
 def _tables(waves, polar, g):
-    """The water's tables (exc (G, n, n_dof), eta (G, n)) of the cases ``g``, made on the device in
-    one call (:func:`_tables_jit`), from the thread that runs the cases: a part's tables are made
-    beside the other parts' work. (numpy's route, case by case, was as fast on 2 cores with only
-    the moved dofs' columns, 17.0 against 17.2 s per thread for 240 cases × 20,000 steps of
-    M4 134, and slower on 16, 2.3×: its Python loop holds the GIL.)"""
+    """The water's tables (exc (G, n, n_dof), eta (G, n), and a wave drift's (G, n, n_dof)) of the
+    cases ``g``, made on the device in one call (:func:`_tables_jit`), from the thread that runs
+    the cases: a part's tables are made beside the other parts' work. (numpy's route, case by
+    case, was as fast on 2 cores with only the moved dofs' columns, 17.0 against 17.2 s per
+    thread for 240 cases × 20,000 steps of M4 134, and slower on 16, 2.3×: its Python loop holds
+    the GIL.)"""
     return _tables_jit(jax.tree_util.tree_map(lambda a: jnp.asarray(a[g]), waves), polar)
 
 
@@ -95,8 +96,29 @@ def _tables(waves, polar, g):
 def _tables_jit(waves, polar):
     """The water's tables of a part's cases (a :class:`~mfm.loads.water.WaveSum` with a leading
     case axis; ``polar`` the excitation table's polar form, every case's), made on the device:
-    (exc (G, n, n_dof), eta (G, n))."""
+    (exc (G, n, n_dof), eta (G, n)) and, with a wave drift, its (G, n, n_dof)."""
     return jax.vmap(lambda w: w.tables(polar))(waves)
+
+
+def _stacked(items):
+    """Cases' pytrees of one structure (their loads, or models) stacked leaf by leaf on a leading
+    case axis. Leaves of different shapes are refused naming the leaf: with ``vary_loads`` each
+    case's loads are made alone, so a load that reads its sea's components at the time step (the
+    nonlinear level's hulls, the relative drag's flow, ``[[morison]]``) has as many as its sea."""
+    paths = jax.tree_util.tree_flatten_with_path(items[0])[0]
+    leaves = [jax.tree_util.tree_leaves(x) for x in items]
+    for j, (path, _) in enumerate(paths):
+        shapes = sorted({np.shape(lv[j]) for lv in leaves})
+        if len(shapes) > 1:
+            raise ValueError(
+                f"simulate_batch: the cases' {jax.tree_util.keystr(path)} differ in shape "
+                f"({shapes}); with vary_loads each case's loads are made alone, so a load that "
+                "reads the sea's components at the time step (the nonlinear level's hulls, drag on "
+                "the relative flow, [[morison]]) has as many as its sea: give the seas as many "
+                "components, leave vary_loads out (the water then pads its cases to one count), "
+                "or run the cases with mfm.simulate")
+    return jax.tree_util.tree_map(lambda *a: jnp.asarray(np.stack([np.asarray(x) for x in a])),
+                                  *items)
 
 
 def _whole(varying, shared):
@@ -144,7 +166,11 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
 
     model: a :class:`Model`, or a sequence of Models of one topology (parameters differ, e.g.
         made with ``equinox.tree_at``; their ``hydro`` must be the same object).
-    seas: a sea state or a sequence of them (``hydro.waves``; None for still water).
+    seas: a sea state or a sequence of them (``hydro.waves``; None for still water). Seas of
+        different numbers of components share one structure (the shorter padded with
+        zero-amplitude components), above linear too: the nonlinear level's hulls, drag on the
+        relative flow and the wave drift take each case's own components (docs/nonlinear.md,
+        Batches); ``[[morison]]`` elements need seas of as many components.
     dt, ramp: s, a number or one per case. Every case runs ``n_steps`` steps (so a sweep at
         dt = T_p/200 over 100 T_p is one shape: 20,000 steps).
     radiation: "state_space" (default; its arrays have one shape whatever dt), "none", or
@@ -154,7 +180,8 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
         (arrays only, e.g. ``equinox.tree_at`` on the water's ``drag`` for a drag-coefficient sweep,
         or on a wind load's speed): the cases stay one compiled, vmapped call. ``loads`` is the
         case's tuple (its water first, then the model's and the extra loads); the structure must
-        not change.
+        not change. Each case's loads are made alone (unpadded): above linear and with
+        ``[[morison]]``, seas of as many components.
     outputs: names of per-sample outputs to record as well (a load's diagnostics such as
         ``point_acceleration`` of the ``[[points]]``, or ``body_rotation``, ``joint_force``, ...:
         the names :func:`simulate` records); only what is named is computed and kept, as
@@ -255,8 +282,8 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
             part = jax.tree_util.tree_map(lambda a: jnp.asarray(np.asarray(a)[g]), varying)
             if waves is None:
                 return part, None
-            exc, eta = _tables(waves, cases.polar, g)
-            return cases.with_tables(tuple(part), exc, eta), eta
+            tables = _tables(waves, cases.polar, g)       # exc, eta (and a drift's)
+            return cases.with_tables(tuple(part), *tables), tables[1]
 
         model_of = lambda g: model_view  # noqa: E731
         model_axis = None
@@ -281,8 +308,7 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
             raise ValueError("simulate_batch: the cases' loads differ in structure (with "
                              "radiation='convolution' the number of lags follows dt: give every "
                              "case the same dt and memory, or use radiation='state_space')")
-        stack = lambda items: jax.tree_util.tree_map(  # noqa: E731
-            lambda *a: jnp.asarray(np.stack([np.asarray(x) for x in a])), *items)
+        stack = _stacked
         varying, shared = [v[1] for v in views], None
         take = lambda g: (stack([varying[i] for i in g]), None)  # noqa: E731
         model_axis = 0 if len(models) > 1 else None
