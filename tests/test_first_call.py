@@ -122,24 +122,33 @@ def test_the_key_changes_with_whatever_changes_the_program(monkeypatch):
     assert _programs.key("f", (1.0,), {}) != _programs.key("f", (np.float64(1.0),), {})
 
 
-def test_a_module_imported_after_the_first_key_keys_only_settings_off_its_code(monkeypatch,
-                                                                             tmp_path):
+def test_a_module_imported_after_the_first_key_keys_only_settings_off_its_code(monkeypatch):
     # M4 134's checks' linearisation was keyed twice in one process: the radiation fit's check
     # (mfm.frequency.fitcheck) is imported between its two calls, and its settings at their
     # defaults changed the key. A module imported late now keys what differs from its code.
+    import importlib.abc
     import importlib.util
+
+    class Source(importlib.abc.SourceLoader):      # a module from text, as a .py file gives it
+        def __init__(self, text):
+            self.text = text
+
+        def get_filename(self, fullname):
+            return f"<{fullname}>"
+
+        def get_data(self, path):
+            return self.text.encode()
 
     monkeypatch.setattr(_programs, "_DEFAULTS", {})
     args = (jnp.zeros(3),)
     _programs.key("f", args, {})                  # the process's first key, if none was made
     k0 = _programs.key("f", args, {})
-    src = tmp_path / "late_probe.py"
-    src.write_text("TOLERANCE = 0.05\nBAND = (0.5, 2.0)\nBYTES = 2 * 2**30\n"
-                   "PICKED = 64 if len('ab') > 5 else 12\nTWICE = 1\nTWICE = 2\n")
-    spec = importlib.util.spec_from_file_location("mfm._late_probe", src)
+    source = Source("TOLERANCE = 0.05\nBAND = (0.5, 2.0)\nBYTES = 2 * 2**30\n"
+                    "PICKED = 64 if len('ab') > 5 else 12\nTWICE = 1\nTWICE = 2\n")
+    spec = importlib.util.spec_from_loader("mfm._late_probe", source)
     late = importlib.util.module_from_spec(spec)
     monkeypatch.setitem(sys.modules, "mfm._late_probe", late)
-    spec.loader.exec_module(late)
+    source.exec_module(late)
     # constants only: a condition or a second assignment is no default (it stays keyed)
     assert _programs._literal_defaults(late) == {"TOLERANCE": 0.05, "BAND": (0.5, 2.0),
                                                  "BYTES": 2**31}

@@ -167,12 +167,13 @@ def equilibrium(model: Model, q_guess=None, *, loads=None, sea=None, tol: float 
 
 
 def _in_mean_drift(loads, sea) -> tuple:
-    from ..loads.water import Water
-
-    if not any(isinstance(ld, Water) for ld in loads):
-        raise ValueError("mfm.equilibrium(sea=...): the model has no water ([hydro]) to carry a "
-                         "mean wave drift force; leave sea out for the equilibrium at rest")
-    return tuple(ld.in_mean_drift(sea) if isinstance(ld, Water) else ld for ld in loads)
+    """The loads with each one's mean wave drift in ``sea`` at rest (:meth:`Load.in_mean_drift`:
+    the water's, from its database's mean_drift)."""
+    made = [getattr(ld, "in_mean_drift", lambda _sea: None)(sea) for ld in loads]
+    if all(m is None for m in made):
+        raise ValueError("mfm.equilibrium(sea=...): no load of the model carries a mean wave drift "
+                         "force (the water, [hydro]); leave sea out for the equilibrium at rest")
+    return tuple(ld if m is None else m for ld, m in zip(loads, made))
 
 
 def _equilibrium(model, loads, q_guess=None, tol=1e-10, max_iter=50):

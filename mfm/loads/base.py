@@ -151,7 +151,8 @@ class Load(eqx.Module):
       :meth:`frequency_terms` with :meth:`frequency_body_loads` and :meth:`frequency_range`,
       :meth:`frequency_outputs`, :meth:`linear_dampers` (a PTO's damping about q₀),
       :meth:`quadratic_drag` (drag on the relative flow, for the spectral level's stochastic
-      linearisation);
+      linearisation), :meth:`in_mean_drift` (the load at rest holding a sea's mean wave drift:
+      the equilibrium in a sea);
     - words: :meth:`provenance`, :meth:`describe_nonfinite`.
 
     - a run: :meth:`for_run` (the load laid on a run's sea and time grid: wave tables at the
@@ -252,6 +253,13 @@ class Load(eqx.Module):
         load itself; None: nothing static)."""
         return self
 
+    def in_mean_drift(self, sea) -> "Load | None":
+        """This load holding, in its :meth:`static_load`, the mean of its second-order wave
+        force in ``sea`` (a :mod:`hydro` sea state), for the equilibrium in that sea
+        (``mfm.equilibrium(model, sea=)``: a moored body's mean offset); None (default): the load
+        has no mean wave force."""
+        return None
+
     def frequency_terms(self, model, q0, kin0, omega, heading: float, options: dict) -> FrequencyTerms:
         """Frequency-dependent impedance and wave force about q₀ (default: none)."""
         return FrequencyTerms()
@@ -311,4 +319,4 @@ OPTIONAL = ("n_states", "initial_state", "init_memory", "update_memory", "reacti
             "diagnostics", "outputs", "batch_outputs", "pto_records", "static_load",
             "frequency_terms", "frequency_body_loads", "frequency_range", "frequency_outputs",
             "linear_dampers", "provenance", "describe_nonfinite", "for_run", "host_view",
-            "linear_hydro", "quadratic_drag")
+            "linear_hydro", "quadratic_drag", "in_mean_drift")
