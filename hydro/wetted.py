@@ -169,6 +169,19 @@ def _decay(k, zs, h):
     return jnp.exp(k * zc) * (1 + jnp.exp(-2 * k * (zc + h))) / (1 + jnp.exp(-2 * k * h))
 
 
+def _velocity_decays(k, zs, h, xp):
+    """The particle velocity's depth decays at z_s ≤ 0: f_h = cosh k(z_s + h)/sinh k h and
+    f_v = sinh k(z_s + h)/sinh k h (z_s clipped to [−h, 0]; e^{k z_s} both in deep water), without
+    overflow: e^{k z_s} (1 ± e^{−2k(z_s+h)})/(1 − e^{−2kh}). ``xp``: jax.numpy in the time
+    domain's traced code, numpy on the frequency domain's host side (the same operations)."""
+    if math.isinf(h):
+        f = xp.exp(k * zs)
+        return f, f
+    zc = xp.clip(zs, -h, 0.0)
+    e, d = xp.exp(k * zc), 1 - xp.exp(-2 * k * h)
+    return e * (1 + xp.exp(-2 * k * (zc + h))) / d, e * (1 - xp.exp(-2 * k * (zc + h))) / d
+
+
 def _kinematics(wave: WaveField, points, t):
     """What the flow's velocity and acceleration share at ``points`` (..., 3): the phases θ
     (J, ...), the depth decays f_h, f_v (J, ...) at the Wheeler-stretched z_s, a ω (J, 1…), the
@@ -180,15 +193,7 @@ def _kinematics(wave: WaveField, points, t):
     a, k = wave.amplitude.reshape(shape), wave.wavenumber.reshape(shape)
     eta = jnp.sum(a * jnp.cos(th), axis=0)
     h = wave.water_depth
-    zs = jnp.minimum(_stretched(z, eta, h), 0.0)
-    if math.isinf(h):
-        fh = fv = jnp.exp(k * zs)
-    else:
-        # cosh, sinh k(z_s + h)/sinh k h without overflow: e^{k z_s} (1 ± e^{−2k(z_s+h)})/(1 − e^{−2kh})
-        zs = jnp.clip(zs, -h, 0.0)
-        e, d = jnp.exp(k * zs), 1 - jnp.exp(-2 * k * h)
-        fh = e * (1 + jnp.exp(-2 * k * (zs + h))) / d
-        fv = e * (1 - jnp.exp(-2 * k * (zs + h))) / d
+    fh, fv = _velocity_decays(k, jnp.minimum(_stretched(z, eta, h), 0.0), h, jnp)
     return (th, fh, fv, a * wave.omega.reshape(shape), jnp.cos(wave.heading).reshape(shape),
             jnp.sin(wave.heading).reshape(shape), z <= eta)
 
@@ -251,14 +256,7 @@ def velocity_transfer(points, omega, wavenumber, heading, water_depth: float) ->
     k = np.asarray(wavenumber, dtype=float).reshape(-1, 1)
     b = np.asarray(heading, dtype=float).reshape(-1, 1)
     x, y, z = p[None, :, 0], p[None, :, 1], np.minimum(p[None, :, 2], 0.0)
-    h = float(water_depth)
-    if math.isinf(h):
-        fh = fv = np.exp(k * z)
-    else:
-        zc = np.clip(z, -h, 0.0)
-        e, d = np.exp(k * zc), 1 - np.exp(-2 * k * h)
-        fh = e * (1 + np.exp(-2 * k * (zc + h))) / d
-        fv = e * (1 - np.exp(-2 * k * (zc + h))) / d
+    fh, fv = _velocity_decays(k, z, float(water_depth), np)
     ph = w * np.exp(1j * k * (x * np.cos(b) + y * np.sin(b)))
     wet = (p[None, :, 2] <= 0.0)
     u = np.stack([ph * fh * np.cos(b), ph * fh * np.sin(b), -1j * ph * fv], axis=-1)
