@@ -1,7 +1,7 @@
 """Where linear potential flow stops being enough: the linear and the nonlinear level (issue 53)
-against wave steepness H/λ, on the floating sphere, RM3 and M4 134.
+against wave steepness H/λ, on the floating sphere, RM3, M4 134 and the Stansby & Li hybrid.
 
-    python tools/steepness.py [--system sphere|rm3|m4_134] [--period T] [--heights H ...]
+    python tools/steepness.py [--system sphere|rm3|m4_134|stansby_li] [--period T] [--heights H ...]
 
 Each height: a regular wave of the period, with the system's run settings below, radiation
 "state_space", the checks off; the amplitudes at the wave frequency over the last periods (least
@@ -11,7 +11,7 @@ wave's pressure on the instantaneous wetted hull), and their relative difference
 (those in docs/nonlinear.md) and writes notebooks/figures/steepness_<system>.png where matplotlib
 is installed.
 
-Every system is held in surge (its other coordinates free): unmoored, the nonlinear level's mean
+The sphere, RM3 and M4 134 are held in surge (their other coordinates free): unmoored, the nonlinear level's mean
 wave force (the waterline moving against the wave) carries a body downstream, and the encounter
 frequency with it (the unmoored sphere: 0.8 m/s at H 1 m; docs/nonlinear.md), which is a mooring's
 question, not the hydrostatics'.
@@ -32,6 +32,11 @@ question, not the hydrostatics'.
   freeboard at panel size 0.02 m): T 1.2 s, 20 periods at dt 0.006 s, a 4-period ramp, the last
   8 periods; the bow float's heave and pitch, the hinge angles of a mid-row and a stern float, the
   PTOs' total mean power.
+- ``stansby_li`` (configs/stansby_li.toml: the 5 MW wind semi-submersible with two hinged
+  floats, on its own station-keeping springs, no wind; each column's hull its [bodies.geometry]
+  under its 9 m freeboard at panel size 1.5 m, the stiffness at rest within 0.5 % of the
+  database's): T 9 s, 20 periods at dt 0.09 s, a 4-period ramp, the last 8 periods; the
+  platform's heave and pitch, the two floats' hinge angles, the PTOs' total mean power.
 """
 from __future__ import annotations
 
@@ -103,7 +108,22 @@ def _m4():
                 power=True, rao=None)
 
 
-SYSTEMS = {"sphere": _sphere, "rm3": _rm3, "m4_134": _m4}
+def _stansby_li():
+    cfg = tomllib.loads((ROOT / "configs" / "stansby_li.toml").read_text())
+    nl = copy.deepcopy(cfg)
+    nl["hydro"]["hydrostatics"] = "nonlinear"
+    for b in nl["bodies"]:
+        if "geometry" in b:          # the five columns (the turbine is dry)
+            b["hull"] = {"shape": "geometry", "top": 9.0, "panel_size": 1.5}
+    T = 9.0
+    return dict(cfg=cfg, nl=nl, period=T, heights=[0.5, 2.0, 3.0, 4.0, 5.0, 6.0, 7.5],
+                run=dict(duration=20 * T, dt=0.09, ramp=4 * T), window=8 * T,
+                coords={"heave": "float2.heave", "pitch": "float2.pitch",
+                        "float B angle": "floatB.angle", "float C angle": "floatC.angle"},
+                power=True, rao=None)
+
+
+SYSTEMS = {"sphere": _sphere, "rm3": _rm3, "m4_134": _m4, "stansby_li": _stansby_li}
 
 
 def main():
