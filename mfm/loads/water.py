@@ -1189,7 +1189,8 @@ def attach_hulls(spec, bodies, config_dir=None) -> None:
                 f"({cob[0]:.4g}, {cob[1]:.4g}, {cob[2]:.4g}) m, the database body "
                 f"{spec.db_names[k]!r} {v_db:.6g} m³ at ({cob_db[k][0]:.4g}, {cob_db[k][1]:.4g}, "
                 f"{cob_db[k][2]:.4g}) m (tolerances {HULL_VOLUME_RTOL:.0%} of the volume, "
-                f"{HULL_COB_RTOL:.0%} of V^(1/3) = {size:.3g} m): not the same hull at the same "
+                f"{HULL_COB_RTOL:.0%} of V^(1/3) = {HULL_COB_RTOL * size:.3g} m; the centres "
+                f"{np.linalg.norm(cob - cob_db[k]):.3g} m apart): not the same hull at the same "
                 "place; give the hull's dimensions and center in the config's axes at rest")
         hulls.append(T)
     spec.hulls = tuple(hulls)
