@@ -270,10 +270,10 @@ def test_regular_wave_newman_is_the_mean_drift():
         drift_time_series(db.drop_vars("mean_drift"), comps, t, mode="mean")
 
 
-def _moored_cylinder(drift, k=2.0e4, c=6.3e4):
+def _moored_cylinder(drift, k=2.0e4, c=6.3e4, database=CYLINDER):
     """The drift check's cylinder (R 1 m, draft 8 m, its own mass) free in surge on a spring k
     (N/m) and a damper c (N s/m): with its added mass (~ the same again) omega_n ~ 0.63 rad/s and
-    c about critical."""
+    c about critical. ``database``: the drift check's file, or a copy of it."""
     import mfm
 
     m = 1000.0 * np.pi * 8.0
@@ -282,7 +282,7 @@ def _moored_cylinder(drift, k=2.0e4, c=6.3e4):
                        "principal_inertia": [1e5, 1e5, 1e4],
                        "joint": {"type": "free", "dofs": ["surge"], "stiffness": [k],
                                  "damping": [c]}}],
-           "hydro": {"database": str(CYLINDER), "drift": drift}}
+           "hydro": {"database": str(database), "drift": drift}}
     return mfm.load(cfg)
 
 
@@ -493,12 +493,7 @@ def test_equilibrium_in_a_sea_is_the_mean_offset(tmp_path):
     from hydro.prepare import open_any_database
 
     to_netcdf(open_any_database(CYLINDER).drop_vars("mean_drift"), bare)
-    model2 = mfm.load({"model": {"name": "moored cylinder", "gravity": 9.81},
-                       "bodies": [{"name": "cylinder", "mass": 1000.0 * np.pi * 8.0,
-                                   "com": [0.0, 0.0, 0.0], "principal_inertia": [1e5, 1e5, 1e4],
-                                   "joint": {"type": "free", "dofs": ["surge"],
-                                             "stiffness": [k]}}],
-                       "hydro": {"database": str(bare)}})
+    model2 = _moored_cylinder("off", k=k, database=bare)
     with pytest.raises(ValueError, match=r"mfm.equilibrium\(sea=...\) needs the database's "
                                          r"mean_drift .*no_drift.nc"):
         mfm.equilibrium(model2, sea=sea)

@@ -63,12 +63,23 @@ def _held_in_surge(body):
     body["joint"] = {"type": "free", "dofs": [d for d in dofs if d != "surge"]}
 
 
-def _sphere():
-    cfg = tomllib.loads((ROOT / "configs" / "sphere.toml").read_text())
-    cfg["bodies"][0]["joint"] = {"type": "free", "dofs": ["heave", "pitch"]}
+def _pair(config, hull_of, held=None):
+    """configs/``config`` (its body ``held`` held in surge) and its copy at the nonlinear level,
+    each body's hull ``hull_of(body)`` (None: a dry body, no hull)."""
+    cfg = tomllib.loads((ROOT / "configs" / config).read_text())
+    if held is not None:
+        _held_in_surge(next(b for b in cfg["bodies"] if b["name"] == held))
     nl = copy.deepcopy(cfg)
     nl["hydro"]["hydrostatics"] = "nonlinear"
-    nl["bodies"][0]["hull"] = {"shape": "sphere", "radius": 1.0}
+    for b in nl["bodies"]:
+        hull = hull_of(b)
+        if hull is not None:
+            b["hull"] = hull
+    return cfg, nl
+
+
+def _sphere():
+    cfg, nl = _pair("sphere.toml", lambda b: {"shape": "sphere", "radius": 1.0}, held="sphere")
     return dict(cfg=cfg, nl=nl, period=4.0, heights=[0.05, 0.4, 0.8, 1.2, 1.6, 2.0, 2.5],
                 run=dict(duration=48.0, dt=0.02, ramp=8.0), window=24.0,
                 coords={"heave": "sphere.heave", "pitch": "sphere.pitch"}, power=False,
@@ -76,16 +87,12 @@ def _sphere():
 
 
 def _rm3():
-    cfg = tomllib.loads((ROOT / "configs" / "rm3.toml").read_text())
-    _held_in_surge(next(b for b in cfg["bodies"] if b["name"] == "spar"))
-    nl = copy.deepcopy(cfg)
-    nl["hydro"]["hydrostatics"] = "nonlinear"
-    for b in nl["bodies"]:
-        # WEC-Sim's meshes about each body's centre of gravity; the plate's moved up 0.51 m to the
-        # database's centre of buoyancy (the module's docstring)
-        b["hull"] = ({"mesh": "../hydro/data/rm3/float.stl", "center": [0.0, 0.0, -0.72]}
-                     if b["name"] == "float" else
-                     {"mesh": "../hydro/data/rm3/plate.stl", "center": [0.0, 0.0, -20.78]})
+    # WEC-Sim's meshes about each body's centre of gravity; the plate's moved up 0.51 m to the
+    # database's centre of buoyancy (the module's docstring)
+    cfg, nl = _pair("rm3.toml", lambda b: (
+        {"mesh": "../hydro/data/rm3/float.stl", "center": [0.0, 0.0, -0.72]}
+        if b["name"] == "float" else
+        {"mesh": "../hydro/data/rm3/plate.stl", "center": [0.0, 0.0, -20.78]}), held="spar")
     T = 8.0
     return dict(cfg=cfg, nl=nl, period=T, heights=[0.25, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0],
                 run=dict(duration=20 * T, dt=0.05, ramp=4 * T), window=8 * T,
@@ -94,12 +101,8 @@ def _rm3():
 
 
 def _m4():
-    cfg = tomllib.loads((ROOT / "configs" / "m4_134.toml").read_text())
-    _held_in_surge(cfg["bodies"][0])
-    nl = copy.deepcopy(cfg)
-    nl["hydro"]["hydrostatics"] = "nonlinear"
-    for b in nl["bodies"]:
-        b["hull"] = {"shape": "geometry", "top": 0.1, "panel_size": 0.02}
+    cfg, nl = _pair("m4_134.toml", lambda b: {"shape": "geometry", "top": 0.1, "panel_size": 0.02},
+                    held="float1")
     T = 1.2
     return dict(cfg=cfg, nl=nl, period=T, heights=[0.005, 0.02, 0.04, 0.06, 0.08, 0.1, 0.12],
                 run=dict(duration=20 * T, dt=0.006, ramp=4 * T), window=8 * T,
@@ -109,12 +112,9 @@ def _m4():
 
 
 def _stansby_li():
-    cfg = tomllib.loads((ROOT / "configs" / "stansby_li.toml").read_text())
-    nl = copy.deepcopy(cfg)
-    nl["hydro"]["hydrostatics"] = "nonlinear"
-    for b in nl["bodies"]:
-        if "geometry" in b:          # the five columns (the turbine is dry)
-            b["hull"] = {"shape": "geometry", "top": 9.0, "panel_size": 1.5}
+    # the five columns (the turbine is dry); on its own station-keeping springs, not held
+    cfg, nl = _pair("stansby_li.toml", lambda b: (
+        {"shape": "geometry", "top": 9.0, "panel_size": 1.5} if "geometry" in b else None))
     T = 9.0
     return dict(cfg=cfg, nl=nl, period=T, heights=[0.5, 2.0, 3.0, 4.0, 5.0, 6.0, 7.5],
                 run=dict(duration=20 * T, dt=0.09, ramp=4 * T), window=8 * T,
