@@ -491,6 +491,38 @@ def _far_field_drift(ds, results, directions, *, motions, inertia, reference_poi
     return out
 
 
+#: ``drift = "kochin"``: the Kochin functions are stored on this many directions θ_i = 2π i / N
+#: (2°): the far-field integrals are periodic trapezoid sums, exact for |H|²'s harmonics below N/2
+#: (a body of radius R radiates harmonics up to ≈ kR + 10: Wu & Yuan's platform, kR ≈ 10 at 5 s)
+KOCHIN_N_THETA = 180
+
+
+def _kochin_functions(ds, results, directions, n_theta):
+    """The Kochin functions of the diffraction (omega, wave_direction, theta) and of each radiating
+    dof (omega, radiating_dof, theta) of the whole layout (capytaine 3.0's
+    ``post_pro.kochin.compute_kochin``, its normalisation) on θ_i = 2π i / n_theta: the far field
+    of any motion ξ of the bodies is H_D + Σ_j ξ_j H_j (:func:`hydro.drift.far_field_drift`).
+    NaN at ω = ∞."""
+    import capytaine as cpt
+    from capytaine.post_pro.kochin import compute_kochin
+
+    theta = 2 * np.pi * np.arange(n_theta) / n_theta
+    om_all = np.asarray(ds["omega"].values, float)
+    dofs = [str(d) for d in ds["radiating_dof"].values]
+    Hd = np.full((om_all.size, len(directions), n_theta), np.nan + 0j)
+    Hr = np.full((om_all.size, len(dofs), n_theta), np.nan + 0j)
+    for iw, w in enumerate(om_all):
+        if not np.isfinite(w):
+            continue
+        rad = {str(r.radiating_dof): r for r in results
+               if isinstance(r.problem, cpt.RadiationProblem) and float(r.omega) == w}
+        dif = {float(r.wave_direction): r for r in results
+               if isinstance(r.problem, cpt.DiffractionProblem) and float(r.omega) == w}
+        Hd[iw] = [compute_kochin(dif[float(b)], theta) for b in directions]
+        Hr[iw] = [compute_kochin(rad[d], theta) for d in dofs]
+    return theta, Hd, Hr
+
+
 def _block_diag(blocks):
     n = 6 * len(blocks)
     out = np.zeros((n, n))
@@ -558,8 +590,13 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
     drift : None, or "fixed" / "free": also the far-field mean drift ``mean_drift`` of a single
         body (:func:`_far_field_drift`), with the body held ("fixed") or freely floating ("free",
         which needs ``drift_inertia`` = {"mass": kg, "com": [x, y, z] m, "inertia": 3×3 kg m²
-        about the CoM}). A layout of several bodies is refused: the far field gives the total
-        force on all of them, not each body's.
+        about the CoM}). A layout of several bodies is refused there: the far field gives the
+        total force on all of them, not each body's. "kochin": the layout's Kochin functions
+        (:func:`_kochin_functions`, any number of bodies) ``kochin_diffraction`` (omega,
+        wave_direction, theta) and ``kochin_radiation`` (omega, radiating_dof, theta) on
+        :data:`KOCHIN_N_THETA` directions, from which the far-field drift of any motion of the
+        bodies follows (:func:`hydro.drift.far_field_drift`: the model's own,
+        :func:`mfm.frequency.drift.model_mean_drift`).
 
     Returns
     -------
@@ -581,12 +618,13 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
     g = _check_positive("g", g)
     if deep_water_kh is not None:
         deep_water_kh = _check_positive("deep_water_kh", deep_water_kh)
-    if drift not in (None, *DRIFT_MOTIONS):
-        raise ValueError(f"drift = {drift!r}: expected None, 'fixed' or 'free'.")
-    if drift is not None and len(specs) != 1:
+    if drift not in (None, "kochin", *DRIFT_MOTIONS):
+        raise ValueError(f"drift = {drift!r}: expected None, 'fixed', 'free' or 'kochin'.")
+    if drift in DRIFT_MOTIONS and len(specs) != 1:
         raise ValueError(f"drift = {drift!r} with {len(specs)} bodies: capytaine's far-field mean "
                          "drift is the total force on all bodies together, not each body's; solve "
-                         "the drift of one body at a time (or leave drift unset)")
+                         "the drift of one body at a time, or store the layout's Kochin functions "
+                         "(drift = 'kochin') for the drift of a model's own motions")
     if drift == "free":
         try:
             drift_inertia = {"mass": _check_positive("drift_inertia['mass']", drift_inertia["mass"]),
@@ -614,7 +652,8 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
                 "water_depth": water_depth, "rho": rho, "g": g, "dx": dx, "lid": bool(lid),
                 "symmetry": symmetry, "infinite_frequency": bool(infinite_frequency)}
     if drift is not None:              # only then: the cache keys of every other solve unchanged
-        settings["drift"] = {"motions": drift, "inertia": drift_inertia, "n_theta": DRIFT_N_THETA}
+        settings["drift"] = {"motions": drift, "inertia": drift_inertia,
+                             "n_theta": KOCHIN_N_THETA if drift == "kochin" else DRIFT_N_THETA}
     deep_from = math.inf  # the lowest ω solved in deep water
     if deep_water_kh is not None and math.isfinite(water_depth):
         settings["deep_water_kh"] = deep_water_kh
@@ -663,7 +702,22 @@ def solve(bodies, *, omega, dx, wave_directions=(0.0,), water_depth=np.inf, rho=
     finally:
         cpt_log.setLevel(level)
     ds = _augment(ds, specs, hulls, rho=rho, g=g)
-    if drift is not None:
+    if drift == "kochin":
+        theta, Hd, Hr = _kochin_functions(ds, results, directions, KOCHIN_N_THETA)
+        ds = ds.assign_coords(theta=("theta", theta, {"units": "rad", "meaning": "direction of "
+                                                      "the far field, 0 = towards +x"}))
+        what = ("Kochin function (far-field amplitude) of capytaine 3.0's "
+                "post_pro.kochin.compute_kochin about the origin")
+        ds["kochin_diffraction"] = xr.DataArray(
+            Hd, dims=("omega", "wave_direction", "theta"),
+            attrs={"long_name": f"diffraction {what}, per unit wave amplitude",
+                   "units": "m^2/s per m"})
+        ds["kochin_radiation"] = xr.DataArray(
+            Hr, dims=("omega", "radiating_dof", "theta"),
+            attrs={"long_name": f"radiation {what}, per unit motion of the dof (the far field of "
+                                "motions ξ is Σ_j ξ_j H_j, as capytaine's far-field drift takes it)",
+                   "units": "m^2/s per m or rad"})
+    elif drift is not None:
         D = _far_field_drift(ds, results, directions, motions=drift, inertia=drift_inertia,
                              reference_point=specs[0]["reference_point"], rho=rho, g=g)
         ds["mean_drift"] = xr.DataArray(

@@ -30,6 +30,12 @@ Data variables (dims in this order)
         "far field" (momentum, Maruo/Newman: surge, sway, yaw only) or "near field" (pressure
         integration)) and which dofs it gives (``dofs``, comma-separated dof labels: the others
         are 0, not computed)
+    kochin_diffraction (omega, wave_direction, theta),
+    kochin_radiation (omega, radiating_dof, theta)            optional, complex, both or neither:
+        the far-field amplitudes (Kochin functions, capytaine 3.0's normalisation, about the
+        origin) of the diffraction and of each dof's radiation of the whole layout, on the
+        directions ``theta`` (rad, θ_i = 2π i/N, 0 = towards +x), from which the far-field mean
+        drift of any motion of the bodies follows (:func:`hydro.drift.far_field_drift`)
 Attributes
     rho (kg/m^3), g (m/s^2), water_depth (m, inf = deep), convention = "exp(-i omega t)",
     source, and provenance strings.
@@ -72,6 +78,8 @@ OPTIONAL = {
     "diffraction": EXCITATION_DIMS,
     "hydrostatic_stiffness": MATRIX_DIMS,
     "mean_drift": EXCITATION_DIMS,
+    "kochin_diffraction": ("omega", "wave_direction", "theta"),
+    "kochin_radiation": ("omega", "radiating_dof", "theta"),
 }
 REQUIRED_ATTRS = ("rho", "g", "water_depth")
 
@@ -184,6 +192,7 @@ def validate(db: xr.Dataset, bodies=None, *, sym_rtol: float = 0.05,
                          "squared, N/m^2); a complex one is a transfer function of two headings "
                          "or frequencies (a QTF): keep its real part at beta_1 = beta_2 only if "
                          "its imaginary part is round-off.")
+    _check_kochin(db, source)
     if bodies is not None:
         _check_bodies(db, [bodies] if isinstance(bodies, str) else list(bodies))
     _check_finite(db, om)
@@ -197,6 +206,32 @@ def validate(db: xr.Dataset, bodies=None, *, sym_rtol: float = 0.05,
                                    labels, om, damping_noise))
     _give_warnings([f for f in found if f is not None], db, source)
     return db
+
+
+def _check_kochin(db: xr.Dataset, source=None) -> None:
+    """The Kochin functions, when present: both, complex, finite, on directions θ_i = 2π i/N
+    (the far-field integrals are periodic trapezoid sums on that grid)."""
+    have = [v for v in ("kochin_diffraction", "kochin_radiation") if v in db]
+    if not have:
+        return
+    where = _where(source)
+    if len(have) != 2:
+        raise ValueError(f"{where}has {have[0]!r} without "
+                         f"{({'kochin_diffraction', 'kochin_radiation'} - set(have)).pop()!r}: the "
+                         "far-field drift needs both (regenerate with [hydro.bem] drift = "
+                         "\"kochin\")")
+    for v in have:
+        if not np.iscomplexobj(db[v].values):
+            raise ValueError(f"{where}variable {v!r} must be complex; if it was read from NetCDF "
+                             "with a 'complex' dim, open it with hydro.database.open_database.")
+        if not np.isfinite(db[v].values).all():
+            raise ValueError(f"{where}variable {v!r} has non-finite values")
+    th = np.asarray(db["theta"].values, dtype=float)
+    n = th.size
+    if n < 8 or not np.allclose(th, 2 * np.pi * np.arange(n) / n, rtol=0, atol=1e-9):
+        raise ValueError(f"{where}coordinate theta ({n} values from {th[:1].tolist()} to "
+                         f"{th[-1:].tolist()}) must be the uniform directions 2π i/N, i = 0…N−1, "
+                         "N ≥ 8 (the far-field integrals are periodic trapezoid sums)")
 
 
 def _where(source) -> str:
@@ -570,7 +605,8 @@ def from_capytaine(ds: xr.Dataset, body_names=None, *, source=None) -> xr.Datase
     from a ``cpt.export_dataset`` NetCDF (the split ``complex`` dim is rejoined here). Steps:
     transpose to (omega, influenced_dof, radiating_dof); omega = inf → ``added_mass_inf``, omega = 0
     → ``added_mass_zero``; ``excitation = Froude_Krylov_force + diffraction_force``; the rotation
-    centres → ``reference_point``; ``mean_drift`` (``hydro.bem.solve(drift=…)``) carried;
+    centres → ``reference_point``; ``mean_drift`` and the Kochin functions
+    (``hydro.bem.solve(drift=…)``) carried;
     ``displaced_volume``, ``center_of_buoyancy``,
     ``waterplane_stiffness``, ``hydrostatic_stiffness`` are carried when present (the project's BEM
     generator ``mfm hydro`` writes them with the schema names). A single body's bare dof names
@@ -666,6 +702,18 @@ def from_capytaine(ds: xr.Dataset, body_names=None, *, source=None) -> xr.Datase
     if "mean_drift" in ds:
         out["mean_drift"] = freq(vec(ds["mean_drift"]).drop_vars(drop, errors="ignore")).astype(float)
         out["mean_drift"].attrs.update(ds["mean_drift"].attrs)
+    if "kochin_diffraction" in ds and "kochin_radiation" in ds:
+        out = out.assign_coords(theta=("theta", np.asarray(ds["theta"].values, float),
+                                       dict(ds["theta"].attrs)))
+        kd = ds["kochin_diffraction"].drop_vars(drop, errors="ignore")
+        out["kochin_diffraction"] = freq(kd.transpose("omega", "wave_direction", "theta")
+                                         ).astype(complex)
+        kr = ds["kochin_radiation"].drop_vars(drop, errors="ignore")
+        kr = kr.assign_coords(radiating_dof=[rename[str(d)] for d in kr["radiating_dof"].values])
+        out["kochin_radiation"] = freq(kr.sel(radiating_dof=labels).transpose(
+            "omega", "radiating_dof", "theta")).astype(complex)
+        for v in ("kochin_diffraction", "kochin_radiation"):
+            out[v].attrs.update(ds[v].attrs)
     for name in ("waterplane_stiffness", "hydrostatic_stiffness"):
         if name in ds:
             out[name] = mat(ds[name]).drop_vars(drop, errors="ignore").astype(float)

@@ -28,7 +28,6 @@ jax.config.update("jax_enable_x64", True)
 from . import frequency, loads, radiation, results  # noqa: E402
 from .errors import (AccuracyWarning, ConfigError, SeaStateError, SimulationError,  # noqa: E402
                      StabilityWarning, SweepError)
-from .frequency import rest as _rest  # noqa: E402
 from .io.build import compile_tree, load  # noqa: E402
 from .mechanics.dynamics import (coriolis_matrix, energies, evaluate, forward_dynamics,  # noqa: E402
                                  mass_matrix, reaction_loads)
@@ -36,7 +35,7 @@ from .mechanics.kinematics import b_matrix, b_matrix_dot, body_poses, kinematics
 from .mechanics.model import Model  # noqa: E402
 from .runner.batch import simulate_batch  # noqa: E402
 from .runner import door as _door  # noqa: E402
-from .runner.frequency import frequency_response, natural_frequencies  # noqa: E402
+from .runner.frequency import equilibrium, frequency_response, natural_frequencies  # noqa: E402
 from .runner.linear import linear_response  # noqa: E402
 from .runner.simulation import simulate  # noqa: E402
 from .runner.spectral import spectral_response  # noqa: E402
@@ -51,7 +50,6 @@ from .timedomain import rollout as _rollout, setup as _setup  # noqa: E402
 # the core's calls get the runner's host (programs kept on disk, tables kept) unless a caller
 # hands another (mfm.host.using): mfm's own state, no setting of the user's
 _door.install()
-equilibrium = _rest.equilibrium
 rollout = _rollout.rollout
 model_loads = _setup.model_loads
 amplification_matrix = _stability.amplification_matrix

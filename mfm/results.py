@@ -392,6 +392,39 @@ def frequency(model, loads, omega, x, q0, kin0, heading, settings, extra,
     return ds
 
 
+def drag_linearisation(ds, groups, C, sigma, case: bool = True) -> xr.Dataset:
+    """``ds`` with the stochastic drag linearisation of the linear levels (:mod:`mfm.frequency.drag`,
+    :func:`mfm.spectral_response`, :func:`mfm.linear_response`): ``drag_damping`` ([case,]
+    drag_point, flow_axis, flow_axis_col) each point's equivalent damping C (N s/m) and
+    ``relative_flow_rms`` ([case,] drag_point, flow_axis) the standard deviation of its relative
+    flow (m/s). ``groups``: the loads' :class:`~mfm.loads.base.QuadraticDrag` in the order of C's
+    points."""
+    labels = [lab for g in groups for lab in g.labels]
+    lead = ("case",) if case else ()
+    ds = ds.assign_coords(drag_point=labels, flow_axis=["x", "y", "z"],
+                          flow_axis_col=["x", "y", "z"])
+    ds["drag_damping"] = (lead + ("drag_point", "flow_axis", "flow_axis_col"), C, {
+        "long_name": "equivalent linear damping C of each drag point's relative flow "
+                     "w = P(u − v), force C w (stochastic linearisation, inertial axes; "
+                     "u = 0 for a drag on the body's own velocity)",
+        "units": "N s/m"})
+    ds["relative_flow_rms"] = (lead + ("drag_point", "flow_axis"), sigma, {
+        "long_name": "standard deviation of the relative flow w = P(u − v) at each drag "
+                     "point (inertial axes; u = 0 for a drag on the body's own velocity)",
+        "units": "m/s"})
+    return ds
+
+
+def drag_settings(groups, drag) -> dict:
+    """The provenance attributes of a stochastic drag linearisation (``drag``: the fixed point's
+    iterations and last change per case)."""
+    on = sorted({"the relative flow" if g.flow else "the bodies' own velocity" for g in groups})
+    return dict(drag_linearisation=f"stochastic on {' and '.join(on)} (mfm.frequency.drag): "
+                "C = D E[dF/dw], per axis D sqrt(8/pi) sigma",
+                drag_iterations=int(np.max(drag["iterations"])),
+                drag_change=float(np.max(drag["change"])))
+
+
 def spectral(model, loads, q0, q_rms, power, ptos, comps, seas, settings, series=None,
              start=None) -> xr.Dataset:
     """The dataset of :func:`mfm.runner.spectral.spectral_sweep` over ``case``: ``q_rms``,

@@ -143,8 +143,8 @@ def compile_jet(model: Model, loads, q):
 
 
 # ------------------------------------------------------------------------------- equilibrium
-def equilibrium(model: Model, q_guess=None, *, loads=None, sea=None, tol: float = 1e-10,
-                max_iter: int = 50):
+def equilibrium(model: Model, q_guess=None, *, loads=None, sea=None, mean_drift=None,
+                tol: float = 1e-10, max_iter: int = 50):
     """Static equilibrium q₀ with Q(q₀, 0) = 0 (Newton with the jax Jacobian; least squares where
     nothing restores a coordinate, which then stays at its guess), under the model's own loads and
     ``loads`` (e.g. a :class:`~mfm.loads.JointLoad` preload).
@@ -154,6 +154,9 @@ def equilibrium(model: Model, q_guess=None, *, loads=None, sea=None, tol: float 
     (:meth:`~mfm.loads.water.Water.in_mean_drift`): a moored body's mean offset, about which
     :func:`linear_system` can linearise. The first-order wave forces average to zero there; the
     slow drift's oscillation (Newman) and the nonlinear level's own mean wave force are not in it.
+    ``mean_drift``: a table D (omega, wave_direction, influenced_dof) in place of the database's
+    (:func:`mfm.equilibrium` passes the drift of the model's own motions where the database has
+    the Kochin functions, :mod:`mfm.frequency.drift`).
 
     Returns (q₀, info) with info = dict(residual, iterations, free: coordinates without
     stiffness). Raises ValueError when no equilibrium is found (a body that cannot float freely
@@ -162,14 +165,18 @@ def equilibrium(model: Model, q_guess=None, *, loads=None, sea=None, tol: float 
     model = check_model(model)
     lds = system_loads(model, loads)
     if sea is not None:
-        lds = _in_mean_drift(lds, sea)
+        lds = _in_mean_drift(lds, sea, mean_drift)
+    elif mean_drift is not None:
+        raise ValueError("mfm.equilibrium: mean_drift without sea; give the sea whose mean drift "
+                         "it is")
     return _equilibrium(model, lds, q_guess, tol, max_iter)
 
 
-def _in_mean_drift(loads, sea) -> tuple:
+def _in_mean_drift(loads, sea, mean_drift=None) -> tuple:
     """The loads with each one's mean wave drift in ``sea`` at rest (:meth:`Load.in_mean_drift`:
-    the water's, from its database's mean_drift)."""
-    made = [getattr(ld, "in_mean_drift", lambda _sea: None)(sea) for ld in loads]
+    the water's, from its database's mean_drift or the table ``mean_drift``)."""
+    made = [getattr(ld, "in_mean_drift", lambda _sea, _table: None)(sea, mean_drift)
+            for ld in loads]
     if all(m is None for m in made):
         raise ValueError("mfm.equilibrium(sea=...): no load of the model carries a mean wave drift "
                          "force (the water, [hydro]); leave sea out for the equilibrium at rest")

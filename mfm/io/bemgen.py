@@ -43,7 +43,10 @@ and the BEM settings in ``[hydro.bem]`` (every key checked, unknown keys are err
     equilibrium_check = true    # refuse a hull that cannot float its body (below); default true
     drift = "free"              # also the far-field mean drift (database variable mean_drift) of
                                 #   the one wet body: "fixed" (held) or "free" (freely floating
-                                #   with its config mass, com, inertia); default: none
+                                #   with its config mass, com, inertia); or "kochin": the layout's
+                                #   Kochin functions (any number of bodies), from which the drift
+                                #   of the model's own motions is made where it is asked for
+                                #   (mfm.frequency.drift); default: none
     notes = "..."               # free text
 
 Before any solve, ``mfm hydro`` checks each mesh hull (:func:`check_hulls`): closed below the water
@@ -80,7 +83,7 @@ from ..errors import ConfigError
 BEM_KEYS = {"omega_min", "omega_max", "n_omega", "omega", "headings_deg", "water_depth", "dx",
             "lid", "symmetry", "infinite_frequency", "rho", "g", "deep_water_kh", "notes",
             "equilibrium_check", "drift"}
-DRIFTS = ("fixed", "free")
+DRIFTS = ("fixed", "free", "kochin")
 GEOMETRY_KEYS = {"shape", "radius", "draft", "base", "knuckle_radius", "profile", "origin",
                  "reference_point", "file", "dx"}
 SYMMETRIES = ("auto", "xOz", "rotation", "none")
@@ -234,8 +237,9 @@ def bem_settings(raw: dict | None, *, hydro: dict | None = None, gravity: float 
     drift = raw.get("drift", False)
     if drift is not False and drift not in DRIFTS:
         raise ConfigError(f"{w}.drift: {drift!r}; accepted: \"fixed\" (the body held), \"free\" "
-                          "(freely floating with its config mass and inertia), or false / absent "
-                          "(no mean drift)")
+                          "(freely floating with its config mass and inertia), \"kochin\" (the "
+                          "layout's Kochin functions: the drift of the model's own motions), or "
+                          "false / absent (no mean drift)")
     record = {k: raw[k] for k in sorted(raw)}
     kwargs = {"omega": omega, "dx": dx, "wave_directions": [math.radians(b) for b in headings],
               "water_depth": depth, "rho": rho, "g": g, "lid": lid, "symmetry": sym,
@@ -569,12 +573,14 @@ def config_bem_inputs(config_path, overrides=None):
 def _drift_inertia(kw, specs, bodies) -> dict:
     """`kw` (hydro.bem.solve's arguments) with ``drift_inertia`` added for ``drift = "free"``: the
     one wet body's config mass, com and inertia (its own, as a freely floating body)."""
-    if kw.get("drift"):
+    if kw.get("drift") in ("fixed", "free"):
         if len(specs) != 1:
             raise ConfigError(f"hydro.bem.drift: {kw['drift']!r} with {len(specs)} wet bodies "
                               f"({[s['name'] for s in specs]}): capytaine's far-field mean drift "
                               "is the total force on all bodies, not each body's; it is computed "
-                              "for a config with one wet body")
+                              "for a config with one wet body (drift = \"kochin\" stores the "
+                              "layout's Kochin functions, for the drift of the model's own "
+                              "motions)")
         if kw["drift"] == "free":
             b = next(b for b in bodies if b.name == specs[0]["name"])
             kw["drift_inertia"] = {"mass": float(b.mass), "com": [float(v) for v in b.com],

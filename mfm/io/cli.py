@@ -274,6 +274,10 @@ def cmd_info(args):
                   f"dofs {md.get('dofs', '?')}; " + (f"applied ([hydro] drift = {use!r})"
                                                     if use != "off" else "not applied ([hydro] "
                                                     "drift = \"mean\" or \"newman\" would)"))
+        if "kochin_radiation" in spec.db:
+            print(f"  Kochin functions of the layout on {spec.db.sizes['theta']} directions: "
+                  "mfm.equilibrium(model, sea=...) takes the far-field drift of the model's own "
+                  "motions (mfm.frequency.drift.model_mean_drift)")
         issues = known_data_issues(model.hydro.source)
         print("  known data issues (not warned at load; every computation uses the symmetric "
               "part of A, B, A∞):" if issues else "  no known data issues")

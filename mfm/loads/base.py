@@ -124,13 +124,16 @@ class QuadraticDrag(NamedTuple):
     v = R q̇ already projected (normal to a member), ``project`` P (P, 3, 3) the projector of the
     flow, ``drag`` D: (P, 3) per inertial axis (``kind = "axis"``: D_a |w_a| w_a) or (P,) on the
     vector (``kind = "vector"``: D |w| w), ``positions`` (P, 3) the points at rest (inertial),
-    ``labels`` (P,) names of the points (outputs)."""
+    ``labels`` (P,) names of the points (outputs), ``flow``: True for a drag on the velocity
+    relative to the incident wave's flow, w = P (u − v); False for one on the points' own
+    velocity, w = −P v (u taken as 0: ``[hydro] drag_flow = "body"``)."""
     rows: np.ndarray
     project: np.ndarray
     drag: np.ndarray
     kind: str
     positions: np.ndarray
     labels: tuple
+    flow: bool = True
 
 
 class Load(eqx.Module):
@@ -150,8 +153,8 @@ class Load(eqx.Module):
     - the linearisation: :meth:`static_load` (its part at rest; None: nothing static),
       :meth:`frequency_terms` with :meth:`frequency_body_loads` and :meth:`frequency_range`,
       :meth:`frequency_outputs`, :meth:`linear_dampers` (a PTO's damping about q₀),
-      :meth:`quadratic_drag` (drag on the relative flow, for the spectral level's stochastic
-      linearisation), :meth:`in_mean_drift` (the load at rest holding a sea's mean wave drift:
+      :meth:`quadratic_drag` (quadratic drag on the relative flow or on the body's own velocity,
+      for the spectral level's stochastic linearisation), :meth:`in_mean_drift` (the load at rest holding a sea's mean wave drift:
       the equilibrium in a sea);
     - words: :meth:`provenance`, :meth:`describe_nonfinite`.
 
@@ -253,11 +256,13 @@ class Load(eqx.Module):
         load itself; None: nothing static)."""
         return self
 
-    def in_mean_drift(self, sea) -> "Load | None":
+    def in_mean_drift(self, sea, mean_drift=None) -> "Load | None":
         """This load holding, in its :meth:`static_load`, the mean of its second-order wave
         force in ``sea`` (a :mod:`hydro` sea state), for the equilibrium in that sea
-        (``mfm.equilibrium(model, sea=)``: a moored body's mean offset); None (default): the load
-        has no mean wave force."""
+        (``mfm.equilibrium(model, sea=)``: a moored body's mean offset); ``mean_drift``: a table
+        of the drift per unit amplitude squared to take in place of the load's own (the water's:
+        the drift of the model's own motions); None (default): the load has no mean wave
+        force."""
         return None
 
     def frequency_terms(self, model, q0, kin0, omega, heading: float, options: dict) -> FrequencyTerms:
@@ -280,10 +285,11 @@ class Load(eqx.Module):
             "joint_reactions=False")
 
     def quadratic_drag(self, model, kin0):
-        """The quadratic drags this load puts on the flow past points, about the kinematics
-        ``kin0`` of q₀, as a :class:`QuadraticDrag` (their velocity rows, the
-        flow's projector, the coefficients and the points at rest): what the spectral level
-        linearises stochastically on the relative flow (:mod:`mfm.frequency.drag`); None
+        """The quadratic drags this load puts on points, about the kinematics ``kin0`` of q₀, as a
+        :class:`QuadraticDrag` (their velocity rows, the flow's projector, the coefficients, the
+        points at rest and whether the drag acts on the relative flow or on the points' own
+        velocity): what the spectral level linearises stochastically
+        (:mod:`mfm.frequency.drag`); None
         (default): none (the drag must already be in :meth:`evaluate`, whose slope at rest is 0)."""
         return None
 

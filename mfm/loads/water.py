@@ -398,7 +398,7 @@ class Water(Load):
             still = dataclasses.replace(still, flow=self.flow.still())
         return still
 
-    def in_mean_drift(self, sea) -> "Water":
+    def in_mean_drift(self, sea, mean_drift=None) -> "Water":
         """This water holding, at rest, the mean wave drift force of ``sea``,
 
             F̄_i = Σ_j D_i(ω_j, β_j) a_j²      (N, N m; inertial axes at the reference points),
@@ -409,11 +409,17 @@ class Water(Load):
         mean. Its :meth:`static_load` carries F̄, so the equilibrium of a model with this water
         is the mean position in that sea (a moored body's mean offset); the waves' first-order
         forces average to zero there. Whatever ``[hydro] drift`` says (the question is the
-        mean offset); a database without ``mean_drift`` is refused, naming how to make one."""
+        mean offset); a database without ``mean_drift`` is refused, naming how to make one.
+        ``mean_drift``: a table D (omega, wave_direction, influenced_dof) in place of the
+        database's (the drift of the model's own motions, :mod:`mfm.frequency.drift`)."""
         from hydro.drift import mean_drift_of
 
         spec = self.spec
         db = spec.database()
+        if mean_drift is not None:
+            import xarray as xr
+
+            db = xr.Dataset({"mean_drift": mean_drift})
         require_mean_drift(db, spec.source, "mfm.equilibrium(sea=...)")
         comps = sea.components(water_depth=spec.water_depth, g=spec.g)
         mean = np.asarray(mean_drift_of(db, comps), np.float64)
@@ -468,11 +474,13 @@ class Water(Load):
         return FrequencyTerms(impedance=Z, force=np.einsum("ai,wa->wi", H0, X))
 
     def quadratic_drag(self, model, kin0):
-        """With ``[hydro] drag_flow = "relative"``: the drag −D_a |ξ̇_a − u_a| (ξ̇_a − u_a) per
-        inertial axis a at each reference point (at its rest position), for the spectral level's
-        stochastic linearisation (:mod:`mfm.frequency.drag`); None on the body's own velocity (the
-        spectral level leaves that drag out, as before; :func:`mfm.optimize` linearises it)."""
-        if self.flow is None:
+        """The drag per inertial axis a at each reference point (at its rest position), for the
+        spectral level's stochastic linearisation (:mod:`mfm.frequency.drag`): with ``[hydro]
+        drag_flow = "relative"`` −D_a |ξ̇_a − u_a| (ξ̇_a − u_a) on the flow relative to the point,
+        with ``"body"`` (the default) −D_a |ξ̇_a| ξ̇_a on its own velocity (``flow`` False: the
+        linearisation :func:`mfm.optimize` makes in jax, :mod:`mfm.studies.design`). None where
+        every D is 0."""
+        if not np.any(np.asarray(self.drag) != 0):
             return None
         K = self.drag.shape[0]
         H0 = np.asarray(h_matrix_at(self.geometry, kin0)).reshape(K, 6, -1)[:, :3]
@@ -480,7 +488,7 @@ class Water(Load):
         labels = tuple(self.dofs[6 * k].rsplit("__", 1)[0] for k in range(K))
         return QuadraticDrag(rows=H0, project=np.broadcast_to(np.eye(3), (K, 3, 3)).copy(),
                              drag=np.asarray(self.drag, dtype=float), kind="axis",
-                             positions=pos, labels=labels)
+                             positions=pos, labels=labels, flow=self.flow is not None)
 
     def frequency_body_loads(self, model, q0, kin0, omega, heading, options, x):
         """The wave and radiation-memory loads at the reference points,

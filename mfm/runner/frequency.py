@@ -3,7 +3,7 @@ labelled datasets (:mod:`mfm.results`)."""
 from __future__ import annotations
 
 from .. import results
-from ..frequency import modes, response
+from ..frequency import drift, modes, response, rest
 
 
 def frequency_response(model, omega, heading: float = 0.0, *, q0=None,
@@ -23,6 +23,30 @@ def natural_frequencies(model, omega_grid=None, *, q0=None, iterations: int = 30
     return results.natural(model, n.loads, n.eigen, n.modes, n.damping_ratio,
                            n.radiation_damping_ratio, n.min_det, n.settings,
                            min_det_damped=n.min_det_damped)
+
+
+def equilibrium(model, q_guess=None, *, loads=None, sea=None, tol: float = 1e-10,
+                max_iter: int = 50):
+    """Static equilibrium q₀ of the model under its loads (:func:`mfm.frequency.rest.equilibrium`:
+    Newton with the jax Jacobian), and with ``sea`` its mean position in that sea under the mean
+    wave drift force F̄ = Σ_j D(ω_j, β_j) a_j²: D the drift of the model's own motions where its
+    database has the layout's Kochin functions (``[hydro.bem] drift = "kochin"``:
+    :func:`mfm.frequency.drift.model_mean_drift`, the RAOs about the still-water equilibrium, the
+    far field's total on the hydro body nearest the root), else the database's ``mean_drift``
+    (a body held or freely floating, as ``mean_drift.attrs["motions"]`` says).
+
+    Returns (q₀, info): info = dict(residual, iterations, free: coordinates without stiffness)
+    and, with ``sea``, ``mean_drift``: which drift was taken (its method and motions). Raises
+    ValueError when no equilibrium is found (the residual named by coordinate), or when the sea's
+    drift cannot be had (no Kochin functions and no mean_drift: how to make them)."""
+    table = drift.model_mean_drift(model, loads=loads) \
+        if sea is not None and drift.has_kochin(model) else None
+    q0, info = rest.equilibrium(model, q_guess, loads=loads, sea=sea, mean_drift=table, tol=tol,
+                                max_iter=max_iter)
+    if sea is not None:
+        da = table if table is not None else model.hydro.database()["mean_drift"]
+        info["mean_drift"] = f"{da.attrs.get('method', '?')}; motions: {da.attrs.get('motions', '?')}"
+    return q0, info
 
 
 # one text per idea: the equations and the dataset's variables are the core's docstrings

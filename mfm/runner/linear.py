@@ -30,6 +30,15 @@ integrated exactly from its velocity,
 No step size limit and no time-stepping error: against the linear model the one error is the hold's
 on the force, O((ωh)²) (the spectral level's steady state has none; this level has the start-up
 transient and the ramp, as ``simulate`` has). Cost per step: one (modes × n_q) complex product.
+
+Quadratic drag (the water's, on the body's own velocity or on the relative flow, and any load's
+:meth:`~mfm.loads.base.Load.quadratic_drag`) enters linearised stochastically for the sea, as the
+spectral level takes it (:mod:`mfm.frequency.drag`, one fixed point for both, here on the
+state-space fit's radiation): a damping Σ_p R_pᵀ C_p R_p added to C and, on the relative flow, the
+excitation Σ_p R_pᵀ C_p P_p u_p(t) of the linear particle velocity at each point's rest position,
+ramped as the excitation is. The equivalent damping is the one of least mean-square error for a
+Gaussian response; the drag's odd harmonics are not in it (a few per cent to ~15 % on a
+drag-dominated standard deviation, docs/nonlinear.md).
 """
 from __future__ import annotations
 
@@ -236,10 +245,15 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
     Returns an xarray.Dataset with ``q``, ``qd``, ``qdd`` (time, coordinate), ``pto_power`` and
     ``pto_displacement`` (time, pto) of each joint damper (c q̇², as :func:`mfm.spectral_response`)
     and each hydraulic piston (β ẇ², ẇ = g(q₀) q̇ to first order), ``eta`` (time) and
-    ``equilibrium`` (coordinate); attributes: provenance, ``level = "linear"``, the state-space
-    fit, ``free_positions``, ``mode_condition`` (‖V‖₁‖V⁻¹‖₁), the wall time.
-    Raises ValueError on bad input, NotImplementedError for a load with frequency-dependent terms
-    other than the water's (no time-domain realisation of them here).
+    ``equilibrium`` (coordinate); with quadratic drag (module docstring) also ``drag_damping``
+    (drag_point, flow_axis, flow_axis_col) and ``relative_flow_rms`` (drag_point, flow_axis), as
+    :func:`mfm.spectral_response` gives them, and the attributes ``drag_linearisation``,
+    ``drag_iterations``, ``drag_change``; attributes: provenance, ``level = "linear"``, the
+    state-space fit, ``free_positions``, ``mode_condition`` (‖V‖₁‖V⁻¹‖₁), the wall time.
+    Raises ValueError on bad input, NotImplementedError for a load other than the water with a
+    frequency-dependent impedance (no time-domain realisation of it here; a load's wave force,
+    such as a Morison element's inertia, is synthesised from its frequency terms at the sea's
+    components).
     """
     model = check_model(model)
     from hydro.excitation import excitation_time_series
@@ -264,11 +278,8 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
                          "steps")
     start = _time.perf_counter()
     sys = linear_system(model, q0, loads=loads)
-    other = [type(ld).__name__ for ld in sys.loads if ld.linear_hydro() is None
+    other = [ld for ld in sys.loads if ld.linear_hydro() is None
              and type(ld).frequency_terms is not Load.frequency_terms]
-    if other:
-        raise NotImplementedError(f"loads {other} add frequency-dependent terms that have no "
-                                  "time-domain realisation in the linear level; use mfm.simulate")
     water = linear_hydro(sys.loads)
     spec = model.hydro
     rad = StateSpace.build(spec, state_space_options)
@@ -278,8 +289,17 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
     t = dt * np.arange(n_steps + 1)
     comps = sea.components(water_depth=spec.water_depth, g=spec.g)
     f = excitation_time_series(spec.database(), comps, t, ramp_duration=ramp) @ H0
+    if other:
+        f = f + _wave_forces(model, sys, other, comps, t, ramp)
+    C = sys.C
+    groups = [g for ld in sys.loads if (g := ld.quadratic_drag(model, sys.kin0)) is not None]
+    if groups:
+        drag = _linearised_drag(model, sys, comps, groups, state_space_options)
+        R = np.concatenate([g.rows for g in groups])                       # (P, 3, n_q)
+        C = C + np.einsum("pai,pab,pbj->ij", R, drag["C"][0], R)
+        f = f + _flow_force(groups, drag["C"][0], comps, t, ramp, spec.water_depth)
     free = _free_columns(sys.K)
-    x, qd, qdd, cond = lti_response(M, sys.C, sys.K, f, dt, save_every=save_every, H0=H0,
+    x, qd, qdd, cond = lti_response(M, C, sys.K, f, dt, save_every=save_every, H0=H0,
                                     rad=rad, free=free)
     ts = t[::save_every]
     q = sys.q0[None] + x
@@ -290,6 +310,73 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
                     n_components=len(comps), free_positions=", ".join(
                         model.coordinates[k] for k in free) or "none",
                     mode_condition=cond, wall_time_s=wall)
-    return results.linear_time_series(model, sys.loads + (rad,), ts, q, qd, qdd, sys.q0, eta,
-                                      settings, source=spec.source,
-                                      dampers=load_dampers(sys.loads, sys.kin0))
+    if groups:
+        settings.update(results.drag_settings(groups, drag))
+    ds = results.linear_time_series(model, sys.loads + (rad,), ts, q, qd, qdd, sys.q0, eta,
+                                    settings, source=spec.source,
+                                    dampers=load_dampers(sys.loads, sys.kin0))
+    if groups:
+        ds = results.drag_linearisation(ds, groups, drag["C"][0], drag["sigma"][0], case=False)
+    return ds
+
+
+def _wave_forces(model, sys, loads, comps, t, ramp):
+    """The wave forces of loads other than the water's with frequency terms (Morison elements'
+    inertia), realised in time: r(t) Re Σ_j a_j e^{iφ_j} F(ω_j, β_j) e^{−iω_j t} (n_t, n_q) of each
+    load's :meth:`~mfm.loads.base.Load.frequency_terms` force at the sea's components (exact for a
+    force linear in the wave), ramped as the excitation is. A load whose terms also carry an
+    impedance (a frequency-dependent mass, damping or stiffness) is refused: this level has no
+    realisation of it."""
+    from hydro.waves import _harmonic_sum
+    from hydro.waves import ramp as ramp_of
+
+    coef = np.zeros((len(comps.omega), model.n_coordinates), dtype=complex)
+    for ld in loads:
+        for beta in np.unique(comps.heading):
+            sel = comps.heading == beta
+            terms = ld.frequency_terms(model, sys.q0, sys.kin0, comps.omega[sel], float(beta),
+                                       {"excitation": True})
+            if terms.impedance is not None and np.any(np.asarray(terms.impedance) != 0):
+                raise NotImplementedError(
+                    f"load {type(ld).__name__} adds a frequency-dependent impedance (a mass, "
+                    "damping or stiffness that depends on ω), which has no time-domain "
+                    "realisation in the linear level; use mfm.simulate")
+            if terms.force is not None:
+                coef[sel] += comps.complex_amplitude[sel, None] * np.asarray(terms.force)
+    r = ramp_of(t, ramp)[:, None] if ramp else 1.0
+    return r * _harmonic_sum(comps.omega, coef, t)
+
+
+def _linearised_drag(model, sys, comps, groups, state_space_options):
+    """The stochastic linearisation of the loads' quadratic drag for this sea
+    (:func:`mfm.runner.spectral.drag_raos`, one place for the fixed point) on the system this
+    level steps: the radiation of the state-space fit, so that the damping C matches the level's
+    own response statistics."""
+    from .spectral import drag_raos
+
+    options = {"radiation": "state_space", "state_space_options": state_space_options}
+    return drag_raos(model, sys, [comps], options, groups)[2]
+
+
+def _flow_force(groups, C, comps, t, ramp, water_depth):
+    """The linearised drag's excitation by the flow, Σ_p R_pᵀ C_p P_p u_p(t) (n_t, n_q): u_p(t) =
+    r(t) Re Σ_j a_j e^{iφ_j} û_p(ω_j, β_j) e^{−iω_j t} the linear particle velocity at each point's
+    rest position (:func:`hydro.wetted.velocity_transfer`), ramped as the excitation is; 0 for a
+    drag on the body's own velocity."""
+    from hydro.waves import _harmonic_sum
+    from hydro.waves import ramp as ramp_of
+    from hydro.wetted import velocity_transfer
+
+    f = np.zeros((len(t), groups[0].rows.shape[-1]))
+    r = ramp_of(t, ramp)[:, None] if ramp else 1.0
+    start = 0
+    for g in groups:
+        P = len(g.rows)
+        if g.flow:
+            U = velocity_transfer(g.positions, comps.omega, comps.wavenumber, comps.heading,
+                                  water_depth)                                # (n_j, P, 3)
+            Pu = np.einsum("pab,jpb->jpa", g.project, U).reshape(len(comps.omega), -1)
+            u = r * _harmonic_sum(comps.omega, comps.complex_amplitude[:, None] * Pu, t)
+            f += np.einsum("pai,pab,tpb->ti", g.rows, C[start:start + P], u.reshape(len(t), P, 3))
+        start += P
+    return f

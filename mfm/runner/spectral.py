@@ -18,8 +18,9 @@ excitation is ``hydro.excitation.excitation_time_series`` of the same components
 compared sample by sample. Valid where the model is linear about q₀ over the motions the sea makes:
 small rotations, no hinge at a stop. :func:`mfm.reduce` measures when that holds.
 
-Quadratic drag on the relative flow — the water's with ``[hydro] drag_flow = "relative"``
-(−D_a |v_a − u_a| (v_a − u_a) per inertial axis at each reference point) and every ``[[morison]]``
+Quadratic drag — the water's (−D_a |v_a − u_a| (v_a − u_a) per inertial axis at each reference
+point on the relative flow with ``[hydro] drag_flow = "relative"``, −D_a |v_a| v_a on the body's
+own velocity with ``"body"``) and every ``[[morison]]``
 point's (½ ρ C_D A |w_n| w_n on the normal flow w_n = (I − e eᵀ)(u − v)) — is linearised
 stochastically for each sea (:mod:`mfm.frequency.drag`): the force of least mean-square error for a
 Gaussian relative flow w, C w with C = E[∂f/∂w] (per axis Borgman's c_eq = D √(8/π) σ_w), so that
@@ -30,8 +31,9 @@ Gaussian relative flow w, C w with C = E[∂f/∂w] (per axis Borgman's c_eq = D
 (R_p the point's projected velocity rows, û_p the linear particle velocity per unit amplitude at
 its rest position, every component of the sea with its heading) iterated from C = 0 to a fixed
 point: damping C on the body's velocity and the excitation C û of the flow. Each sea gets its own
-C (``drag_damping``, ``relative_flow_rms``). The drag on the body's own velocity
-(``drag_flow = "body"``) is still left out (:func:`mfm.optimize` linearises that one). The
+C (``drag_damping``, ``relative_flow_rms``). The drag on the body's own velocity (``[hydro]
+drag_flow = "body"``, the default) is linearised the same way with u = 0: a damping C alone, the
+fixed point :func:`mfm.optimize` reaches in jax (:mod:`mfm.studies.design`). The
 linearisation's known error: a Gaussian response assumed (the drag's own non-Gaussian, odd
 harmonics are dropped), typically 5–15 % on the standard deviation where drag dominates the
 damping, less where radiation and PTO damping do.
@@ -68,9 +70,9 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
     ``pto_power_mean`` (pto) the expected mean power of each joint damper and hydraulic piston
     (W; a piston's rate ẇ = G q̇ linearised at q₀, :meth:`~mfm.loads.base.Load.linear_dampers`),
     ``equilibrium`` (coordinate); with ``t`` also ``q``, ``qd`` (time, coordinate), ``pto_power``
-    (time, pto) = c (G q̇)² (W) and ``eta`` (time) the elevation at the origin (m). With drag on
-    the relative flow (``[hydro] drag_flow = "relative"``, ``[[morison]]`` elements: module
-    docstring) also ``drag_damping`` (drag_point, flow_axis, flow_axis_col) each point's
+    (time, pto) = c (G q̇)² (W) and ``eta`` (time) the elevation at the origin (m). With
+    quadratic drag (the water's, on the relative flow or the body's own velocity, and
+    ``[[morison]]`` elements: module docstring) also ``drag_damping`` (drag_point, flow_axis, flow_axis_col) each point's
     equivalent damping C (N s/m) and ``relative_flow_rms`` (drag_point, flow_axis) the standard
     deviation of its relative flow (m/s), and the attributes ``drag_iterations``, ``drag_change``
     (the fixed point's). Attributes: provenance, the sea, ``level = "spectral"``,
@@ -221,12 +223,12 @@ def _sweep(model, seas, labels, *, t, q0, loads, radiation, state_space_options,
     comps = _check_in_grid(model, seas, labels)
     options = {"radiation": radiation, "state_space_options": state_space_options}
     sys = linear_system(model, q0, loads=loads)
-    # drag on the relative flow (the water's with [hydro] drag_flow = "relative", Morison
+    # quadratic drag (the water's, on the relative flow or the body's own velocity, and Morison
     # elements'): linearised stochastically per sea (its damping depends on the sea)
     groups = [g for ld in sys.loads if (g := ld.quadratic_drag(model, sys.kin0)) is not None]
     solve_start = _time.perf_counter()
     if groups:
-        xs, n_union, drag = _drag_raos(model, sys, comps, options, groups)
+        xs, n_union, drag = drag_raos(model, sys, comps, options, groups)
     else:
         xs, n_union = _union_raos(model, sys, comps, options)
     solve_s = _time.perf_counter() - solve_start
@@ -245,27 +247,15 @@ def _sweep(model, seas, labels, *, t, q0, loads, radiation, state_space_options,
     settings = dict(level="spectral", seas=repr(seas), n_frequencies_solved=n_union,
                     radiation=radiation_label(radiation), convention="exp(-i omega t)", rao_solve_s=solve_s)
     if groups:
-        settings.update(drag_linearisation="stochastic on the relative flow (mfm.frequency.drag): "
-                        "C = D E[dF/dw], per axis D sqrt(8/pi) sigma",
-                        drag_iterations=int(drag["iterations"].max()),
-                        drag_change=float(drag["change"].max()))
+        settings.update(results.drag_settings(groups, drag))
     ds = results.spectral(model, sys.loads, sys.q0, q_rms, power, ptos, comps, seas, settings,
                           series, start)
     if groups:
-        labels = [lab for g in groups for lab in g.labels]
-        ds = ds.assign_coords(drag_point=labels, flow_axis=["x", "y", "z"],
-                              flow_axis_col=["x", "y", "z"])
-        ds["drag_damping"] = (("case", "drag_point", "flow_axis", "flow_axis_col"), drag["C"], {
-            "long_name": "equivalent linear damping C of each drag point's relative flow "
-                         "w = P(u − v), force C w (stochastic linearisation, inertial axes)",
-            "units": "N s/m"})
-        ds["relative_flow_rms"] = (("case", "drag_point", "flow_axis"), drag["sigma"], {
-            "long_name": "standard deviation of the relative flow w = P(u − v) at each drag "
-                         "point (inertial axes)", "units": "m/s"})
+        ds = results.drag_linearisation(ds, groups, drag["C"], drag["sigma"])
     return ds
 
 
-def _drag_raos(model, sys, comps_list, options, groups):
+def drag_raos(model, sys, comps_list, options, groups):
     """The RAOs x̂ (n_j, n_q) of every sea's components with the loads' quadratic drag on the
     relative flow linearised stochastically for that sea (:func:`mfm.frequency.drag.linearise`):
     Z(ω) and F(ω, β) made once per distinct (β, ω) pair of the seas (one per heading), the fixed
@@ -288,6 +278,7 @@ def _drag_raos(model, sys, comps_list, options, groups):
     for i, cm in enumerate(comps_list):
         idx = inverse[bounds[i]:bounds[i + 1]]
         U = [velocity_transfer(g.positions, cm.omega, cm.wavenumber, cm.heading, depth)
+             if g.flow else np.zeros((len(cm.omega), len(g.positions), 3), dtype=complex)
              for g in groups]
         lin = linearise(groups, Zu[idx], Fu[idx], cm.omega, cm.amplitude, U)
         if lin.change > TOL:

@@ -4,11 +4,11 @@ cheapest level whose answer stays within a tolerance of the full model on the sc
 The levels, cheapest first:
 
 - ``"spectral"``: the linear frequency-domain response summed over the sea's components
-  (:func:`mfm.runner.spectral.spectral_response`), no time stepping. Linear about the equilibrium: no
-  drag, no large rotations, no stops.
+  (:func:`mfm.runner.spectral.spectral_response`), no time stepping. Linear about the equilibrium:
+  quadratic drag linearised stochastically for the sea, no large rotations, no stops.
 - ``"linear"``: the same linear model in the time domain (:func:`mfm.runner.linear.linear_response`):
-  radiation by the state-space fit, the modes stepped exactly; it has the start-up transient and
-  ramp that the spectral level's steady state has not.
+  radiation by the state-space fit, the modes stepped exactly, the drag linearised as the spectral
+  level's; it has the start-up transient and ramp that the spectral level's steady state has not.
 - ``"fast"``: the full nonlinear model stepped once per step (``integrator="verlet"``) with the
   radiation states advanced exactly (``radiation="state_space_exact"``): second order in dt.
 - ``"full"``: the full nonlinear model with RK4 and the engine's default radiation

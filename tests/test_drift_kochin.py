@@ -1,0 +1,169 @@
+"""The mean wave drift of a model's own motions (issue 53 item 3, a layout of several bodies): the
+far-field formula on stored Kochin functions (hydro.drift.far_field_drift) and the model's drift
+(mfm.frequency.drift.model_mean_drift) against capytaine 3.0's own chain on the same two bodies
+(tools/drift_kochin_check.py: fill_dataset with 0.25° Kochin functions, post_pro.rao,
+far_field_mean_drift_force), the total put on the root body with its yaw moved, the mean offset of
+a moored layout through mfm.equilibrium(sea=), and the errors."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import hydro
+import mfm
+from hydro import bem
+from hydro.drift import far_field_drift
+from hydro.waves import wavenumber
+from mfm.frequency.drift import model_mean_drift
+
+pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
+
+DATA = Path(__file__).resolve().parents[1] / "hydro" / "data"
+CHECK = DATA / "drift_kochin_check.nc"
+MASS = 1000.0 * math.pi * 1.5
+# capytaine's yaw takes H′(θ) by central differences on its θ grid (0.25° in the check: relative
+# error ~(n dθ)²/6 for the Kochin functions' harmonics n ≲ 10, ≈ 1e-5); ours is the grid's
+# Fourier series (no such error): the yaw moments agree to 1e-4, the forces (no derivative) to
+# round-off
+YAW_RTOL = 1e-4
+
+
+def _check():
+    ds = bem.load(CHECK)
+    fin = np.isfinite(ds["omega"].values)
+    return ds, fin
+
+
+def _two_cylinders(order=("A", "B"), **hydro_keys):
+    """The check's two cylinders freely floating (6 dofs each), their masses and inertias the
+    tool's."""
+    bodies = {
+        "A": {"name": "A", "mass": MASS, "com": [0.0, 0.0, -0.9],
+              "principal_inertia": [3000.0, 4500.0, 2400.0], "joint": {"type": "free"}},
+        "B": {"name": "B", "mass": MASS, "com": [3.0, 1.5, -0.9],
+              "principal_inertia": [3500.0, 3500.0, 2000.0], "joint": {"type": "free"}},
+    }
+    return mfm.load({"model": {"name": "two cylinders", "gravity": 9.81},
+                     "bodies": [bodies[n] for n in order],
+                     "hydro": {"database": str(CHECK), **hydro_keys}})
+
+
+def test_far_field_drift_against_capytaine_on_given_motions():
+    """Random complex motions of both bodies (the tool's, seed 7): surge and sway force of
+    far_field_drift on the stored 2° Kochin functions against capytaine's far_field_mean_drift_force
+    on its own 0.25° ones, to 1e-12 of the largest (the periodic trapezoid sum is exact for the
+    functions' harmonics, far below 90 of them); the yaw moment to YAW_RTOL. Two headings (0, 30°)
+    on the grid, three frequencies."""
+    ds, fin = _check()
+    om = ds["omega"].values[fin]
+    beta = ds["wave_direction"].values
+    X = ds["motions_random"].values[fin]
+    ref = ds["drift_capytaine_random"].values[fin]
+    nw, nb, nd = X.shape
+    W, B = np.repeat(om, nb), np.tile(beta, nw)
+    Hd = ds["kochin_diffraction"].values[fin].reshape(nw * nb, -1)
+    Hr = np.repeat(ds["kochin_radiation"].values[fin], nb, axis=0)
+    out = far_field_drift(Hd, Hr, X.reshape(-1, nd), W, wavenumber(W, math.inf, 9.81), B,
+                          water_depth=math.inf, rho=1000.0, g=9.81).reshape(nw, nb, 3)
+    for i, tol in ((0, 1e-12), (1, 1e-12), (2, YAW_RTOL)):
+        np.testing.assert_allclose(out[..., i], ref[..., i], rtol=0,
+                                   atol=tol * np.abs(ref[..., i]).max())
+    # the motions matter: held bodies drift otherwise
+    held = far_field_drift(Hd, Hr, 0 * X.reshape(-1, nd), W, wavenumber(W, math.inf, 9.81), B,
+                           water_depth=math.inf, rho=1000.0, g=9.81).reshape(nw, nb, 3)
+    assert np.abs(held[..., 0] - ref[..., 0]).max() > 0.1 * np.abs(ref[..., 0]).max()
+
+
+def test_the_model_s_own_drift_against_capytaine_s_chain():
+    """Two cylinders freely floating, an mfm model of them (its own mechanics, its frequency
+    response): its RAOs are capytaine's motions with A(ω), B(ω) symmetrised as mfm takes them
+    (1e-12), and model_mean_drift the far-field drift capytaine's chain gives for them: surge and
+    sway to 1e-12, yaw to YAW_RTOL, the layout's total on body A (the first of equals at the
+    root), B's rows 0, heave, roll and pitch 0."""
+    ds, fin = _check()
+    model = _two_cylinders()
+    D = model_mean_drift(model)
+    ref = ds["drift_capytaine_free_symmetric"].values[fin]
+    np.testing.assert_allclose(D["omega"].values, ds["omega"].values[fin])
+    for dof, i, tol in (("A__Surge", 0, 1e-12), ("A__Sway", 1, 1e-12), ("A__Yaw", 2, YAW_RTOL)):
+        np.testing.assert_allclose(D.sel(influenced_dof=dof).values, ref[..., i], rtol=0,
+                                   atol=tol * np.abs(ref[..., i]).max())
+    others = [d for d in D["influenced_dof"].values if d not in ("A__Surge", "A__Sway", "A__Yaw")]
+    assert np.all(D.sel(influenced_dof=others).values == 0)
+    assert D.attrs["dofs"] == "A__Surge, A__Sway, A__Yaw" and "model 'two cylinders'" in \
+        D.attrs["motions"]
+    x = mfm.frequency_response(model, ds["omega"].values[fin], heading=0.0,
+                               joint_reactions=False).xi_rao.values
+    want = ds["motions_free_symmetric"].values[fin][:, 0]
+    np.testing.assert_allclose(x, want, rtol=0, atol=1e-12 * np.abs(want).max())
+    # capytaine's own rao keeps the BEM's asymmetry: a visibly different drift (what the
+    # symmetric reference above is for)
+    raw = ds["drift_capytaine_free"].values[fin]
+    assert 1e-5 < np.abs(raw[..., 0] - ref[..., 0]).max() / np.abs(ref[..., 0]).max() < 0.05
+
+
+def test_the_total_is_put_on_the_root_body_with_its_yaw_moved():
+    """The same bodies given in the order B, A: the total goes on B (the first of equals at the
+    root), its yaw moment moved from the Kochin functions' origin to B's reference point
+    (3, 1.5): M_B = M_0 − (x_B F_y − y_B F_x), to round-off against the A-first table."""
+    a_first = model_mean_drift(_two_cylinders(("A", "B")))
+    b_first = model_mean_drift(_two_cylinders(("B", "A")))
+    F = {c: a_first.sel(influenced_dof=f"A__{c}").values for c in ("Surge", "Sway", "Yaw")}
+    scale = np.abs(F["Surge"]).max()
+    np.testing.assert_allclose(b_first.sel(influenced_dof="B__Surge").values, F["Surge"],
+                               rtol=0, atol=1e-12 * scale)
+    moved = F["Yaw"] - (3.0 * F["Sway"] - 1.5 * F["Surge"])
+    np.testing.assert_allclose(b_first.sel(influenced_dof="B__Yaw").values, moved, rtol=0,
+                               atol=1e-12 * np.abs(moved).max())
+    assert np.all(b_first.sel(influenced_dof=[f"A__{c}" for c in ("Surge", "Sway", "Yaw")])
+                  .values == 0)
+
+
+def test_the_mean_offset_of_a_moored_layout():
+    """B welded to A, A moored in surge by a spring k and free in heave and pitch (the layout
+    moves as one body): mfm.equilibrium(model, sea=Regular) takes the drift of the model's own
+    motions (the database has Kochin functions and no mean_drift) and the surge offset is
+    F_x a²/k of model_mean_drift's table at the wave's frequency and heading (1e-9: Newton's
+    tolerance); info says which drift; without the sea the layout stays at rest."""
+    k = 5.0e3
+    cfg = {"model": {"name": "moored pair", "gravity": 9.81},
+           "bodies": [{"name": "A", "mass": MASS, "com": [0.0, 0.0, -0.9],
+                       "principal_inertia": [3000.0, 4500.0, 2400.0],
+                       "joint": {"type": "free", "dofs": ["surge", "heave", "pitch"],
+                                 "stiffness": [k, 0.0, 0.0]}},
+                      {"name": "B", "parent": "A", "mass": MASS, "com": [3.0, 1.5, -0.9],
+                       "principal_inertia": [3500.0, 3500.0, 2000.0],
+                       "joint": {"type": "fixed"}}],
+           "hydro": {"database": str(CHECK)}}
+    model = mfm.load(cfg)
+    rest, _ = mfm.equilibrium(model)
+    a, w = 0.1, 2.2
+    q0, info = mfm.equilibrium(model, sea=hydro.Regular(height=2 * a, period=2 * math.pi / w))
+    D = model_mean_drift(model).sel(omega=w, wave_direction=0.0, influenced_dof="A__Surge")
+    i = model.coordinates.index("A.surge")
+    assert q0[i] - rest[i] == pytest.approx(float(D) * a * a / k, rel=1e-9)
+    assert abs(float(D)) * a * a / k > 1e-3                      # a visible offset
+    assert "own motions" in info["mean_drift"] and "moored pair" in info["mean_drift"]
+
+
+def test_errors():
+    """A database without Kochin functions: model_mean_drift says how to make them; one of the two
+    variables alone, or directions not uniform, are refused by the database check (every reader);
+    [hydro.bem] drift accepts "kochin"."""
+    from hydro.database import from_capytaine, validate
+    from mfm.io.bemgen import DRIFTS
+
+    sphere = mfm.load(Path(__file__).resolve().parents[1] / "configs" / "sphere.toml")
+    with pytest.raises(ValueError, match='drift = "kochin"'):
+        model_mean_drift(sphere)
+    ds, _ = _check()
+    db = from_capytaine(ds)
+    with pytest.raises(ValueError, match="'kochin_diffraction' without 'kochin_radiation'"):
+        validate(db.drop_vars("kochin_radiation"), warn=False)
+    bent = db.assign_coords(theta=db["theta"].values ** 1.01)
+    with pytest.raises(ValueError, match="uniform directions"):
+        validate(bent, warn=False)
+    assert "kochin" in DRIFTS
