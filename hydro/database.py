@@ -360,6 +360,7 @@ KNOWN_DATA_ISSUES = {
     # coupling at 1.257 rad/s, unconverged at the mesh used (the symmetric part is what every
     # computation uses); a finer mesh is a BEM re-solve of the 12-WEC platform, ~hours
     "wu_yuan_m1.nc": {("radiation_damping", "wec2__Surge", "wec2__Pitch"): 0.12},
+    "wu_yuan_m1_drift.nc": {("radiation_damping", "wec2__Surge", "wec2__Pitch"): 0.12},
     "wu_yuan_m1_td.nc": {("radiation_damping", "wec6__Surge", "wec6__Pitch"): 0.06},
     "wu_yuan_m2.nc": {("radiation_damping", "wec11__Sway", "wec11__Roll"): 0.12},
     "wu_yuan_m3.nc": {("radiation_damping", "wec6__Sway", "wec6__Roll"): 0.12},

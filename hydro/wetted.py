@@ -56,11 +56,25 @@ class WaveField(eqx.Module):
     water_depth: float = eqx.field(static=True, default=math.inf)
 
     @classmethod
-    def of(cls, components) -> "WaveField":
-        """The field of :class:`hydro.waves.WaveComponents` (no ramp)."""
-        f = lambda a: jnp.asarray(np.asarray(a, dtype=float))  # noqa: E731
-        return cls(f(components.amplitude), f(components.omega), f(components.wavenumber),
-                   f(components.heading), f(components.phase), float(components.water_depth))
+    def of(cls, components, pad_to: int | None = None, g: float | None = None) -> "WaveField":
+        """The field of :class:`hydro.waves.WaveComponents` (no ramp). ``pad_to``: that many
+        components, the ones beyond the sea's of zero amplitude at ω = 1 rad/s (its wavenumber at
+        the depth and ``g``, default the components' g: finite and positive, so every depth decay
+        stays finite and every term a padded component adds is 0 · finite = 0 exactly): one
+        structure for the cases of a batch whose seas have fewer components than its most."""
+        cols = [np.asarray(getattr(components, k), dtype=float)
+                for k in ("amplitude", "omega", "wavenumber", "heading", "phase")]
+        n = len(cols[0])
+        if pad_to is not None and pad_to != n:
+            from .waves import wavenumber
+
+            if pad_to < n:
+                raise ValueError(f"pad_to = {pad_to}: fewer than the sea's {n} components")
+            g = float(getattr(components, "g", 9.81) if g is None else g)
+            k1 = float(wavenumber(1.0, float(components.water_depth), g))
+            fill = (0.0, 1.0, k1, 0.0, 0.0)
+            cols = [np.concatenate([c, np.full(pad_to - n, v)]) for c, v in zip(cols, fill)]
+        return cls(*(jnp.asarray(c) for c in cols), float(components.water_depth))
 
 
 def still_water() -> WaveField:

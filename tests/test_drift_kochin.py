@@ -167,3 +167,29 @@ def test_errors():
     with pytest.raises(ValueError, match="uniform directions"):
         validate(bent, warn=False)
     assert "kochin" in DRIFTS
+
+
+def test_wu_yuan_severe_sea_mean_offset_and_line_tensions():
+    """Wu & Yuan model 1 with its hinges locked (the seed's severe sea, H 8.1 m, T 11.4 s, head
+    seas), its database's Kochin functions (configs/wu_yuan_m1_drift.toml): the mean drift of the
+    moored platform's own motions pushes it down-wave (+x); at the mean position the lines' total
+    horizontal pull has changed by minus the drift force (the horizontal balance: nothing else
+    acts horizontally at rest; 1e-6 of the force, Newton's tolerance), the up-wave lines (anchors
+    at −x) take more tension and the down-wave ones less; mfm.studies.wu_yuan.mean_offset names the
+    drift it took."""
+    from mfm.studies.wu_yuan import mean_offset
+
+    ds = mean_offset(1, locked=True)
+    F = ds["drift_force"].values
+    assert F[0] > 0 and abs(F[1]) < 1e-6 * F[0]           # head seas, a layout symmetric in y
+    surge = ds["q_mean"].sel(coordinate="platform.surge") - ds["q_rest"].sel(
+        coordinate="platform.surge")
+    assert float(surge) > 0
+    change = ds["mooring_force_mean"].values - ds["mooring_force_rest"].values
+    np.testing.assert_allclose(change, -F[:2], rtol=0, atol=1e-6 * F[0])
+    print(f"drift {F[0] / 1e3:.1f} kN, offset {float(surge):.3f} m; tensions "
+          f"{np.round(ds['tension_rest'].values / 1e3, 1)} -> "
+          f"{np.round(ds['tension_mean'].values / 1e3, 1)} kN")
+    dT = ds["tension_mean"].values - ds["tension_rest"].values
+    assert dT.max() > 0 > dT.min()
+    assert "own motions" in ds.attrs["mean_drift"]

@@ -9,6 +9,7 @@ all call these: one place where loads meet the equations of motion, as Bᵀ body
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Sequence
 
 import equinox as eqx
@@ -141,9 +142,13 @@ def carried_loads_batch(model, seas, *, dts, ramps, n_steps: int, t0=0.0, radiat
             added_mass=added_mass, stage_offsets=tuple(float(o) for o in stage_offsets))
         out.append(water)
         batched.append(mask)
+    # the most components of any case's sea: loads that read them pad theirs to it (one structure)
+    n_c = max((0 if sea is None else len(sea.components(
+        water_depth=model.hydro.water_depth if model.hydro is not None else math.inf).omega)
+        for sea in seas), default=0)
     for ld in tuple(model.loads) + tuple(extra):
         laid = [laid_on(model, (ld,), RunGrid(sea, float(t0), float(dt), int(n_steps), float(ramp),
-                                              tuple(float(o) for o in stage_offsets)))[0]
+                                              tuple(float(o) for o in stage_offsets), n_c))[0]
                 for sea, dt, ramp in zip(seas, dts, ramps)]
         ld_out, mask = stack_cases(ld, laid)
         out.append(ld_out)
@@ -173,9 +178,9 @@ def stack_cases(load: Load, laid: Sequence[Load]) -> tuple[Load, object]:
             raise ValueError(f"load {type(load).__name__}: its for_run gives the cases arrays of "
                              f"different shapes ({sorted({np.shape(lv[j]) for lv in leaves})}); a "
                              "batch stacks them on one case axis (give the cases one dt and "
-                             "duration, and for a load that reads the sea's components, such as "
-                             "[[morison]], seas of as many components, e.g. all regular; or run "
-                             "them apart with mfm.simulate)")
+                             "duration; a load that reads the sea's components pads them to "
+                             "RunGrid.n_components, as [[morison]] does; or run them apart with "
+                             "mfm.simulate)")
         return any(not np.array_equal(np.asarray(lv[j]), a0) for lv in leaves[1:])
 
     flags = [differs(j) for j in range(len(leaves[0]))]

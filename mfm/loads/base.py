@@ -93,13 +93,17 @@ class RunGrid(NamedTuple):
     None for still water), the start ``t0`` (s), the step ``dt`` (s), ``n_steps``, the wave ramp
     ``ramp`` (s) and the integrator's ``stage_offsets`` (the fractions of dt at which it evaluates
     the loads; a table laid on t0 + (j + c) dt for each offset c is read without interpolation
-    error at every stage)."""
+    error at every stage). ``n_components``: in a batch (:func:`mfm.simulate_batch`), the most
+    components of any case's sea: a load that reads the sea's components pads its own to this many
+    with zero amplitudes (:meth:`hydro.wetted.WaveField.of`), so that the cases stack on one axis;
+    None in a single run."""
     sea: Any
     t0: float
     dt: float
     n_steps: int
     ramp: float
     stage_offsets: tuple
+    n_components: int | None = None
 
 
 class LinearHydro(NamedTuple):

@@ -44,10 +44,10 @@ amplitude has no sea to linearise on: with C_D ≠ 0 it is the inertia part alon
 stochastically on the relative normal flow of each sea, per point (:meth:`quadratic_drag`,
 :mod:`mfm.frequency.drag`: ½ ρ C_D A |w_n| w_n ≈ C w_n, C = ½ ρ C_D A E[|w| I + w wᵀ/|w|] of the
 Gaussian w_n, iterated to a fixed point): damping C on the point's normal velocity, excitation C
-û_n. The linear level (:func:`mfm.linear_response`) still refuses it (no time-domain realisation
-there): use :func:`mfm.simulate`.
-``simulate_batch`` takes it for seas of as many components (their wave arrays stack on the case
-axis; others are refused by :func:`mfm.loads.assembly.stack_cases`).
+û_n. The linear level (:func:`mfm.linear_response`) takes the same: the inertia's wave force
+synthesised from :meth:`frequency_terms` at the sea's components, the drag linearised.
+``simulate_batch`` takes it for any seas: each case's wave arrays padded to the batch's most
+components with zero amplitudes (``RunGrid.n_components``), stacked on the case axis.
 
 Outputs (dims ``morison_element``, ``axis``): ``morison_force`` the force on each element (its
 segments summed), inertial axes (N), the added-mass term included.
@@ -72,6 +72,15 @@ from .base import FrequencyTerms, Load, LoadOutput, QuadraticDrag
 
 KEYS = {"name", "body", "point", "from", "to", "segments", "cd", "diameter", "area", "ca",
         "volume", "notes"}
+
+
+def _no_components(spec):
+    """Still water as wave components (none), at the water's depth and g: a batch's still-water
+    case, padded like the others."""
+    from hydro.waves import WaveComponents
+
+    z = np.zeros(0)
+    return WaveComponents(z, z, z, z, z, water_depth=float(spec.water_depth), g=float(spec.g))
 
 
 def _safe_norm(x):
@@ -170,8 +179,13 @@ class MorisonElements(Load):
         from hydro.wetted import WaveField, still
 
         spec = model.hydro
-        wave = still(self.wave) if run.sea is None else WaveField.of(
-            run.sea.components(water_depth=spec.water_depth, g=spec.g))
+        if run.sea is None and run.n_components is None:
+            wave = still(self.wave)
+        else:
+            # a batch's case: padded to the batch's most components (still water: all padding)
+            comps = (run.sea.components(water_depth=spec.water_depth, g=spec.g)
+                     if run.sea is not None else _no_components(spec))
+            wave = WaveField.of(comps, pad_to=run.n_components, g=spec.g)
         return dataclasses.replace(self, wave=wave, ramp=device_array(float(run.ramp)))
 
     def static_load(self):

@@ -170,7 +170,7 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
         different numbers of components share one structure (the shorter padded with
         zero-amplitude components), above linear too: the nonlinear level's hulls, drag on the
         relative flow and the wave drift take each case's own components (docs/nonlinear.md,
-        Batches); ``[[morison]]`` elements need seas of as many components.
+        Batches), and ``[[morison]]`` elements.
     dt, ramp: s, a number or one per case. Every case runs ``n_steps`` steps (so a sweep at
         dt = T_p/200 over 100 T_p is one shape: 20,000 steps).
     radiation: "state_space" (default; its arrays have one shape whatever dt), "none", or

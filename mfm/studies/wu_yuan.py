@@ -83,24 +83,88 @@ def lone_headings(heading_deg: float = 0.0) -> dict[str, float]:
 
 
 @functools.lru_cache(maxsize=None)
-def platform_model(m: int, locked: bool = False):
+def platform_model(m: int, locked: bool = False, drift: bool = False):
     """Model ``m`` (1–5) of the platform: configs/wu_yuan_m<m>.toml, or with ``locked`` its
     severe-sea variant (every hinge locked: no PTO, no preload; 6 coordinates), written by
     :func:`mfm.studies.wu_yuan_layout.config_text` into a temporary file that reads the same
-    database. Loaded once per process (a model keeps its compiled linearisation: a second study
-    of it is cheap)."""
+    database. ``drift``: the mean-drift twin (configs/wu_yuan_m<m>_drift.toml: the database with
+    the layout's Kochin functions, models in ``layout.DRIFT_MODELS``), locked or not. Loaded once
+    per process (a model keeps its compiled linearisation: a second study of it is cheap)."""
     if m not in (1, 2, 3, 4, 5):
         raise ValueError(f"m: {m!r}; the seed's models are 1, 2, 3, 4, 5")
+    if drift and m not in layout.DRIFT_MODELS:
+        raise ValueError(f"m: {m!r} with drift: the models with a Kochin-function database are "
+                         f"{list(layout.DRIFT_MODELS)} (configs/wu_yuan_m<m>_drift.toml)")
+    name = f"wu_yuan_m{m}_drift" if drift else f"wu_yuan_m{m}"
     if not locked:
-        return load(ROOT / "configs" / f"wu_yuan_m{m}.toml")
-    text = layout.config_text(m, locked=True)
-    rel = f'"../hydro/data/wu_yuan_m{m}.nc"'
+        return load(ROOT / "configs" / f"{name}.toml")
+    text = layout.config_text(m, locked=True, drift=drift)
+    rel = f'"../hydro/data/{name}.nc"'
     if rel not in text:
         raise RuntimeError(f"mfm.studies.wu_yuan_layout no longer names the database as {rel}")
-    text = text.replace(rel, '"' + (ROOT / "hydro" / "data" / f"wu_yuan_m{m}.nc").as_posix() + '"')
-    path = Path(tempfile.mkdtemp(prefix="wu_yuan_locked_")) / f"wu_yuan_m{m}_locked.toml"
+    text = text.replace(rel, '"' + (ROOT / "hydro" / "data" / f"{name}.nc").as_posix() + '"')
+    path = Path(tempfile.mkdtemp(prefix="wu_yuan_locked_")) / f"{name}_locked.toml"
     path.write_text(text)
     return load(path)
+
+
+def mean_offset(m: int = 1, sea=None, *, locked: bool = True) -> xr.Dataset:
+    """The platform's mean position and its catenary lines' tensions in a sea, against still
+    water (issue 53 item 3): :func:`mfm.equilibrium` with and without ``sea`` on the mean-drift
+    twin of model ``m`` (its database's Kochin functions: the far-field drift of the model's own
+    motions, the layout's total on the platform, :mod:`mfm.frequency.drift`).
+
+    sea: default the seed's severe regular wave (H 8.1 m, T 11.4 s, head seas); locked: every
+    hinge locked (the seed's severe-sea state; False: the WECs working on their PTOs).
+    Returns a Dataset: ``q_rest``, ``q_mean`` (coordinate) the equilibria (m, rad),
+    ``tension_rest``, ``tension_mean`` (line) each line's fairlead tension √(H² + V²) (N),
+    ``mooring_force_rest``, ``mooring_force_mean`` (axis: x, y) the lines' total horizontal force
+    on the platform (N), ``drift_force`` (component: surge, sway, yaw) the mean drift on the platform (N, N m), and
+    attributes naming the drift taken."""
+    import hydro
+    from ..frequency.drift import model_mean_drift
+    from ..frequency.rest import system_loads
+    from ..loads.catenary import CatenaryLines
+    from ..mechanics.kinematics import kinematics
+    from ..runner.frequency import equilibrium
+
+    sea = hydro.Regular(height=SEVERE[0], period=SEVERE[1]) if sea is None else sea
+    model = platform_model(m, locked=locked, drift=True)
+    lines = next(ld for ld in system_loads(model) if isinstance(ld, CatenaryLines))
+    zero = np.zeros(model.n_coordinates)
+
+    def tension(q):
+        H, V, _ = lines.tensions(lines.fairleads.positions(kinematics(model, q, zero)))
+        return np.hypot(np.asarray(H), np.asarray(V))
+
+    def pull(q):
+        # the lines' total horizontal force on the platform (x, y)
+        f = lines.fairlead_forces(lines.fairleads.positions(kinematics(model, q, zero)))
+        return np.asarray(f)[:, :2].sum(axis=0)
+
+    rest, _ = equilibrium(model)
+    mean, info = equilibrium(model, q_guess=rest, sea=sea)
+    table = model_mean_drift(model, q0=rest)
+    comps = sea.components(water_depth=model.hydro.water_depth, g=model.hydro.g)
+    from hydro.drift import mean_drift_of
+
+    F = mean_drift_of(xr.Dataset({"mean_drift": table}), comps)
+    root = table.attrs["dofs"].split(", ")
+    return xr.Dataset(
+        {"q_rest": (("coordinate",), rest, {"units": "m or rad"}),
+         "q_mean": (("coordinate",), mean, {"units": "m or rad",
+                                            "long_name": "mean position in the sea"}),
+         "tension_rest": (("line",), tension(rest), {"units": "N"}),
+         "tension_mean": (("line",), tension(mean), {"units": "N"}),
+         "mooring_force_rest": (("axis",), pull(rest), {"units": "N", "long_name": "the lines' "
+                                                        "total horizontal force on the platform"}),
+         "mooring_force_mean": (("axis",), pull(mean), {"units": "N"}),
+         "drift_force": (("component",), [F[list(table["influenced_dof"].values).index(d)]
+                                          for d in root], {"units": "N, N, N m"})},
+        coords={"coordinate": list(model.coordinates), "line": list(lines.names),
+                "component": ["surge", "sway", "yaw"], "axis": ["x", "y"]},
+        attrs={"model": model.name, "sea": repr(sea), "mean_drift": info["mean_drift"],
+               "locked": str(bool(locked))})
 
 
 @functools.lru_cache(maxsize=1)

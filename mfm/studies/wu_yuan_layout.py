@@ -393,9 +393,21 @@ value = {value}   # N m [D]: holds the 2 m draft (positive lifts the WEC)
 """
 
 
-def config_text(m: int, td: bool = False, locked: bool = False) -> str:
+DRIFT_MODELS = (1,)         # the models with a Kochin-function twin (wu_yuan_m<m>_drift.toml)
+DRIFT_NOTE = """\
+# MEAN-DRIFT TWIN: model {m} with its database made again with the layout's Kochin functions
+#   ([hydro.bem] drift = "kochin": the same hulls, frequencies and solve as wu_yuan_m{m}.nc, plus the
+#   far field of the diffraction and of every dof's radiation on 180 directions), from which
+#   mfm.equilibrium(model, sea=...) takes the mean wave drift of the model's own motions
+#   (mfm.frequency.drift; docs/nonlinear.md, "Mean wave drift").
+"""
+
+
+def config_text(m: int, td: bool = False, locked: bool = False, drift: bool = False) -> str:
     """The config of model m; ``td``: its time-domain twin (same bodies and loads, the band
-    database ``wu_yuan_m<m>_td.nc``); ``locked``: the severe-sea variant (seed §4.3: every hinge
+    database ``wu_yuan_m<m>_td.nc``); ``drift``: its mean-drift twin (the same, its database
+    ``wu_yuan_m<m>_drift.nc`` made with the Kochin functions as well: ``[hydro.bem] drift =
+    "kochin"``); ``locked``: the severe-sea variant (seed §4.3: every hinge
     locked, so no PTO damper and no preload: each WEC rigid on the platform at its design
     position, the platform carrying its excess weight). Not written to configs/ (the same hulls
     and database as model m): :func:`mfm.studies.wu_yuan.platform_model` ``(m, locked=True)``
@@ -413,9 +425,25 @@ def config_text(m: int, td: bool = False, locked: bool = False) -> str:
                   n_w=TD_BAND[2], w_2=TD_BAND[0] + TD_STEP, dw=TD_STEP, tk=math.pi / TD_STEP)
     parts = [(HEADER + (BEM_NOTE_TD + TABLES_TD if td else BEM_NOTE_FD + TABLES_FD)
               + PLATFORM).format(**values)]
+    if drift:
+        if td:
+            raise ValueError("config_text: td and drift together; the drift twin is of the "
+                             "frequency-domain database")
+        fd_db = f"wu_yuan_m{m}.nc"
+        text = parts[0].replace(f'"../hydro/data/{fd_db}"   # made by `mfm hydro configs/'
+                                f'wu_yuan_m{m}.toml', f'"../hydro/data/wu_yuan_m{m}_drift.nc"   '
+                                f'# made by `mfm hydro configs/wu_yuan_m{m}_drift.toml', 1)
+        text = text.replace("infinite_frequency = true\n", "infinite_frequency = true\n"
+                            "drift = \"kochin\"            # the layout's Kochin functions [D]\n", 1)
+        text = text.replace(f'name = "Wu-Yuan model {m}"', f'name = "Wu-Yuan model {m} (drift)"',
+                            1)
+        if text.count("_drift") != 2 or 'drift = "kochin"' not in text:
+            raise RuntimeError("config_text: the FD template no longer has the lines the drift "
+                               "twin edits")
+        parts[0] = DRIFT_NOTE.format(m=m) + text
     if locked:
-        parts[0] = LOCKED_NOTE + parts[0].replace(f'name = "Wu-Yuan model {m}"',
-                                                  f'name = "Wu-Yuan model {m}, hinges locked"', 1)
+        parts[0] = LOCKED_NOTE + parts[0].replace(f'name = "Wu-Yuan model {m}',
+                                                  f'name = "Wu-Yuan model {m}, hinges locked', 1)
     notes = {"column1": "apex column on +x", "column2": "column at +120°", "column3": "column at −120°"}
     for name, c in columns():
         parts.append(COLUMN.format(name=name, notes=notes[name], com=vec([c[0], c[1], -9.68]),
@@ -547,6 +575,8 @@ def outputs(root=ROOT) -> dict:
     out = {root / "configs" / f"wu_yuan_m{m}.toml": config_text(m) for m in range(1, 6)}
     out.update({root / "configs" / f"wu_yuan_m{m}_td.toml": config_text(m, td=True)
                 for m in TD_MODELS})
+    out.update({root / "configs" / f"wu_yuan_m{m}_drift.toml": config_text(m, drift=True)
+                for m in DRIFT_MODELS})
     out[root / "configs" / "wu_yuan_wec.toml"] = wec_config_text()
     return out
 
