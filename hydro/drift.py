@@ -55,7 +55,9 @@ class DriftTable:
                 "the hydro database has no 'mean_drift' (the mean drift force per unit wave "
                 "amplitude squared); make it with `mfm hydro` and [hydro.bem] drift = \"free\" or "
                 "\"fixed\" (one wet body), or read WAMIT output with its .8/.9 beside the .out; "
-                "or leave [hydro] drift unset")
+                "a database with the layout's Kochin functions ([hydro.bem] drift = \"kochin\") "
+                "gives the drift of the model's own motions to mfm.simulate, simulate_batch and "
+                "mfm.equilibrium; or leave [hydro] drift unset")
         da = db["mean_drift"].transpose("omega", "wave_direction", "influenced_dof")
         da = da.sortby("omega").sortby("wave_direction")
         if dofs is not None:

@@ -122,23 +122,55 @@ def test_the_total_is_put_on_the_root_body_with_its_yaw_moved():
                   .values == 0)
 
 
+def _moored_pair(k=5.0e3, **hydro_keys):
+    """B welded to A, A moored in surge by a spring k (and a damper) and free in heave and pitch:
+    the layout moves as one body."""
+    return mfm.load({
+        "model": {"name": "moored pair", "gravity": 9.81},
+        "bodies": [{"name": "A", "mass": MASS, "com": [0.0, 0.0, -0.9],
+                    "principal_inertia": [3000.0, 4500.0, 2400.0],
+                    "joint": {"type": "free", "dofs": ["surge", "heave", "pitch"],
+                              "stiffness": [k, 0.0, 0.0], "damping": [1.0e4, 0.0, 0.0]}},
+                   {"name": "B", "parent": "A", "mass": MASS, "com": [3.0, 1.5, -0.9],
+                    "principal_inertia": [3500.0, 3500.0, 2000.0], "joint": {"type": "fixed"}}],
+        "hydro": {"database": str(CHECK), **hydro_keys}})
+
+
+def test_the_time_domain_takes_the_drift_of_the_model_s_own_motions():
+    """[hydro] drift = "mean" on the Kochin database (no mean_drift in it; the config is
+    accepted): mfm.simulate records the drift force D a² r(t) on A's surge with D the model's own
+    (model_mean_drift at the wave's ω, on the grid) at every sample, to round-off, and 0 on B's
+    rows; simulate_batch of two heights records each case's the same (1e-12)."""
+    model = _moored_pair(drift="mean")
+    a, w = 0.1, 2.2
+    D = model_mean_drift(model).sel(omega=w, wave_direction=0.0)
+    sea = hydro.Regular(height=2 * a, period=2 * math.pi / w)
+    run = dict(dt=0.05, ramp=2.0, radiation="none")          # 3 frequencies: no fit
+    ds = mfm.simulate(model, sea, duration=4.0, check_stability=False, **run)
+    t = ds["time"].values
+    F = ds["drift_force"]
+    r = hydro.waves.ramp(t, 2.0)
+    expect = float(D.sel(influenced_dof="A__Surge")) * a * a * r
+    np.testing.assert_allclose(F.sel(hydro_dof="A__Surge").values, expect, rtol=1e-12,
+                               atol=1e-12 * abs(expect).max())
+    assert np.all(F.sel(hydro_dof=[d for d in F["hydro_dof"].values if d.startswith("B__")])
+                  .values == 0)
+    b = mfm.simulate_batch(model, [sea, hydro.Regular(height=a, period=2 * math.pi / w)],
+                           n_steps=80, outputs=("drift_force",), **run)
+    got = b["drift_force"].sel(hydro_dof="A__Surge").values
+    np.testing.assert_allclose(got[0], expect[:got.shape[1]], rtol=0,
+                               atol=1e-12 * abs(expect).max())
+    np.testing.assert_allclose(got[1], expect[:got.shape[1]] / 4, rtol=0,
+                               atol=1e-12 * abs(expect).max())
+
+
 def test_the_mean_offset_of_a_moored_layout():
-    """B welded to A, A moored in surge by a spring k and free in heave and pitch (the layout
-    moves as one body): mfm.equilibrium(model, sea=Regular) takes the drift of the model's own
+    """The moored pair (B welded to A, A on a surge spring k): mfm.equilibrium(model, sea=Regular) takes the drift of the model's own
     motions (the database has Kochin functions and no mean_drift) and the surge offset is
     F_x a²/k of model_mean_drift's table at the wave's frequency and heading (1e-9: Newton's
     tolerance); info says which drift; without the sea the layout stays at rest."""
     k = 5.0e3
-    cfg = {"model": {"name": "moored pair", "gravity": 9.81},
-           "bodies": [{"name": "A", "mass": MASS, "com": [0.0, 0.0, -0.9],
-                       "principal_inertia": [3000.0, 4500.0, 2400.0],
-                       "joint": {"type": "free", "dofs": ["surge", "heave", "pitch"],
-                                 "stiffness": [k, 0.0, 0.0]}},
-                      {"name": "B", "parent": "A", "mass": MASS, "com": [3.0, 1.5, -0.9],
-                       "principal_inertia": [3500.0, 3500.0, 2000.0],
-                       "joint": {"type": "fixed"}}],
-           "hydro": {"database": str(CHECK)}}
-    model = mfm.load(cfg)
+    model = _moored_pair(k)
     rest, _ = mfm.equilibrium(model)
     a, w = 0.1, 2.2
     q0, info = mfm.equilibrium(model, sea=hydro.Regular(height=2 * a, period=2 * math.pi / w))

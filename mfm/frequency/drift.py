@@ -127,3 +127,14 @@ def model_mean_drift(model: Model, *, q0=None, loads=None) -> xr.DataArray:
                "dofs": ", ".join(f"{root_name}__{m}" for m in ("Surge", "Sway", "Yaw")),
                "applied_on": f"{root_name}: the layout's total (the far field gives no body's "
                              "share)"})
+
+
+def run_mean_drift(model: Model):
+    """The drift table a run of ``model`` takes for ``[hydro] drift``: the drift of its own
+    motions (:func:`model_mean_drift`, about the still-water equilibrium) where its database has
+    the Kochin functions, else None (the database's ``mean_drift``)."""
+    from ..loads.water import wave_drift
+
+    if model.hydro is None or not wave_drift(model.hydro) or not has_kochin(model):
+        return None
+    return model_mean_drift(model)

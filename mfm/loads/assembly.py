@@ -29,12 +29,13 @@ RK4_STAGE_OFFSETS = (0.0, 0.5, 1.0)
 
 def carried_loads(model, sea=None, *, dt, duration, t0=0.0, ramp=0.0, radiation="convolution",
                   memory=None, state_space_options=None, added_mass="lhs",
-                  stage_offsets=RK4_STAGE_OFFSETS, extra=()) -> tuple[Load, ...]:
+                  stage_offsets=RK4_STAGE_OFFSETS, extra=(), mean_drift=None) -> tuple[Load, ...]:
     """The loads of a run: with a [hydro] config the model's water for this sea and time grid
     (:func:`mfm.loads.water.build_water`, prepared for an integrator's ``stage_offsets``), then
     the config's loads (``model.loads``: moorings, PTOs, …) and the ``extra`` loads of a front
     door, each laid on the run by its :meth:`~mfm.loads.base.Load.for_run`. The time domain's
-    :func:`mfm.timedomain.setup.model_loads` names the integrator instead of its offsets."""
+    :func:`mfm.timedomain.setup.model_loads` names the integrator instead of its offsets.
+    ``mean_drift``: the water's drift table in place of its database's (:func:`build_water`)."""
     out = []
     run = run_grid(sea, dt=dt, duration=duration, t0=t0, ramp=ramp, stage_offsets=stage_offsets)
     if model.hydro is not None:
@@ -42,7 +43,7 @@ def carried_loads(model, sea=None, *, dt, duration, t0=0.0, ramp=0.0, radiation=
         out.append(build_water(model, model.hydro, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                                radiation=radiation, memory=memory,
                                state_space_options=state_space_options, added_mass=added_mass,
-                               stage_offsets=run.stage_offsets))
+                               stage_offsets=run.stage_offsets, mean_drift=mean_drift))
     return tuple(out) + laid_on(model, tuple(model.loads) + tuple(extra), run)
 
 
@@ -125,7 +126,7 @@ class CaseLoads:
 
 def carried_loads_batch(model, seas, *, dts, ramps, n_steps: int, t0=0.0, radiation="convolution",
                         memory=None, state_space_options=None, added_mass="lhs",
-                        stage_offsets=RK4_STAGE_OFFSETS, extra=()) -> CaseLoads:
+                        stage_offsets=RK4_STAGE_OFFSETS, extra=(), mean_drift=None) -> CaseLoads:
     """:func:`carried_loads` of B cases of one model at once (case b: ``seas[b]``, ``dts[b]``,
     ``ramps[b]``, ``n_steps`` steps): its water by :func:`mfm.loads.water.build_water_batch`
     (what the cases share made once, what differs vectorised, the tables left to the device),
@@ -139,7 +140,8 @@ def carried_loads_batch(model, seas, *, dts, ramps, n_steps: int, t0=0.0, radiat
         water, mask, waves, polar = build_water_batch(
             model, model.hydro, seas, dts=dts, ramps=ramps, n_steps=n_steps, t0=t0,
             radiation=radiation, memory=memory, state_space_options=state_space_options,
-            added_mass=added_mass, stage_offsets=tuple(float(o) for o in stage_offsets))
+            added_mass=added_mass, stage_offsets=tuple(float(o) for o in stage_offsets),
+            mean_drift=mean_drift)
         out.append(water)
         batched.append(mask)
     # the most components of any case's sea: loads that read them pad theirs to it (one structure)

@@ -523,7 +523,7 @@ class Water(Load):
 def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0,
                 ramp: float = 0.0, radiation: str = "convolution", memory: float | None = None,
                 state_space_options: dict | None = None, added_mass: str = "lhs",
-                stage_offsets=(0.0, 0.5, 1.0)) -> Water:
+                stage_offsets=(0.0, 0.5, 1.0), mean_drift=None) -> Water:
     """The :class:`Water` load of ``model`` for one sea state and time grid.
 
     sea: a ``hydro.waves`` sea state (Regular, Jonswap, …) or None for still water.
@@ -531,6 +531,9 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
     (the passive fit of hydro.statespace; its corrected A∞), or "none" (A∞ only).
     stage_offsets: the integrator's stage times as fractions of dt (RK4: 0, ½, 1): the excitation
     is tabulated so that each stage falls on a sample, and the convolution has weights per stage.
+    mean_drift: with ``[hydro] drift``, a table D (omega, wave_direction, influenced_dof) in place
+    of the database's ``mean_drift`` (the drift of the model's own motions,
+    :func:`mfm.frequency.drift.run_mean_drift`).
     """
     from hydro.excitation import excitation_time_series
     from hydro.waves import elevation
@@ -567,8 +570,11 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
     if wave_drift(spec):
         from hydro.drift import drift_time_series
 
-        drift = _f64(drift_time_series(spec.database(), comps, t_grid, mode=spec.drift,
-                                      reference_points=spec.ref0, ramp_duration=ramp))
+        # still water (the linearisation's loads, a decay) has no drift: no table read
+        drift = _f64(np.zeros((len(t_grid), len(spec.dofs))) if comps is None else
+                     drift_time_series(_drift_source(spec, mean_drift), comps, t_grid,
+                                       mode=spec.drift, reference_points=spec.ref0,
+                                       ramp_duration=ramp))
     return Water(geometry=geometry, A_inf=_f64(rad.added_mass_inf(spec)), C_wp=_f64(C_wp),
                  buoyancy=_f64(buoyancy), d_cob=_f64(spec.d_cob),
                  drag=_f64(spec.drag), exc_t0=_f64(t0), exc_step=_f64(step),
@@ -600,15 +606,29 @@ def relative_drag(spec) -> bool:
     return getattr(spec, "drag_flow", "body") == "relative"
 
 
-def require_mean_drift(db, path, what: str, *, error=ValueError, fix: str = "") -> None:
+def _drift_source(spec, mean_drift=None):
+    """What the drift is read from: the database, or a dataset of the table ``mean_drift``."""
+    if mean_drift is None:
+        return spec.database()
+    import xarray as xr
+
+    return xr.Dataset({"mean_drift": mean_drift})
+
+
+def require_mean_drift(db, path, what: str, *, error=ValueError, fix: str = "",
+                       kochin: bool = False) -> None:
     """Refuse a database without ``mean_drift`` for ``what`` (one check behind the config's
-    ``[hydro] drift`` and the equilibrium in a sea), naming the file and how to make one."""
+    ``[hydro] drift`` and the equilibrium in a sea), naming the file and how to make one.
+    ``kochin``: a database with the layout's Kochin functions will do (the drift of the model's
+    own motions is made from them, :mod:`mfm.frequency.drift`)."""
+    if kochin and "kochin_diffraction" in db and "kochin_radiation" in db:
+        return
     if "mean_drift" not in db:
         raise error(
             f"{what} needs the database's mean_drift (the mean drift force per unit wave amplitude "
             f"squared), which {str(path)!r} does not have: make it with `mfm hydro` and "
-            "[hydro.bem] drift = \"free\" (one wet body), or give WAMIT output with its .8/.9 "
-            f"files{fix}")
+            "[hydro.bem] drift = \"free\" (one wet body) or \"kochin\" (a layout: the drift of "
+            f"the model's own motions), or give WAMIT output with its .8/.9 files{fix}")
 
 
 def wave_drift(spec) -> bool:
@@ -820,7 +840,7 @@ class WaveSum(eqx.Module):
 def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float = 0.0,
                       radiation: str = "convolution", memory: float | None = None,
                       state_space_options: dict | None = None, added_mass: str = "lhs",
-                      stage_offsets=(0.0, 0.5, 1.0)):
+                      stage_offsets=(0.0, 0.5, 1.0), mean_drift=None):
     """The :class:`Water` of B cases at once (a batch's seas, time steps and ramps, each run
     ``n_steps`` steps): ``(water, batched, waves, polar)``. ``water`` is one Water whose fields
     that differ between the cases carry a leading case axis (``batched``: a pytree of bools like
@@ -884,7 +904,7 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
         arrays["active"][i, :n] = ~outside[j]
         for name, values in zip(("i0", "k0", "k1", "sw", "sb"), br):
             arrays[name][i, :n] = values[j]
-    above = _above_linear_batch(spec, comps, live, B, n_c, omega)
+    above = _above_linear_batch(spec, comps, live, B, n_c, omega, mean_drift)
     waves = WaveSum(omega=omega, **arrays, t0=np.full(B, float(t0)), step=steps.copy(),
                     ramp=ramps.copy(), n_grid=n_grid, one_heading=table.beta.shape[0] == 1,
                     **above["waves"])
@@ -924,7 +944,7 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
 FK_CHUNK = 64
 
 
-def _above_linear_batch(spec, comps, live, B: int, n_c: int, omega) -> dict:
+def _above_linear_batch(spec, comps, live, B: int, n_c: int, omega, mean_drift=None) -> dict:
     """What the above-linear options add to a batch (``comps``: the components of the cases
     ``live``, each padded to ``n_c`` with zero amplitudes, as :class:`WaveSum`'s; ``omega``
     (B, n_c) its frequencies, 1 rad/s on the padding): ``"waves"``, the :class:`WaveSum` fields
@@ -953,7 +973,7 @@ def _above_linear_batch(spec, comps, live, B: int, n_c: int, omega) -> dict:
             fk[i, :len(c.omega)] = X
         out["waves"].update(fk_re=fk.real.copy(), fk_im=fk.imag.copy())
     if wave_drift(spec):
-        out["waves"].update(_drift_coefficients(spec, comps, live, B, n_c))
+        out["waves"].update(_drift_coefficients(spec, comps, live, B, n_c, mean_drift))
     return out
 
 
@@ -989,14 +1009,19 @@ def drift_table(spec):
     return spec._cache["drift_table"]
 
 
-def _drift_coefficients(spec, comps, live, B: int, n_c: int) -> dict:
+def _drift_coefficients(spec, comps, live, B: int, n_c: int, mean_drift=None) -> dict:
     """The :class:`WaveSum` drift fields of the cases (:func:`hydro.drift.drift_time_series`'s
     terms, the same numpy per case; D_j at every case's components in one interpolation):
     "mean": Σ_j D_j a_j² (B, n_dof); "newman": c_j s_j √|D_j| and sgn D_j (B, n_c, n_dof), 0 on
     the padding (and for still water)."""
     import types
 
-    table = drift_table(spec)
+    if mean_drift is None:
+        table = drift_table(spec)
+    else:
+        from hydro.drift import DriftTable
+
+        table = DriftTable(_drift_source(spec, mean_drift))
     nd = len(table.labels)
     if nd != len(spec.dofs):
         raise ValueError(f"hydro.drift: the database's mean_drift has {nd} dofs "
@@ -1133,7 +1158,7 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
         spec.drag_flow = "relative"
     if options.get("drift", "off") != "off":
         require_mean_drift(db, path, f"hydro.drift: {options['drift']!r}", error=ConfigError,
-                           fix="; or remove hydro.drift")
+                           fix="; or remove hydro.drift", kochin=True)
         spec.drift = options["drift"]       # set only when asked (the spec's content key)
     return spec
 

@@ -14,6 +14,7 @@ import xarray as xr
 
 from .. import results
 from ..errors import SimulationError
+from ..frequency.drift import run_mean_drift
 from ..loads.assembly import (CaseLoads, as_loads, carried_loads_batch, compile_view,
                               initial_states)
 from ..validation import check_model, finite_number, initial_vector, whole_number
@@ -265,7 +266,8 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
                                     t0=t0, radiation=radiation, memory=memory,
                                     state_space_options=state_space_options,
                                     stage_offsets=stage_offsets(integ) if m0.hydro is not None
-                                    else declared_stage_offsets(integ), extra=extra)
+                                    else declared_stage_offsets(integ), extra=extra,
+                                    mean_drift=run_mean_drift(m0))
         model_view, loads_view = compile_view(m0, cases.loads)
         # the view blanks static fields only: its leaves are the loads' own, in the same order
         mask = jax.tree_util.tree_unflatten(jax.tree_util.tree_structure(loads_view),
@@ -289,11 +291,18 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
         model_axis = None
         loads = cases
     else:
+        drift_tables: dict = {}            # one per distinct model (the drift of its motions)
+
+        def run_mean_drift_of(m):
+            if id(m) not in drift_tables:
+                drift_tables[id(m)] = run_mean_drift(m)
+            return drift_tables[id(m)]
+
         loads = [model_loads(pick(models, i), pick(seas, i), dt=float(pick(dts, i)),
                              duration=n_steps * float(pick(dts, i)), t0=t0,
                              ramp=float(pick(ramps, i)), radiation=radiation, memory=memory,
                              state_space_options=state_space_options, integrator=integ,
-                             extra=extra)
+                             extra=extra, mean_drift=run_mean_drift_of(pick(models, i)))
                  for i in range(B)]
         if vary_loads is not None:
             if not callable(vary_loads):

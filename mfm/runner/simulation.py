@@ -14,6 +14,7 @@ from hydro import phases
 from .. import results
 from ..errors import SimulationError
 from ..frequency import rest
+from ..frequency.drift import run_mean_drift
 from ..loads.assembly import as_loads
 from ..mechanics.model import Model
 from ..radiation import resolve as resolve_radiation
@@ -168,10 +169,13 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                 radiation, how = state_space_update(model, dt=dt, integrator=integ,
                                                     state_space_options=state_space_options)
                 choice = f"{choice}; {how}"
+            # [hydro] drift on a database with the layout's Kochin functions: the drift of the
+            # model's own motions (mfm.frequency.drift), made once for the run
+            drift_table = run_mean_drift(model) if sea is not None else None
             loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                                 radiation=radiation, memory=memory,
                                 state_space_options=state_space_options, added_mass=added_mass,
-                                integrator=integ, extra=extra)
+                                integrator=integ, extra=extra, mean_drift=drift_table)
         # the recorded run (its programs: the whole run, or its start and chunks), compiled here:
         # beside the jet's compilation where the water builds faster than that (no fit), and
         # before the checks' warnings
@@ -201,7 +205,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                 phase(bar, "preparing the loads (the convolution)")
                 loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                                     radiation=radiation, memory=memory, added_mass=added_mass,
-                                    integrator=integ, extra=extra)
+                                    integrator=integ, extra=extra, mean_drift=drift_table)
                 phase(bar, "compiling")
                 run = prepare_run(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ,
                                   loads=loads, save_every=save_every, t0=t0, recording=OUTPUTS,

@@ -13,13 +13,13 @@ from ..validation import check_model
 
 def model_loads(model: Model, sea=None, *, dt, duration, t0=0.0, ramp=0.0,
                 radiation="convolution", memory=None, state_space_options=None,
-                added_mass="lhs", integrator="rk4", extra=()) -> tuple[Load, ...]:
+                added_mass="lhs", integrator="rk4", extra=(), mean_drift=None) -> tuple[Load, ...]:
     """The loads of a run, ready for :func:`~mfm.timedomain.rollout.rollout`: with a [hydro]
     config the model's water for this sea and time grid (:func:`mfm.loads.water.build_water`,
     prepared for the stage times of ``integrator``), then the config's loads (``model.loads``:
     moorings, PTOs, …) and the ``extra`` loads of a front door, each laid on the run
     (:meth:`~mfm.loads.base.Load.for_run`): :func:`mfm.loads.assembly.carried_loads` for this
-    integrator."""
+    integrator (``mean_drift``: the water's drift table in place of its database's)."""
     model = check_model(model)
     radiation, memory, state_space_options = resolve_radiation(radiation, memory,
                                                                state_space_options)
@@ -28,7 +28,7 @@ def model_loads(model: Model, sea=None, *, dt, duration, t0=0.0, ramp=0.0,
     return carried_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                          radiation=radiation, memory=memory,
                          state_space_options=state_space_options, added_mass=added_mass,
-                         stage_offsets=stages, extra=extra)
+                         stage_offsets=stages, extra=extra, mean_drift=mean_drift)
 
 
 def declared_stage_offsets(integrator) -> tuple:
