@@ -424,6 +424,18 @@ def gravity_stiffness(mass, com, reference_point, g):
     return C
 
 
+def _results_at(results, w):
+    """capytaine's results at the frequency ``w``: the radiation ones by radiating dof and the
+    diffraction ones by heading."""
+    import capytaine as cpt
+
+    rad = {str(r.radiating_dof): r for r in results
+           if isinstance(r.problem, cpt.RadiationProblem) and float(r.omega) == w}
+    dif = {float(r.wave_direction): r for r in results
+           if isinstance(r.problem, cpt.DiffractionProblem) and float(r.omega) == w}
+    return rad, dif
+
+
 def _far_field_drift(ds, results, directions, *, motions, inertia, reference_point, rho, g):
     """``mean_drift`` (omega, wave_direction, influenced_dof) of ONE body by capytaine 3.0's
     far-field formula (``capytaine.post_pro.far_field_mean_drift_force``: Maruo's momentum flux
@@ -453,10 +465,7 @@ def _far_field_drift(ds, results, directions, *, motions, inertia, reference_poi
     for iw, w in enumerate(om_all):
         if not np.isfinite(w):
             continue
-        rad = {str(r.radiating_dof): r for r in results
-               if isinstance(r.problem, cpt.RadiationProblem) and float(r.omega) == w}
-        dif = {float(r.wave_direction): r for r in results
-               if isinstance(r.problem, cpt.DiffractionProblem) and float(r.omega) == w}
+        rad, dif = _results_at(results, w)
         any_r = next(iter(dif.values()))
         h = float(any_r.water_depth)
         Hd = np.array([compute_kochin(dif[float(b)], theta) for b in directions])
@@ -503,7 +512,6 @@ def _kochin_functions(ds, results, directions, n_theta):
     ``post_pro.kochin.compute_kochin``, its normalisation) on θ_i = 2π i / n_theta: the far field
     of any motion ξ of the bodies is H_D + Σ_j ξ_j H_j (:func:`hydro.drift.far_field_drift`).
     NaN at ω = ∞."""
-    import capytaine as cpt
     from capytaine.post_pro.kochin import compute_kochin
 
     theta = 2 * np.pi * np.arange(n_theta) / n_theta
@@ -514,10 +522,7 @@ def _kochin_functions(ds, results, directions, n_theta):
     for iw, w in enumerate(om_all):
         if not np.isfinite(w):
             continue
-        rad = {str(r.radiating_dof): r for r in results
-               if isinstance(r.problem, cpt.RadiationProblem) and float(r.omega) == w}
-        dif = {float(r.wave_direction): r for r in results
-               if isinstance(r.problem, cpt.DiffractionProblem) and float(r.omega) == w}
+        rad, dif = _results_at(results, w)
         Hd[iw] = [compute_kochin(dif[float(b)], theta) for b in directions]
         Hr[iw] = [compute_kochin(rad[d], theta) for d in dofs]
     return theta, Hd, Hr

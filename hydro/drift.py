@@ -49,6 +49,18 @@ class DriftTable:
     """D(ω, β) (n_ω, n_β, n_dof) of a database sorted for interpolation, the heading grid closed
     around the circle where the database covers it (as :class:`hydro.excitation.ExcitationTable`)."""
 
+    @classmethod
+    def of_arrays(cls, omega, wave_direction, D, labels, attrs=None) -> "DriftTable":
+        """The table of D (n_ω, n_β, n_dof) on ``omega`` (rad/s) and ``wave_direction`` (rad)
+        for the dofs ``labels``, without a dataset (the drift of a model's own motions,
+        mfm.frequency.drift)."""
+        da = xr.DataArray(np.asarray(D, float), dims=("omega", "wave_direction", "influenced_dof"),
+                          coords={"omega": np.asarray(omega, float),
+                                  "wave_direction": np.asarray(wave_direction, float),
+                                  "influenced_dof": [str(d) for d in labels]},
+                          attrs=dict(attrs or {}))
+        return cls(xr.Dataset({"mean_drift": da}))
+
     def __init__(self, db: xr.Dataset, dofs=None):
         if "mean_drift" not in db:
             raise KeyError(
@@ -86,7 +98,8 @@ class DriftTable:
 
 def drift_time_series(db: xr.Dataset, comps: WaveComponents, t, *, mode: str,
                       reference_points=None, ramp_duration: float = 0.0, dofs=None) -> np.ndarray:
-    """The drift force (len(t), n_dof) of the module docstring on the database's dofs.
+    """The drift force (len(t), n_dof) of the module docstring on the database's dofs (``db``: a
+    database, or a :class:`DriftTable` made already).
 
     reference_points: (n_body, 3) the bodies' reference points (the wave's phase there, Newman's
     envelope; default the database's ``reference_point``), one per 6 dofs in order.
@@ -95,7 +108,7 @@ def drift_time_series(db: xr.Dataset, comps: WaveComponents, t, *, mode: str,
         raise ValueError(f"drift mode {mode!r}; accepted: {list(MODES)} (mean: the constant mean "
                          "drift; newman: Newman's slow drift)")
     t = np.asarray(t, float)
-    table = DriftTable(db, dofs)
+    table = db if isinstance(db, DriftTable) else DriftTable(db, dofs)
     n_dof = len(table.labels)
     if comps is None or len(comps.omega) == 0:
         return np.zeros((t.shape[0], n_dof))
@@ -105,6 +118,9 @@ def drift_time_series(db: xr.Dataset, comps: WaveComponents, t, *, mode: str,
         out = np.broadcast_to((D * (a * a)[:, None]).sum(0), (t.shape[0], n_dof)).copy()
     else:
         if reference_points is None:
+            if isinstance(db, DriftTable):
+                raise ValueError("drift_time_series: newman on a DriftTable needs "
+                                 "reference_points (the table has no bodies' positions)")
             reference_points = np.asarray(db["reference_point"].values, float)
         ref = np.repeat(np.asarray(reference_points, float)[:, :2], 6, axis=0)[:n_dof]  # per dof
         k, beta = np.asarray(comps.wavenumber, float), np.asarray(comps.heading, float)
@@ -121,8 +137,9 @@ def drift_time_series(db: xr.Dataset, comps: WaveComponents, t, *, mode: str,
 
 
 def mean_drift_of(db: xr.Dataset, comps: WaveComponents, dofs=None) -> np.ndarray:
-    """Σ_j D(ω_j, β_j) a_j² (n_dof,): the mean drift force of the components (N, N m)."""
-    D = DriftTable(db, dofs).at(comps)
+    """Σ_j D(ω_j, β_j) a_j² (n_dof,): the mean drift force of the components (N, N m). ``db``:
+    a database, or a :class:`DriftTable` made already."""
+    D = (db if isinstance(db, DriftTable) else DriftTable(db, dofs)).at(comps)
     return (D * np.asarray(comps.amplitude, float)[:, None] ** 2).sum(0)
 
 

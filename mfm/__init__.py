@@ -35,7 +35,8 @@ from .mechanics.kinematics import b_matrix, b_matrix_dot, body_poses, kinematics
 from .mechanics.model import Model  # noqa: E402
 from .runner.batch import simulate_batch  # noqa: E402
 from .runner import door as _door  # noqa: E402
-from .runner.frequency import equilibrium, frequency_response, natural_frequencies  # noqa: E402
+from .runner.frequency import (equilibrium, frequency_response, mean_drift,  # noqa: E402
+                               natural_frequencies)
 from .runner.linear import linear_response  # noqa: E402
 from .runner.simulation import simulate  # noqa: E402
 from .runner.spectral import spectral_response  # noqa: E402
@@ -60,6 +61,6 @@ __all__ = ["AccuracyWarning", "ConfigError", "Model", "PerformanceWarning", "Sea
            "b_matrix", "b_matrix_dot", "body_poses", "compile_tree", "coriolis_matrix",
            "energies", "equilibrium", "evaluate", "floquet", "forward_dynamics", "frequency",
            "frequency_response", "integrators", "kinematics", "largest_stable_dt",
-           "linear_response", "load", "loads", "mass_matrix", "model_loads",
+           "linear_response", "load", "loads", "mass_matrix", "mean_drift", "model_loads",
            "natural_frequencies", "optimize", "radiation", "reaction_loads", "reduce", "results",
            "rollout", "simulate", "simulate_batch", "spectral_response", "sweep"]

@@ -392,6 +392,18 @@ def frequency(model, loads, omega, x, q0, kin0, heading, settings, extra,
     return ds
 
 
+def mean_drift(md) -> xr.DataArray:
+    """A :class:`mfm.frequency.drift.MeanDrift` as a labelled DataArray (omega, wave_direction,
+    influenced_dof), as a database's ``mean_drift`` is laid out, its attributes kept."""
+    return xr.DataArray(np.asarray(md.D, float), dims=("omega", "wave_direction", "influenced_dof"),
+                        coords={"omega": ("omega", np.asarray(md.omega, float), {"units": "rad/s"}),
+                                "wave_direction": ("wave_direction",
+                                                   np.asarray(md.wave_direction, float),
+                                                   {"units": "rad"}),
+                                "influenced_dof": list(md.dofs)},
+                        attrs=dict(md.attrs), name="mean_drift")
+
+
 def drag_linearisation(ds, groups, C, sigma, case: bool = True) -> xr.Dataset:
     """``ds`` with the stochastic drag linearisation of the linear levels (:mod:`mfm.frequency.drag`,
     :func:`mfm.spectral_response`, :func:`mfm.linear_response`): ``drag_damping`` ([case,]

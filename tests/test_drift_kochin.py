@@ -17,7 +17,6 @@ import mfm
 from hydro import bem
 from hydro.drift import far_field_drift
 from hydro.waves import wavenumber
-from mfm.frequency.drift import model_mean_drift
 
 pytestmark = pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 
@@ -85,7 +84,7 @@ def test_the_model_s_own_drift_against_capytaine_s_chain():
     root), B's rows 0, heave, roll and pitch 0."""
     ds, fin = _check()
     model = _two_cylinders()
-    D = model_mean_drift(model)
+    D = mfm.mean_drift(model)
     ref = ds["drift_capytaine_free_symmetric"].values[fin]
     np.testing.assert_allclose(D["omega"].values, ds["omega"].values[fin])
     for dof, i, tol in (("A__Surge", 0, 1e-12), ("A__Sway", 1, 1e-12), ("A__Yaw", 2, YAW_RTOL)):
@@ -109,8 +108,8 @@ def test_the_total_is_put_on_the_root_body_with_its_yaw_moved():
     """The same bodies given in the order B, A: the total goes on B (the first of equals at the
     root), its yaw moment moved from the Kochin functions' origin to B's reference point
     (3, 1.5): M_B = M_0 − (x_B F_y − y_B F_x), to round-off against the A-first table."""
-    a_first = model_mean_drift(_two_cylinders(("A", "B")))
-    b_first = model_mean_drift(_two_cylinders(("B", "A")))
+    a_first = mfm.mean_drift(_two_cylinders(("A", "B")))
+    b_first = mfm.mean_drift(_two_cylinders(("B", "A")))
     F = {c: a_first.sel(influenced_dof=f"A__{c}").values for c in ("Surge", "Sway", "Yaw")}
     scale = np.abs(F["Surge"]).max()
     np.testing.assert_allclose(b_first.sel(influenced_dof="B__Surge").values, F["Surge"],
@@ -143,7 +142,7 @@ def test_the_time_domain_takes_the_drift_of_the_model_s_own_motions():
     rows; simulate_batch of two heights records each case's the same (1e-12)."""
     model = _moored_pair(drift="mean")
     a, w = 0.1, 2.2
-    D = model_mean_drift(model).sel(omega=w, wave_direction=0.0)
+    D = mfm.mean_drift(model).sel(omega=w, wave_direction=0.0)
     sea = hydro.Regular(height=2 * a, period=2 * math.pi / w)
     run = dict(dt=0.05, ramp=2.0, radiation="none")          # 3 frequencies: no fit
     ds = mfm.simulate(model, sea, duration=4.0, check_stability=False, **run)
@@ -174,7 +173,7 @@ def test_the_mean_offset_of_a_moored_layout():
     rest, _ = mfm.equilibrium(model)
     a, w = 0.1, 2.2
     q0, info = mfm.equilibrium(model, sea=hydro.Regular(height=2 * a, period=2 * math.pi / w))
-    D = model_mean_drift(model).sel(omega=w, wave_direction=0.0, influenced_dof="A__Surge")
+    D = mfm.mean_drift(model).sel(omega=w, wave_direction=0.0, influenced_dof="A__Surge")
     i = model.coordinates.index("A.surge")
     assert q0[i] - rest[i] == pytest.approx(float(D) * a * a / k, rel=1e-9)
     assert abs(float(D)) * a * a / k > 1e-3                      # a visible offset
@@ -190,7 +189,7 @@ def test_errors():
 
     sphere = mfm.load(Path(__file__).resolve().parents[1] / "configs" / "sphere.toml")
     with pytest.raises(ValueError, match='drift = "kochin"'):
-        model_mean_drift(sphere)
+        mfm.mean_drift(sphere)
     ds, _ = _check()
     db = from_capytaine(ds)
     with pytest.raises(ValueError, match="'kochin_diffraction' without 'kochin_radiation'"):

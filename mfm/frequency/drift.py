@@ -25,9 +25,9 @@ whose RAOs are taken to be the same (no wave-drift damping, no iteration).
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
-import xarray as xr
 
 from ..mechanics.model import Model
 from ..mechanics.points import h_matrix_at
@@ -36,6 +36,36 @@ from .response import _amplitudes
 from .rest import linear_hydro, linear_system
 
 KOCHIN_VARIABLES = ("kochin_diffraction", "kochin_radiation")
+
+
+class MeanDrift(NamedTuple):
+    """The drift of a model's own motions (:func:`model_mean_drift`): ``D`` (n_ω, n_β, 6K) per
+    unit wave amplitude squared (N/m², N m/m²) on ``omega`` (rad/s) and ``wave_direction`` (rad),
+    for the hydro ``dofs`` (6K labels), and ``attrs`` (units, method, motions, the dofs it is on);
+    as a database's ``mean_drift`` (:meth:`table`; a dataset: :func:`mfm.mean_drift`)."""
+    omega: np.ndarray
+    wave_direction: np.ndarray
+    D: np.ndarray
+    dofs: tuple
+    attrs: dict
+
+    def table(self):
+        """The :class:`hydro.drift.DriftTable` of D: the interpolation every drift reads."""
+        from hydro.drift import DriftTable
+
+        return DriftTable.of_arrays(self.omega, self.wave_direction, self.D, self.dofs,
+                                    self.attrs)
+
+    def at(self, omega: float, heading: float, dof: str) -> float:
+        """D at a frequency and heading of the grid, for one dof (N/m² or N m/m²)."""
+        i = int(np.argmin(np.abs(self.omega - omega)))
+        j = int(np.argmin(np.abs(self.wave_direction - heading)))
+        if not (np.isclose(self.omega[i], omega, rtol=1e-9)
+                and np.isclose(self.wave_direction[j], heading, rtol=0, atol=1e-12)):
+            raise ValueError(f"omega {omega}, heading {heading}: not on the table's grid "
+                             f"(omega {self.omega.tolist()}, headings "
+                             f"{self.wave_direction.tolist()}); interpolate with table().at")
+        return float(self.D[i, j, list(self.dofs).index(dof)])
 
 
 def has_kochin(model: Model) -> bool:
@@ -55,12 +85,13 @@ def root_hydro_body(model: Model, body_index) -> int:
     return min(range(len(body_index)), key=lambda k: (depth(int(body_index[k])), k))
 
 
-def model_mean_drift(model: Model, *, q0=None, loads=None) -> xr.DataArray:
-    """D(ω, β) (omega, wave_direction, influenced_dof) of the module docstring: the far-field mean
-    drift force of the model's own motions per unit wave amplitude squared (N/m², N m/m²), on the
-    database's finite frequencies and headings, at the hydro bodies' reference points (inertial
-    axes), as a database's ``mean_drift`` is (the same table and interpolation serve it:
-    :meth:`mfm.loads.water.Water.in_mean_drift`).
+def model_mean_drift(model: Model, *, q0=None, loads=None) -> MeanDrift:
+    """D(ω, β) of the module docstring as a :class:`MeanDrift` (omega, wave_direction, hydro
+    dofs): the far-field mean drift force of the model's own motions per unit wave amplitude
+    squared (N/m², N m/m²), on the database's finite frequencies and headings, at the hydro
+    bodies' reference points (inertial axes), as a database's ``mean_drift`` is (the same table
+    and interpolation serve it: :meth:`MeanDrift.table`, :meth:`mfm.loads.water.Water.in_mean_drift`;
+    as a labelled DataArray: :func:`mfm.mean_drift`).
 
     model: a Model whose database has the Kochin functions (``[hydro.bem] drift = "kochin"``);
     q0, loads: the linearisation point (default the still-water equilibrium) and extra loads, as
@@ -114,19 +145,16 @@ def model_mean_drift(model: Model, *, q0=None, loads=None) -> xr.DataArray:
         D[:, ib, 6 * root + 1] = F[:, 1]
         D[:, ib, 6 * root + 5] = F[:, 2] - (x_r * F[:, 1] - y_r * F[:, 0])
     root_name = labels[6 * root].rsplit("__", 1)[0]
-    return xr.DataArray(
-        D, dims=("omega", "wave_direction", "influenced_dof"),
-        coords={"omega": om, "wave_direction": betas, "influenced_dof": labels},
-        attrs={"units": "N/m^2 (forces), N m/m^2 (moments): mean force per unit wave amplitude "
-                        "squared, at the bodies' reference points",
-               "method": "far field of the model's own motions (mfm.frequency.drift."
-                         "model_mean_drift: hydro.drift.far_field_drift, Maruo and Newman, on "
-                         f"the database's Kochin functions on {db.sizes['theta']} directions)",
-               "motions": f"model {model.name!r} linearised at q0 = "
-                          f"{np.round(sys.q0, 9).tolist()} (its joints, PTOs and moorings)",
-               "dofs": ", ".join(f"{root_name}__{m}" for m in ("Surge", "Sway", "Yaw")),
-               "applied_on": f"{root_name}: the layout's total (the far field gives no body's "
-                             "share)"})
+    return MeanDrift(om, betas, D, tuple(labels), {
+        "units": "N/m^2 (forces), N m/m^2 (moments): mean force per unit wave amplitude squared, "
+                 "at the bodies' reference points",
+        "method": "far field of the model's own motions (mfm.frequency.drift.model_mean_drift: "
+                  "hydro.drift.far_field_drift, Maruo and Newman, on the database's Kochin "
+                  f"functions on {db.sizes['theta']} directions)",
+        "motions": f"model {model.name!r} linearised at q0 = {np.round(sys.q0, 9).tolist()} (its "
+                   "joints, PTOs and moorings)",
+        "dofs": ", ".join(f"{root_name}__{m}" for m in ("Surge", "Sway", "Yaw")),
+        "applied_on": f"{root_name}: the layout's total (the far field gives no body's share)"})
 
 
 def run_mean_drift(model: Model):

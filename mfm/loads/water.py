@@ -410,19 +410,15 @@ class Water(Load):
         is the mean position in that sea (a moored body's mean offset); the waves' first-order
         forces average to zero there. Whatever ``[hydro] drift`` says (the question is the
         mean offset); a database without ``mean_drift`` is refused, naming how to make one.
-        ``mean_drift``: a table D (omega, wave_direction, influenced_dof) in place of the
-        database's (the drift of the model's own motions, :mod:`mfm.frequency.drift`)."""
+        ``mean_drift``: a :class:`mfm.frequency.drift.MeanDrift` in place of the database's
+        (the drift of the model's own motions)."""
         from hydro.drift import mean_drift_of
 
         spec = self.spec
-        db = spec.database()
-        if mean_drift is not None:
-            import xarray as xr
-
-            db = xr.Dataset({"mean_drift": mean_drift})
-        require_mean_drift(db, spec.source, "mfm.equilibrium(sea=...)")
+        if mean_drift is None:
+            require_mean_drift(spec.database(), spec.source, "mfm.equilibrium(sea=...)")
         comps = sea.components(water_depth=spec.water_depth, g=spec.g)
-        mean = np.asarray(mean_drift_of(db, comps), np.float64)
+        mean = np.asarray(mean_drift_of(_drift_source(spec, mean_drift), comps), np.float64)
         if mean.shape != (self.A_inf.shape[0],):
             raise ValueError(f"mfm.equilibrium(sea=...): the database's mean drift has "
                              f"{mean.shape[0]} dofs, the water {self.A_inf.shape[0]}")
@@ -531,8 +527,8 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
     (the passive fit of hydro.statespace; its corrected A∞), or "none" (A∞ only).
     stage_offsets: the integrator's stage times as fractions of dt (RK4: 0, ½, 1): the excitation
     is tabulated so that each stage falls on a sample, and the convolution has weights per stage.
-    mean_drift: with ``[hydro] drift``, a table D (omega, wave_direction, influenced_dof) in place
-    of the database's ``mean_drift`` (the drift of the model's own motions,
+    mean_drift: with ``[hydro] drift``, a :class:`mfm.frequency.drift.MeanDrift` in place of the
+    database's ``mean_drift`` (the drift of the model's own motions,
     :func:`mfm.frequency.drift.run_mean_drift`).
     """
     from hydro.excitation import excitation_time_series
@@ -607,12 +603,9 @@ def relative_drag(spec) -> bool:
 
 
 def _drift_source(spec, mean_drift=None):
-    """What the drift is read from: the database, or a dataset of the table ``mean_drift``."""
-    if mean_drift is None:
-        return spec.database()
-    import xarray as xr
-
-    return xr.Dataset({"mean_drift": mean_drift})
+    """What the drift is read from: the database, or the :class:`hydro.drift.DriftTable` of
+    ``mean_drift`` (a :class:`mfm.frequency.drift.MeanDrift`)."""
+    return spec.database() if mean_drift is None else mean_drift.table()
 
 
 def require_mean_drift(db, path, what: str, *, error=ValueError, fix: str = "",
@@ -1016,12 +1009,7 @@ def _drift_coefficients(spec, comps, live, B: int, n_c: int, mean_drift=None) ->
     the padding (and for still water)."""
     import types
 
-    if mean_drift is None:
-        table = drift_table(spec)
-    else:
-        from hydro.drift import DriftTable
-
-        table = DriftTable(_drift_source(spec, mean_drift))
+    table = drift_table(spec) if mean_drift is None else mean_drift.table()
     nd = len(table.labels)
     if nd != len(spec.dofs):
         raise ValueError(f"hydro.drift: the database's mean_drift has {nd} dofs "

@@ -44,9 +44,18 @@ def equilibrium(model, q_guess=None, *, loads=None, sea=None, tol: float = 1e-10
     q0, info = rest.equilibrium(model, q_guess, loads=loads, sea=sea, mean_drift=table, tol=tol,
                                 max_iter=max_iter)
     if sea is not None:
-        da = table if table is not None else model.hydro.database()["mean_drift"]
-        info["mean_drift"] = f"{da.attrs.get('method', '?')}; motions: {da.attrs.get('motions', '?')}"
+        attrs = table.attrs if table is not None else model.hydro.database()["mean_drift"].attrs
+        info["mean_drift"] = f"{attrs.get('method', '?')}; motions: {attrs.get('motions', '?')}"
     return q0, info
+
+
+def mean_drift(model, *, q0=None, loads=None):
+    """The mean wave drift of the model's own motions per unit wave amplitude squared, as a
+    labelled ``xarray.DataArray`` (omega, wave_direction, influenced_dof) in N/m² and N m/m²,
+    the layout's far-field total on the hydro body nearest the root
+    (:func:`mfm.frequency.drift.model_mean_drift`: the equations, the approximation, the errors).
+    Needs a database with the layout's Kochin functions (``[hydro.bem] drift = "kochin"``)."""
+    return results.mean_drift(drift.model_mean_drift(model, q0=q0, loads=loads))
 
 
 # one text per idea: the equations and the dataset's variables are the core's docstrings

@@ -146,9 +146,7 @@ def mean_offset(m: int = 1, sea=None, *, locked: bool = True) -> xr.Dataset:
     mean, info = equilibrium(model, q_guess=rest, sea=sea)
     table = model_mean_drift(model, q0=rest)
     comps = sea.components(water_depth=model.hydro.water_depth, g=model.hydro.g)
-    from hydro.drift import mean_drift_of
-
-    F = mean_drift_of(xr.Dataset({"mean_drift": table}), comps)
+    F = table.table().at(comps).T @ np.asarray(comps.amplitude, float) ** 2   # Σ_j D_j a_j²
     root = table.attrs["dofs"].split(", ")
     return xr.Dataset(
         {"q_rest": (("coordinate",), rest, {"units": "m or rad"}),
@@ -159,8 +157,8 @@ def mean_offset(m: int = 1, sea=None, *, locked: bool = True) -> xr.Dataset:
          "mooring_force_rest": (("axis",), pull(rest), {"units": "N", "long_name": "the lines' "
                                                         "total horizontal force on the platform"}),
          "mooring_force_mean": (("axis",), pull(mean), {"units": "N"}),
-         "drift_force": (("component",), [F[list(table["influenced_dof"].values).index(d)]
-                                          for d in root], {"units": "N, N, N m"})},
+         "drift_force": (("component",), [F[list(table.dofs).index(d)] for d in root],
+                         {"units": "N, N, N m"})},
         coords={"coordinate": list(model.coordinates), "line": list(lines.names),
                 "component": ["surge", "sway", "yaw"], "axis": ["x", "y"]},
         attrs={"model": model.name, "sea": repr(sea), "mean_drift": info["mean_drift"],
