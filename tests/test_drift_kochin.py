@@ -76,6 +76,50 @@ def test_far_field_drift_against_capytaine_on_given_motions():
     assert np.abs(held[..., 0] - ref[..., 0]).max() > 0.1 * np.abs(ref[..., 0]).max()
 
 
+def test_finite_depth_coefficient_against_capytaine_s_formula():
+    """The same stored functions and random motions taken at a finite depth h = 4 m (kh 0.9–3.7:
+    only the wavenumber and the energy-flux coefficient c₂ change): far_field_drift's surge and
+    sway force against capytaine 3.0's far_field_mean_drift_force on our own 2° grid, wrapped past
+    both ends as it asks, to 1e-12 (no derivative in the forces; its H(β) on the grid)."""
+    cpt = pytest.importorskip("capytaine")
+    import xarray as xr
+
+    ds, fin = _check()
+    h, g, rho = 4.0, 9.81, 1000.0
+    om = ds["omega"].values[fin]
+    beta = ds["wave_direction"].values
+    th = ds["theta"].values
+    N = th.size
+    wrap = np.concatenate([[N - 1], np.arange(N), [0, 1]])
+    theta = np.concatenate([[th[0] - 2 * np.pi / N], th, [2 * np.pi, 2 * np.pi + 2 * np.pi / N]])
+    Hd = ds["kochin_diffraction"].values[fin]
+    Hr = ds["kochin_radiation"].values[fin]
+    X = ds["motions_random"].values[fin]
+    k = wavenumber(om, h, g)
+    dofs = [str(d) for d in ds["radiating_dof"].values]
+    data = xr.Dataset(
+        {"kochin_diffraction": (("omega", "wave_direction", "theta"), Hd[..., wrap]),
+         "kochin_radiation": (("omega", "radiating_dof", "theta"), Hr[..., wrap])},
+        coords={"omega": om, "wavenumber": ("omega", k), "water_depth": h, "rho": rho, "g": g,
+                "theta": theta, "wave_direction": beta, "radiating_dof": dofs})
+    Xda = xr.DataArray(X, dims=("omega", "wave_direction", "radiating_dof"),
+                       coords={"omega": om, "wave_direction": beta, "radiating_dof": dofs})
+    f = cpt.post_pro.far_field_mean_drift_force(Xda, data)
+    nw, nb = len(om), len(beta)
+    ours = far_field_drift(Hd.reshape(nw * nb, N),
+                           np.repeat(Hr, nb, axis=0), X.reshape(nw * nb, -1), np.repeat(om, nb),
+                           np.repeat(k, nb), np.tile(beta, nw), water_depth=h, rho=rho,
+                           g=g).reshape(nw, nb, 3)
+    for i, name in enumerate(("drift_force_surge", "drift_force_sway")):
+        v = f[name].transpose("omega", "wave_direction_k", "wave_direction_l").values
+        ref = np.real(np.diagonal(v, axis1=1, axis2=2))
+        np.testing.assert_allclose(ours[..., i], ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+    deep = far_field_drift(Hd.reshape(nw * nb, N), np.repeat(Hr, nb, axis=0),
+                           X.reshape(nw * nb, -1), np.repeat(om, nb), np.repeat(k, nb),
+                           np.tile(beta, nw), water_depth=math.inf, rho=rho, g=g)
+    assert np.abs(deep[:, 0] - ours[..., 0].ravel()).max() > 1e-3 * np.abs(ours[..., 0]).max()
+
+
 def test_the_model_s_own_drift_against_capytaine_s_chain():
     """Two cylinders freely floating, an mfm model of them (its own mechanics, its frequency
     response): its RAOs are capytaine's motions with A(ω), B(ω) symmetrised as mfm takes them

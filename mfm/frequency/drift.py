@@ -56,17 +56,6 @@ class MeanDrift(NamedTuple):
         return DriftTable.of_arrays(self.omega, self.wave_direction, self.D, self.dofs,
                                     self.attrs)
 
-    def at(self, omega: float, heading: float, dof: str) -> float:
-        """D at a frequency and heading of the grid, for one dof (N/m² or N m/m²)."""
-        i = int(np.argmin(np.abs(self.omega - omega)))
-        j = int(np.argmin(np.abs(self.wave_direction - heading)))
-        if not (np.isclose(self.omega[i], omega, rtol=1e-9)
-                and np.isclose(self.wave_direction[j], heading, rtol=0, atol=1e-12)):
-            raise ValueError(f"omega {omega}, heading {heading}: not on the table's grid "
-                             f"(omega {self.omega.tolist()}, headings "
-                             f"{self.wave_direction.tolist()}); interpolate with table().at")
-        return float(self.D[i, j, list(self.dofs).index(dof)])
-
 
 def has_kochin(model: Model) -> bool:
     """Whether the model's database carries the Kochin functions (``drift = "kochin"``)."""
