@@ -132,7 +132,7 @@ def test_capytaine_231_reader(capy):
 
 def _variant(tmp_path, name, edit, single_body=False):
     """A hand-made capytaine file of another layout, from the 2.3.1 fixture."""
-    ds = xr.open_dataset(CAPY_RM3).load()
+    ds = xr.load_dataset(CAPY_RM3)
     d = tmp_path / name
     d.mkdir()
     if single_body:

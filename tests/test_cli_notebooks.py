@@ -21,7 +21,7 @@ def test_cli_simulate_and_plot(tmp_path, capsys):
     nc = tmp_path / "dp.nc"
     assert main(["simulate", str(CONFIGS / "double_pendulum.toml"), "--duration", "0.5", "--dt", "0.01",
                  "--initial", "upper.angle=0.3", "--integrator", "beeman", "--out", str(nc)]) == 0
-    ds = xr.open_dataset(nc)
+    ds = xr.load_dataset(nc)
     assert ds.sizes["time"] == 51 and float(ds.q.isel(time=0, coordinate=0)) == 0.3
     assert ds.attrs["integrator"] == "beeman"
     png = tmp_path / "layout.png"
@@ -62,7 +62,7 @@ def test_cli_optimize_as_the_readme_writes_it(tmp_path, capsys):
     assert main(argv) == 0
     out = capsys.readouterr().out
     assert "sphere.heave.damping:" in out and "rms(sphere.heave): 0.1 ≤ 0.1 (active" in out
-    ds = xr.open_dataset(nc)
+    ds = xr.load_dataset(nc)
     assert bool(ds.constraint_active.item()) and ds.attrs["command"]
     c = float(ds.optimum.item())
     assert 0.0 < c < 20000.0

@@ -241,10 +241,10 @@ def test_a_second_process_loads_the_programs_and_gives_the_same_bits(tmp_path):
     assert l2 == 0 and s2 == 0          # no cache: the ordinary path
     # tracing left: the small eager helpers (tables, memories), not the run's programs
     assert trace1 < 0.5 * trace2, (trace1, trace2)
-    ref = xr.open_dataset(tmp_path / "2.nc")
+    ref = xr.load_dataset(tmp_path / "2.nc")
     for k in (0, 1):
         for name in (f"{k}.nc", f"{k}.nc.whole.nc"):
-            got = xr.open_dataset(tmp_path / name)
+            got = xr.load_dataset(tmp_path / name)
             for var in ("q", "qd", "qdd", "joint_force", "kinetic_energy"):
                 np.testing.assert_array_equal(got[var].values, ref[var].values, err_msg=name)
 
@@ -620,6 +620,6 @@ def test_a_first_answer_compiles_its_programs_only_and_a_cached_one_none(tmp_pat
     # traced again: the few small jitted helpers that are not kept as traced programs (the
     # memories at rest, H at q0); the run's programs come from disk untraced
     assert traced1 < compiled0 + 4, counts
-    a, b = xr.open_dataset(tmp_path / "0.nc"), xr.open_dataset(tmp_path / "1.nc")
+    a, b = xr.load_dataset(tmp_path / "0.nc"), xr.load_dataset(tmp_path / "1.nc")
     for var in ("q", "qd", "qdd", "pto_power"):
         np.testing.assert_array_equal(a[var].values, b[var].values, err_msg=var)

@@ -168,7 +168,7 @@ def test_from_capytaine_transposes_and_splits(rm3):
 @pytest.fixture(scope="module")
 def sphere():
     path = DATA / "sphere.nc"   # shipped (hydro/data/README.md)
-    return D.from_capytaine(xr.open_dataset(path))
+    return D.from_capytaine(xr.load_dataset(path))
 
 
 def test_sphere_dataset_is_valid(sphere):

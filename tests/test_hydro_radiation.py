@@ -101,7 +101,7 @@ def test_rm3_added_mass_and_damping_from_K(rm3, rm3_K):
 
 def test_sphere_added_mass_from_K():
     path = DATA / "sphere.nc"   # shipped (hydro/data/README.md)
-    sp = D.from_capytaine(xr.open_dataset(path))
+    sp = D.from_capytaine(xr.load_dataset(path))
     om = sp.omega.values
     K = R.impulse_response(sp, np.arange(0.0, 40.0, 0.01))
     band = (om >= 0.2) & (om <= 5.0)

@@ -250,7 +250,7 @@ def test_capytaine_two_bodies_of_different_mass_about_their_rotation_centres(tmp
     import xarray as xr
     from hydro.prepare import open_any_database
 
-    ds = xr.open_dataset(CAPY_RM3).load()
+    ds = xr.load_dataset(CAPY_RM3)
     d = tmp_path / "capy"
     d.mkdir()
     for f in CAPY_RM3.parent.glob("*.dat"):

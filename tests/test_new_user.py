@@ -246,7 +246,7 @@ shape = "mesh"
 file = "hull.stl"
 """)
     out = bemgen.generate(cfg, progress=False, cache=False)
-    ds = xr.open_dataset(out)
+    ds = xr.load_dataset(out)
     assert len(ds.attrs["mfm_geometry_sha256"]) == 64 and ds.attrs["mfm_code_version"]
     ds.close()
     bemgen.generate(cfg, progress=False, cache=False)
