@@ -118,6 +118,63 @@ def test_a_ctrl_c_while_a_first_run_compiles_ends_the_process_at_once(tmp_path):
     assert took < CTRL_C_SECONDS, f"the process ended {took:.1f} s after the interrupt"
 
 
+# a Ctrl-C raised while the main thread runs a gc callback (as jax's _xla_gc_callback, where the
+# full suite's lost interrupt was raised): the interpreter prints it and goes on
+_LOST_INTERRUPT = """
+import gc, os, signal, sys
+signal.signal(signal.SIGINT, signal.default_int_handler)
+import hydro, mfm
+from mfm.runner.threads import keeping_interrupts
+
+armed = []
+
+def interrupt_inside_gc(phase, info):
+    if armed and phase == "start":
+        armed.pop()
+        os.kill(os.getpid(), signal.SIGINT)
+        for _ in range(1000):      # bytecode, where Python runs the handler
+            pass
+
+gc.callbacks.append(interrupt_inside_gc)
+
+def work():
+    armed.append(1)
+    gc.collect()
+    return "went on"
+
+def outcome(call):
+    try:
+        call()
+        return "went on"
+    except KeyboardInterrupt:
+        return "raised"
+
+print("plain", outcome(work))
+print("kept", outcome(keeping_interrupts(work)))
+m = mfm.load(%r)
+armed.append(1)
+print("simulate", outcome(lambda: mfm.simulate(m, hydro.Regular(height=1.0, period=8.0),
+                                               duration=20.0, dt=0.1)))
+print("handler", signal.getsignal(signal.SIGINT) is signal.default_int_handler)
+"""
+
+
+def test_a_ctrl_c_that_python_prints_and_forgets_is_raised_again(tmp_path):
+    """Item 15, the full suite's failure of the test above (1 in 12 interrupts of a compiling
+    run): Python raised the Ctrl-C inside jax's gc callback, printed it and went on, and the run
+    finished. The interrupt here is raised inside a gc callback on purpose: a plain function
+    goes on (the loss is real), a function under keeping_interrupts and mfm.simulate raise it,
+    and the process's SIGINT handler is given back."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MFM_FIT_CACHE=str(tmp_path / "fits"))
+    out = subprocess.run([sys.executable, "-c", _LOST_INTERRUPT % str(CONFIGS / "sphere.toml")],
+                         env=env, cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-3000:]
+    said = dict(line.split(" ", 1) for line in out.stdout.splitlines())
+    assert said == {"plain": "went on", "kept": "raised", "simulate": "raised",
+                    "handler": "True"}, (said, out.stderr[-3000:])
+    assert out.stderr.count("Exception ignored in") == 3, out.stderr[-3000:]
+
+
 def _files(folder):
     return sorted(str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file())
 

@@ -21,7 +21,7 @@ from ..validation import check_model, finite_number, initial_vector, whole_numbe
 from ..timedomain import integrators as _integrators
 from .checks import check_sea_read, refuse_impossible
 from .progress import progress_bar, progress_options, run_chunked
-from .threads import background
+from .threads import background, keeping_interrupts, result
 from ..timedomain.record import Recording, map_in_groups, output_names
 from ..timedomain.rollout import TRACES, rollout_blocks, rollout_impl, rollout_start
 from ..timedomain.setup import declared_stage_offsets, model_loads, stage_offsets
@@ -71,7 +71,7 @@ def _in_threads(n, call):
     # parts' compilation and run (mfm.runner.threads)
     made = [background(lambda k: jax.block_until_ready(call(k)), k, name="mfm-batch")
             for k in range(n)]
-    return [f.result() for f in made]
+    return [result(f) for f in made]
 
 
 def _join_parts(outs, B):
@@ -155,6 +155,7 @@ def _chunk_batch_jit(model, loads, shared, carry, dt, *, model_axis, n_blocks, i
                        model, model_axis, (loads, carry, dt), lanes)
 
 
+@keeping_interrupts
 def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
                    radiation: str = "state_space", state_space_options: dict | None = None,
                    memory: float | None = None, save_every: int = 1, t0: float = 0.0,

@@ -17,7 +17,7 @@ from ..timedomain.rollout import (chunk_jit, headed_chunk_jit, init_memories_jit
 from . import programs as _programs
 from . import progress
 from .progress import chunk_plan, run_chunked, run_pipelined
-from .threads import background, wait
+from .threads import background, result, wait
 
 
 def _strong(tree):
@@ -128,7 +128,7 @@ def prepare_run(model, q0, qd0, *, dt, n_steps, integrator, loads, save_every, t
     # a pipelined run steps once its steps' program is ready: the outputs' program (the
     # larger: M4 134 3.5 s, Wu & Yuan 4–9 s of compilation on 2 cores) goes on compiling
     # beside the first chunks, whose outputs wait for it on the outputs' thread
-    made = [ahead[0].result(), ahead[1]] if pipelined else [f.result() for f in ahead]
+    made = [result(ahead[0]), ahead[1]] if pipelined else [result(f) for f in ahead]
     if pipelined:
         steps, outputs = made
         return lambda bar: run_pipelined(

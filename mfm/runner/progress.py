@@ -11,7 +11,7 @@ import time
 import jax
 import numpy as np
 
-from .threads import Serial
+from .threads import Serial, interrupted, result
 
 
 def chunk_plan(n_blocks: int, fewest: int = 20, most: int = 100,
@@ -95,7 +95,9 @@ def _say(bar, what: str):
 
 
 def phase(bar, what: str):
-    """Say on ``bar`` (or nowhere, for None) which phase of the preparation is under way."""
+    """Say on ``bar`` (or nowhere, for None) which phase of the preparation is under way; a
+    Ctrl-C that Python lost before it is raised here (:func:`mfm.runner.threads.interrupted`)."""
+    interrupted()
     if bar is not None:
         _say(bar, what)
 
@@ -213,7 +215,7 @@ def run_pipelined(carry, steps, outputs, c, n_blocks, save_every, bar=None, bega
                 _advance(bar, done, take, save_every, began)
             if not finite:
                 break
-        pieces = [f.result() for f in made]
+        pieces = [result(f) for f in made]
     finally:
         # an interrupted run (Ctrl-C) waits neither for the chunk being made nor for those queued
         pool.close()

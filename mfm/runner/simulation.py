@@ -27,9 +27,10 @@ from .checks import (check_sea_read, nonfinite_message, refuse_impossible, warn_
 from .choices import convolution_or_state_space, judge_radiation, judged_choice, state_space_update
 from .pipeline import prepare_run
 from .progress import phase, progress_bar, progress_options
-from .threads import background
+from .threads import background, keeping_interrupts, result
 
 
+@keeping_interrupts
 def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="rk4",
              q0=None, qd0=None, loads=None, save_every: int = 1, t0: float = 0.0,
              ramp: float = 0.0, radiation: str = "auto", memory: float | None = None,
@@ -185,7 +186,7 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                           chunked=bar is not None, fast=fast)
         if check_stability:
             phase(bar, "linearising at q0 for the checks")
-            ahead.result()
+            result(ahead)
             # one linearisation at q0 gives the shortest period and the coordinates that nothing
             # pulls back (those of no_restoring(model, q0, loads=<the extra loads>), `mfm info`'s)
             J, K = rest.linearised_at_rest(model, q0, loads)

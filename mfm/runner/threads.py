@@ -15,12 +15,22 @@ C++ frame that may not unwind meets the thread's forced exit). So where one of t
 still at work, a process ended by a Ctrl-C (an unhandled KeyboardInterrupt, its traceback
 printed) flushes its streams and logs and ends as Python ends such a process, by SIGINT, with no
 finalisation; any other exit waits for them, as a thread pool's did.
+
+A Ctrl-C that Python loses (:func:`keeping_interrupts`): Python raises the KeyboardInterrupt of
+a signal in whatever Python code the main thread runs next, and where that is a callback whose
+exceptions the interpreter only prints (a ``gc.callbacks`` entry such as jax's
+``_xla_gc_callback``, a ``__del__``, a weakref's finaliser) the interrupt is printed and lost:
+RM3's cold run went on to its end (1 in 12 interrupts while it compiled, issue 54 item 15).
+Inside :func:`keeping_interrupts` (the front doors' bodies) the interrupts that Python's handler
+raised are counted, and the main thread's waits (:func:`result`, :func:`wait`) and the phases
+raise again an interrupt counted but not raised through the run.
 """
 from __future__ import annotations
 
 import atexit
 import concurrent.futures
 import contextvars
+import functools
 import os
 import queue
 import signal
@@ -79,6 +89,67 @@ def _at_exit() -> None:
 atexit.register(_at_exit)
 
 
+# the interrupts raised by Python's handler in the main thread inside keeping_interrupts (a list
+# per block, the innermost last); a block left by the exception forgets its own
+_KEPT: list = []
+
+# seconds between the main thread's looks at a lost interrupt while it waits for a future: a
+# Ctrl-C raised where Python prints it (above) ends the process this long after at most
+_LOOK_S = 0.05
+
+
+def interrupted() -> None:
+    """Raise KeyboardInterrupt if a Ctrl-C was raised by Python's handler inside the current
+    :func:`keeping_interrupts` block and the run still goes on: the interrupt was lost in a
+    callback whose exceptions Python only prints (see the module's docstring)."""
+    if _KEPT and _KEPT[-1]:
+        raise KeyboardInterrupt("mfm: a Ctrl-C raised inside a callback whose exceptions "
+                                "Python only prints (the traceback above), raised again here")
+
+
+def keeping_interrupts(fn):
+    """``fn`` with the Ctrl-C's that Python loses raised again (module docstring). In the main
+    thread, with a Python SIGINT handler (not ignored, not the OS default), that handler is
+    wrapped for the call: an interrupt it raises is counted, the exception left as it was; a
+    handler that does not raise (a script's own graceful stop) is not changed. On return a
+    counted interrupt is raised. The handler is given back on the way out, whatever happens."""
+    @functools.wraps(fn)
+    def call(*args, **kwargs):
+        if threading.current_thread() is not threading.main_thread():
+            return fn(*args, **kwargs)
+        previous = signal.getsignal(signal.SIGINT)
+        if not callable(previous):
+            return fn(*args, **kwargs)
+        kept = []
+
+        def handler(signum, frame):
+            try:
+                previous(signum, frame)
+            except KeyboardInterrupt:
+                kept.append(signum)
+                raise
+
+        signal.signal(signal.SIGINT, handler)
+        _KEPT.append(kept)
+        try:
+            out = fn(*args, **kwargs)
+            interrupted()
+            return out
+        finally:
+            _KEPT.pop()
+            signal.signal(signal.SIGINT, previous)
+    return call
+
+
+def result(future: concurrent.futures.Future):
+    """``future.result()``, looking every ``_LOOK_S`` for an interrupt Python lost
+    (:func:`interrupted`)."""
+    # wait() and then result(): a TimeoutError that fn raised is fn's, not the look's
+    while not concurrent.futures.wait([future], timeout=_LOOK_S).done:
+        interrupted()
+    return future.result()
+
+
 def background(fn, *args, name: str = "mfm-compile") -> concurrent.futures.Future:
     """``fn(*args)`` on a daemon thread of its own, in this thread's context variables (the host
     of :func:`mfm.host.using`); its future."""
@@ -90,7 +161,7 @@ def background(fn, *args, name: str = "mfm-compile") -> concurrent.futures.Futur
 def wait(fn, *args, name: str = "mfm-compile"):
     """``fn(*args)``, made on a daemon thread while this one waits for it: a Ctrl-C here is
     raised at once, where ``fn`` made here (an XLA compilation) would hold it until its end."""
-    return background(fn, *args, name=name).result()
+    return result(background(fn, *args, name=name))
 
 
 class Serial:
