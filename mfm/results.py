@@ -404,6 +404,42 @@ def mean_drift(md) -> xr.DataArray:
                         attrs=dict(md.attrs), name="mean_drift")
 
 
+def linear_outputs(model, loads, kin0) -> dict:
+    """Every load's :meth:`~mfm.loads.base.Load.linear_outputs` at ``kin0``, merged: name → (dims,
+    y₀, L, attrs), and "coords"."""
+    out, coords = {}, {}
+    for ld in loads:
+        got = dict(ld.linear_outputs(model, kin0))
+        coords.update(got.pop("coords", {}))
+        out.update(got)
+    return {**out, "coords": coords} if out else {}
+
+
+def add_linear_outputs(ds, outs, q0, q=None, lead=("time",), rms=None) -> xr.Dataset:
+    """``ds`` with the linear levels' outputs of the loads (``outs``: :func:`linear_outputs`):
+    ``<name>`` (lead…, dims) = y₀ + L (q − q₀) where ``q`` (lead…, n_q) is given, the value at the
+    equilibrium ``<name>_equilibrium`` (dims), and where ``rms`` {name: (case, k)} is given (the
+    spectral level's Σ ½ a² |L x̂|²) ``<name>_rms`` (case, dims)."""
+    if not outs:
+        return ds
+    outs = dict(outs)
+    ds = ds.assign_coords(outs.pop("coords"))
+    for name, (dims, y0, L, attrs) in outs.items():
+        y0, L = np.asarray(y0, float), np.asarray(L, float)
+        units = attrs.get("units", "")
+        ds[f"{name}_equilibrium"] = (tuple(dims), y0, {
+            "long_name": f"{attrs.get('long_name', name)}: at the equilibrium", "units": units})
+        if q is not None:
+            ds[name] = (tuple(lead) + tuple(dims),
+                        y0 + np.einsum("...i,ki->...k", np.asarray(q) - np.asarray(q0), L),
+                        dict(attrs))
+        if rms is not None:
+            ds[f"{name}_rms"] = (("case",) + tuple(dims), rms[name], {
+                "long_name": f"{attrs.get('long_name', name)}: standard deviation about the "
+                             "equilibrium, sqrt(Σ ½ a² |L x̂|²)", "units": units})
+    return ds
+
+
 def drag_linearisation(ds, groups, C, sigma, case: bool = True) -> xr.Dataset:
     """``ds`` with the stochastic drag linearisation of the linear levels (:mod:`mfm.frequency.drag`,
     :func:`mfm.spectral_response`, :func:`mfm.linear_response`): ``drag_damping`` ([case,]

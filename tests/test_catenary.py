@@ -732,3 +732,85 @@ table_step = [1.0, 1.0]
     assert mfm_cli.main(["info", str(p)]) == 0
     err = capsys.readouterr().err
     assert "loading one moored hull" in err and "mooring table (MoorPy): 16 of 20 solves" in err
+
+
+@pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
+def test_every_level_of_the_ladder_reports_the_line_tensions():
+    """Issue 53 item 4: the linear levels report a catenary's fairlead tension (to first order
+    about the equilibrium, CatenaryLines.linear_outputs) and mfm.reduce compares it across the
+    ladder. Three light lines on the floating sphere (fairlead at the CoM), a regular wave
+    H 0.2 m, T 4 s:
+
+    - the spectral series against MoorPy's catenary at the spectral run's own fairlead positions:
+      what is left is second order (the tension's curvature times the motion's square): relative
+      to the tension's range it doubles with the wave height (H 0.1 → 0.2 m: 3.1e-3 → 6.2e-3,
+      ratio 2 within 5 %), under 1e-2;
+    - its standard deviation from the RAOs (fairlead_tension_rms) against that of its series over
+      whole periods (1e-9);
+    - the spectral and linear levels' standard deviations against mfm.simulate's recorded tension
+      (the nonlinear table, every load) within 2 % (measured 0.14 % and 0.8 %: the weakly damped
+      surge mode's start-up transient in the pilot, which the spectral steady state lacks), the
+      means within 5e-4 (measured 1.1e-4: the time domain's second-order mean tension, which
+      the linear levels lack);
+    - reduce counts each line's mean and standard deviation."""
+    from conftest import CONFIGS
+
+    m = mfm.load(CONFIGS / "sphere.toml")
+    com = np.asarray(m.com[m.body_index("sphere")])
+    angles = np.radians([0.0, 120.0, 240.0])
+    lines = [{"name": f"S{k}", "body": "sphere", "fairlead": list(com),
+              "anchor": [30 * math.cos(a), 30 * math.sin(a), -20.0], "length": 40.0, "weight": 5.0,
+              "EA": 1e7, "table_extent": [3.0, 3.0], "table_step": [0.2, 0.2]}
+             for k, a in enumerate(angles)]
+    moored = dataclasses.replace(m, loads=tuple(m.loads) + (CatenaryLines.create(m, lines),))
+    T = 4.0
+    import hydro
+
+    sea = hydro.Regular(height=0.2, period=T)
+    dt, window = T / 100, slice(15 * T, None)
+    kw = dict(duration=30 * T, dt=dt, ramp=5 * T)
+    full = mfm.simulate(moored, sea, **kw)
+    spec = mfm.spectral_response(moored, sea, t=full.time.values)
+    lin = mfm.linear_response(moored, sea, **kw)
+    for ds in (spec, lin):
+        assert ds.fairlead_tension.dims == ("time", "mooring_line")
+        assert ds.fairlead_tension.attrs["units"] == "N"
+        assert list(ds.mooring_line.values) == ["S0", "S1", "S2"]
+    # the spectral series against MoorPy's catenary at its own fairleads (translations move the
+    # fairlead at the CoM; the pitch does not): what is left is second order, so relative to the
+    # tension's range it doubles with the wave height
+    cols = [list(m.coordinates).index(f"sphere.{c}") for c in ("surge", "heave")]
+
+    def left(ds):
+        y, q = ds.fairlead_tension.values, ds.q.values
+        rng, worst = float(y.max() - y.min()), 0.0
+        for i in range(0, q.shape[0], 10):
+            p = com + [q[i, cols[0]], 0.0, q[i, cols[1]]]
+            for k, ln in enumerate(lines):
+                an = np.asarray(ln["anchor"])
+                ref = math.hypot(*catenary_forces(np.hypot(*(p[:2] - an[:2])), p[2] - an[2],
+                                                  40.0, 1e7, 5.0))
+                worst = max(worst, abs(float(y[i, k]) - ref) / rng)
+        return worst
+
+    half = mfm.spectral_response(moored, hydro.Regular(height=0.1, period=T), t=full.time.values)
+    worst, worst_half = left(spec), left(half)
+    print(f"spectral tension against MoorPy at its fairleads: {worst:.2e} of the range at H 0.2 m, "
+          f"{worst_half:.2e} at 0.1 m")
+    assert worst < 1e-2 and 1.9 < worst / worst_half < 2.1
+    # the RAOs' standard deviation is that of the series over whole periods
+    sel = spec.fairlead_tension.sel(time=window)
+    assert np.allclose(spec.fairlead_tension_rms.values, sel.std("time").values, rtol=1e-9)
+    ref = full.fairlead_tension.sel(time=window)
+    for name, ds in (("spectral", spec), ("linear", lin)):
+        y = ds.fairlead_tension.sel(time=window)
+        std = np.abs(y.std("time").values / ref.std("time").values - 1)
+        mean = np.abs(y.mean("time").values / ref.mean("time").values - 1)
+        print(f"{name}: standard deviations {np.round(std, 5).tolist()}, means "
+              f"{np.round(mean, 7).tolist()} relative to the time domain's")
+        assert std.max() < 0.02 and mean.max() < 5e-4, name
+    red = mfm.reduce(moored, sea, levels=("spectral", "linear"), timing=False)
+    for lv in ("spectral", "linear"):
+        assert {f"{s}[fairlead_tension[S{k}]]" for s in ("mean", "std") for k in range(3)} \
+            <= set(red.errors[lv]), red.errors[lv]
+    assert red.level == "spectral", red.reason

@@ -156,7 +156,9 @@ class Load(eqx.Module):
       (a load that is a PTO);
     - the linearisation: :meth:`static_load` (its part at rest; None: nothing static),
       :meth:`frequency_terms` with :meth:`frequency_body_loads` and :meth:`frequency_range`,
-      :meth:`frequency_outputs`, :meth:`linear_dampers` (a PTO's damping about q₀),
+      :meth:`frequency_outputs`, :meth:`linear_outputs` (what :meth:`diagnostics` records, to
+      first order about q₀: the linear levels' series of it), :meth:`linear_dampers` (a PTO's
+      damping about q₀),
       :meth:`quadratic_drag` (quadratic drag on the relative flow or on the body's own velocity,
       for the spectral level's stochastic linearisation), :meth:`in_mean_drift` (the load at rest holding a sea's mean wave drift:
       the equilibrium in a sea);
@@ -306,6 +308,15 @@ class Load(eqx.Module):
         name → (dims after "omega", array, attrs), plus "coords" (default: none)."""
         return {}
 
+    def linear_outputs(self, model, kin0) -> dict:
+        """Outputs this load records in the time domain (:meth:`diagnostics`), to first order
+        about the kinematics ``kin0`` of q₀: y ≈ y₀ + L (q − q₀), what the linear levels
+        (:func:`mfm.spectral_response`, :func:`mfm.linear_response`) report of them and
+        :func:`mfm.reduce` compares across the ladder. name → (dims after the run's own, y₀ (k,),
+        L (k, n_q), attrs), plus "coords" (default: none). The same L serves a frequency
+        response: ŷ = L x̂ (:meth:`frequency_outputs`)."""
+        return {}
+
     def linear_dampers(self, kin0) -> LinearDampers | None:
         """The PTOs this load adds as seen by the linear levels (:func:`mfm.spectral_response`,
         :func:`mfm.linear_response`), linearised at the kinematics ``kin0`` of q₀, so that every
@@ -328,5 +339,6 @@ REQUIRED = ("evaluate",)
 OPTIONAL = ("n_states", "initial_state", "init_memory", "update_memory", "reaction_loads",
             "diagnostics", "outputs", "batch_outputs", "pto_records", "static_load",
             "frequency_terms", "frequency_body_loads", "frequency_range", "frequency_outputs",
+            "linear_outputs",
             "linear_dampers", "provenance", "describe_nonfinite", "for_run", "host_view",
             "linear_hydro", "quadratic_drag", "in_mean_drift")

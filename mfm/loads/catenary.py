@@ -203,12 +203,20 @@ class CatenaryLines(Load):
                 "fairlead_vertical_tension": (line, {"long_name": "vertical fairlead tension V "
                                                      "(the line pulls down)", "units": "N"})}
 
+    def linear_outputs(self, model, kin0):
+        """The fairlead tension T = √(H² + V²) to first order about q₀: T₀ at the fairleads of
+        ``kin0`` and L = ∂T/∂r_F ∂r_F/∂q (the line's own linearisation, the one the stiffness
+        uses)."""
+        T0, dT, Hp = (np.asarray(a) for a in _tension_gradient(self, kin0))
+        return {"fairlead_tension": (("mooring_line",), T0, np.einsum("ka,kai->ki", dT, Hp),
+                                     {"long_name": "tension at the fairlead of each catenary line, "
+                                      "linearised about the equilibrium", "units": "N"}),
+                "coords": {"mooring_line": list(self.names)}}
+
     def frequency_outputs(self, model, kin0, x, omega):
-        """Tension amplitude per metre of wave amplitude: ∂T/∂r_F at q₀ times the fairlead's
-        displacement amplitude (the line's own linearisation, the one the stiffness uses)."""
-        dT, Hp = (np.asarray(a) for a in _tension_gradient(self, kin0))
-        rao = np.einsum("ka,kai,wi->wk", dT, Hp, x)
-        return {"fairlead_tension_rao": (("mooring_line",), rao,
+        """Tension amplitude per metre of wave amplitude: L x̂ with L of :meth:`linear_outputs`."""
+        _, _, L, _ = self.linear_outputs(model, kin0)["fairlead_tension"]
+        return {"fairlead_tension_rao": (("mooring_line",), np.asarray(x) @ L.T,
                                          {"long_name": "fairlead tension amplitude per metre of "
                                           "wave amplitude (linearised at the equilibrium)",
                                           "units": "N/m"}),
@@ -404,7 +412,7 @@ class CatenaryLines(Load):
 
 @eqx.filter_jit
 def _tension_gradient(lines: CatenaryLines, kin0):
-    """∂T/∂r_F (P, 3) of each line's fairlead tension T = √(H² + V²) at the fairleads of
+    """Each line's fairlead tension T = √(H² + V²) (P,) and ∂T/∂r_F (P, 3) at the fairleads of
     ``kin0``, and the fairleads' velocity maps ∂ṙ_F/∂q̇ (P, 3, n_q) there (compiled: op by op,
     the first frequency response of Wu & Yuan spent 6 s compiling its primitives one by one)."""
     P = len(lines.names)
@@ -416,7 +424,7 @@ def _tension_gradient(lines: CatenaryLines, kin0):
     p0 = lines.fairleads.positions(kin0)
     k = jnp.arange(P)
     dT = jax.jacfwd(tension)(p0)[k, k]                                      # line k's own
-    return dT, lines.fairleads.h_matrix(kin0)[0].reshape(P, 6, -1)[:, :3]
+    return tension(p0), dT, lines.fairleads.h_matrix(kin0)[0].reshape(P, 6, -1)[:, :3]
 
 
 @eqx.filter_jit

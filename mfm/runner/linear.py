@@ -248,7 +248,9 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
     ``equilibrium`` (coordinate); with quadratic drag (module docstring) also ``drag_damping``
     (drag_point, flow_axis, flow_axis_col) and ``relative_flow_rms`` (drag_point, flow_axis), as
     :func:`mfm.spectral_response` gives them, and the attributes ``drag_linearisation``,
-    ``drag_iterations``, ``drag_change``; attributes: provenance, ``level = "linear"``, the
+    ``drag_iterations``, ``drag_change``; the loads' outputs linear about q₀ (a catenary line's
+    ``fairlead_tension`` (time, mooring_line) = y₀ + L (q − q₀), and ``<name>_equilibrium``:
+    :meth:`~mfm.loads.base.Load.linear_outputs`); attributes: provenance, ``level = "linear"``, the
     state-space fit, ``free_positions``, ``mode_condition`` (‖V‖₁‖V⁻¹‖₁), the wall time.
     Raises ValueError on bad input, NotImplementedError for a load other than the water with a
     frequency-dependent impedance (no time-domain realisation of it here; a load's wave force,
@@ -315,6 +317,8 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
     ds = results.linear_time_series(model, sys.loads + (rad,), ts, q, qd, qdd, sys.q0, eta,
                                     settings, source=spec.source,
                                     dampers=load_dampers(sys.loads, sys.kin0))
+    ds = results.add_linear_outputs(ds, results.linear_outputs(model, sys.loads, sys.kin0),
+                                    sys.q0, q)
     if groups:
         ds = results.drag_linearisation(ds, groups, drag["C"][0], drag["sigma"][0], case=False)
     return ds

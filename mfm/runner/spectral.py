@@ -75,7 +75,10 @@ def spectral_response(model: Model, sea, *, t=None, q0=None, loads=None,
     ``[[morison]]`` elements: module docstring) also ``drag_damping`` (drag_point, flow_axis, flow_axis_col) each point's
     equivalent damping C (N s/m) and ``relative_flow_rms`` (drag_point, flow_axis) the standard
     deviation of its relative flow (m/s), and the attributes ``drag_iterations``, ``drag_change``
-    (the fixed point's). Attributes: provenance, the sea, ``level = "spectral"``,
+    (the fixed point's). With loads that record outputs linear about q₀
+    (:meth:`~mfm.loads.base.Load.linear_outputs`: a catenary line's ``fairlead_tension``) also
+    ``<name>_equilibrium`` (its value at the equilibrium), ``<name>_rms`` its standard deviation
+    sqrt(Σ ½ a² |L x̂|²) and, with ``t``, ``<name>`` (time, …) = y₀ + L (q − q₀). Attributes: provenance, the sea, ``level = "spectral"``,
     ``n_components`` and the wall time. The one-sea case of :func:`spectral_sweep`.
     """
     model = check_model(model)
@@ -203,7 +206,8 @@ def spectral_sweep(model: Model, seas, *, t=None, q0=None, loads=None,
     ``q``, ``qd`` (case, step, coordinate), ``pto_power`` (case, step, pto) and ``eta`` (case,
     step); with drag on the relative flow ``drag_damping`` (case, drag_point, flow_axis,
     flow_axis_col) and ``relative_flow_rms`` (case, drag_point, flow_axis), each sea linearised on
-    its own (module docstring). Attributes: provenance, ``level = "spectral"``, the seas,
+    its own (module docstring); the loads' linear outputs as :func:`spectral_response` (``<name>_rms``
+    over case, ``<name>`` over case and step). Attributes: provenance, ``level = "spectral"``, the seas,
     ``n_frequencies_solved`` (the union), the wall times of the RAO solve and of the whole call.
     """
     start = _time.perf_counter()
@@ -250,6 +254,16 @@ def _sweep(model, seas, labels, *, t, q0, loads, radiation, state_space_options,
         settings.update(results.drag_settings(groups, drag))
     ds = results.spectral(model, sys.loads, sys.q0, q_rms, power, ptos, comps, seas, settings,
                           series, start)
+    # what the loads record in the time domain, to first order (a catenary's fairlead tension):
+    # its standard deviation from the RAOs, its series from the synthesised q
+    outs = results.linear_outputs(model, sys.loads, sys.kin0)
+    if outs:
+        rms = {name: np.stack([np.sqrt(np.sum(0.5 * cm.amplitude[:, None] ** 2
+                                              * np.abs(x @ np.asarray(L).T) ** 2, axis=0))
+                               for cm, x in zip(comps, xs)])
+               for name, (_, _, L, _) in ((k, v) for k, v in outs.items() if k != "coords")}
+        ds = results.add_linear_outputs(ds, outs, sys.q0, None if series is None else series[1],
+                                        lead=("case", "step"), rms=rms)
     if groups:
         ds = results.drag_linearisation(ds, groups, drag["C"], drag["sigma"])
     return ds

@@ -30,8 +30,10 @@ on M4 134 and the Stansby & Li semi-sub: docs/fidelity.md.
 Whether a level holds is measured, not guessed: :func:`reduce` runs the full model and each cheaper
 level on a pilot window of the scene (the same sea, the same components and phases, so the time
 series agree sample by sample where the model is linear) and compares the scene's outputs — the
-mean power of each PTO and the standard deviation of named coordinates — over the pilot's settled
-part. A level is chosen when every output is within ``tolerance``; the cost is a pilot of the full
+mean power of each PTO, the standard deviation of named coordinates, and the mean and standard
+deviation of each catenary line's fairlead tension (every level reports it: the linear levels to
+first order about the equilibrium, :meth:`mfm.loads.base.Load.linear_outputs`) — over the pilot's
+settled part. A level is chosen when every output is within ``tolerance``; the cost is a pilot of the full
 model, paid once for a scene that is then run long or swept.
 """
 from __future__ import annotations
@@ -150,23 +152,52 @@ class Reduction:
         return simulate(model, sea, duration=duration, dt=self.dt, ramp=ramp, **self.options)
 
 
+# what the loads record that every level reports (mfm.loads.base.Load.linear_outputs): each
+# one's mean and standard deviation over the window, per element (a catenary line's fairlead
+# tension)
+LOAD_OUTPUTS = ("fairlead_tension",)
+
+
 def _measures(ds, window, coordinates):
-    """Mean power per PTO (W) and the standard deviation of named coordinates over the window."""
+    """Mean power per PTO (W), the standard deviation of named coordinates, and each element's
+    mean and standard deviation of the loads' outputs (:data:`LOAD_OUTPUTS`) over the window."""
     sel = ds.sel(time=window)
     out = {f"pto_power[{p}]": float(sel.pto_power.sel(pto=p).mean()) for p in
            ds.pto.values} if "pto_power" in ds else {}
     for c in coordinates:
         out[f"std[{c}]"] = float(sel.q.sel(coordinate=c).std())
+    for name in LOAD_OUTPUTS:
+        if name in ds:
+            y = sel[name]
+            (dim,) = (d for d in y.dims if d != "time")
+            for k in y[dim].values:
+                out[f"mean[{name}[{k}]]"] = float(y.sel({dim: k}).mean())
+                out[f"std[{name}[{k}]]"] = float(y.sel({dim: k}).std())
     return out
 
 
 def _errors(measured, reference):
     """Relative errors: each PTO against the total mean power (a PTO that absorbs little does not
-    inflate the error), each standard deviation against its own."""
+    inflate the error), each coordinate's standard deviation and each load output's mean against
+    its own, each load output's standard deviation against the largest of that output's (a line
+    the sea hardly moves does not inflate it). A measure the reference has and the level lacks
+    is an error: the level does not report it."""
     total = sum(abs(v) for k, v in reference.items() if k.startswith("pto_power")) or 1.0
+    spread = {}
+    for k, v in reference.items():
+        for name in LOAD_OUTPUTS:
+            if k.startswith(f"std[{name}["):
+                spread[name] = max(spread.get(name, 0.0), abs(v))
     out = {}
     for k, ref in reference.items():
-        scale = total if k.startswith("pto_power") else (abs(ref) or 1.0)
+        if k not in measured:
+            raise ValueError(f"reduce: the level's answer has no {k!r}, which the reference has")
+        scale = abs(ref) or 1.0
+        if k.startswith("pto_power"):
+            scale = total
+        for name in LOAD_OUTPUTS:
+            if k.startswith(f"std[{name}["):
+                scale = spread[name] or 1.0
         out[k] = abs(measured[k] - ref) / scale
     return out
 
@@ -175,13 +206,14 @@ def reduce(model: Model, sea, *, tolerance: float = 0.02, coordinates=(), period
            pilot_periods: float = 40.0, settle_periods: float = 15.0,
            steps_per_period: int = 200, levels=LEVELS, timing: bool = True,
            options=()) -> Reduction:
-    """The cheapest level of the fidelity ladder (module docstring) whose mean PTO powers and
-    coordinate standard deviations stay within ``tolerance`` of the full model on a pilot run of
-    the scene.
+    """The cheapest level of the fidelity ladder (module docstring) whose mean PTO powers,
+    coordinate standard deviations and catenary lines' fairlead tensions (mean and standard
+    deviation of each) stay within ``tolerance`` of the full model on a pilot run of the scene.
 
     model: a Model with hydrodynamics; sea: its sea state (:mod:`hydro.waves`).
     tolerance: the largest relative error accepted (0.02 = 2 %): each PTO's mean power against the
-    total mean power, each named coordinate's standard deviation against its own.
+    total mean power, each named coordinate's standard deviation against its own, each line's
+    mean tension against its own and its standard deviation against the largest line's.
     coordinates: coordinate names whose standard deviation counts too (free coordinates without
     restoring drift in the time domain and should not be named).
     period: s, the scene's period (default the sea's ``tp`` or ``period``); the pilot runs
