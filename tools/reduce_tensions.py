@@ -1,22 +1,42 @@
 """What each rung of the fidelity ladder changes in Wu & Yuan's line tensions (issue 53 item 4):
-``mfm.reduce`` on model 1 (configs/wu_yuan_m1.toml, the six catenary lines) in two scenes, each
+``mfm.reduce`` on model 1 with its time-domain database (configs/wu_yuan_m1_td.toml: the band
+0.25–3 rad/s; the seed's 10-frequency database gives no K(t)), its six catenary lines, in two
+scenes, each
 level's error in the mean PTO power, the mean and standard deviation of every line's fairlead
 tension against the full model (RK4, radiation "auto") over the pilot's settled part:
 
 - the seed's H 3.8 m, T 8 s head sea with the twelve WECs working (their PTOs);
-- the seed's severe sea, H 8.1 m, T 11.4 s, every hinge locked (mfm.studies.wu_yuan.platform_model).
+- the seed's severe sea, H 8.1 m, T 11.4 s, every hinge locked (the locked layout of
+  mfm.studies.wu_yuan_layout.config_text on the same database).
 
 Not a test; the table is in docs/fidelity.md ("Line tensions"). From the repository root, with mfm
 installed:
 
     python tools/reduce_tensions.py          # about 10 minutes on 2 shared cores
 """
+import tempfile
 import time
 import warnings
+from pathlib import Path
 
 import hydro
 import mfm
-from mfm.studies.wu_yuan import SEVERE, platform_model
+from mfm.studies import wu_yuan_layout as layout
+from mfm.studies.wu_yuan import SEVERE
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def locked_model():
+    """Model 1 with every hinge locked, on the time-domain database."""
+    text = layout.config_text(1, locked=True)
+    rel = '"../hydro/data/wu_yuan_m1.nc"'
+    if rel not in text:
+        raise RuntimeError(f"mfm.studies.wu_yuan_layout no longer names the database as {rel}")
+    text = text.replace(rel, '"' + (ROOT / "hydro" / "data" / "wu_yuan_m1_td.nc").as_posix() + '"')
+    path = Path(tempfile.mkdtemp(prefix="wu_yuan_locked_td_")) / "wu_yuan_m1_locked_td.toml"
+    path.write_text(text)
+    return mfm.load(path)
 
 
 def table(name, red):
@@ -31,8 +51,9 @@ def table(name, red):
 
 def main():
     warnings.simplefilter("ignore")
-    scenes = [("H 3.8 m, T 8 s, WECs working", platform_model(1), hydro.Regular(height=3.8, period=8.0)),
-              (f"H {SEVERE[0]} m, T {SEVERE[1]} s, hinges locked", platform_model(1, locked=True),
+    scenes = [("H 3.8 m, T 8 s, WECs working", mfm.load(ROOT / "configs" / "wu_yuan_m1_td.toml"),
+               hydro.Regular(height=3.8, period=8.0)),
+              (f"H {SEVERE[0]} m, T {SEVERE[1]} s, hinges locked", locked_model(),
                hydro.Regular(height=SEVERE[0], period=SEVERE[1]))]
     for name, model, sea in scenes:
         start = time.perf_counter()

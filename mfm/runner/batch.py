@@ -19,7 +19,7 @@ from ..loads.assembly import (CaseLoads, as_loads, carried_loads_batch, compile_
                               initial_states)
 from ..validation import check_model, finite_number, initial_vector, whole_number
 from ..timedomain import integrators as _integrators
-from .checks import check_sea_read, refuse_impossible
+from .checks import check_sea_read, refuse_convolution, refuse_impossible
 from .progress import progress_bar, progress_options, run_chunked
 from .threads import background, keeping_interrupts, result
 from ..timedomain.record import Recording, map_in_groups, output_names
@@ -258,6 +258,10 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     refuse_impossible(models[0], extra + tuple(models[0].loads), int(n_steps), int(save_every),
                       cases=B, every_output=False, names=outputs, what="n_steps")
     m0 = models[0]
+    if radiation == "convolution":
+        # the shortest dt has the most lags
+        refuse_convolution(m0, dt=float(dts.min()), memory=memory,
+                           n_offsets=len(stage_offsets(integ)))
     dts_all = np.broadcast_to(dts, (B,))
     if vary_loads is None and len(models) == 1:
         # the cases' loads made together (loads.assembly.carried_loads_batch): what they share

@@ -22,7 +22,7 @@ from ..timedomain import integrators as _integrators
 from ..timedomain.record import OUTPUTS
 from ..timedomain.setup import model_loads, stage_offsets
 from ..validation import check_model, finite_number, initial_vector, whole_number
-from .checks import (check_sea_read, nonfinite_message, refuse_impossible, warn_accuracy, warn_stability,
+from .checks import (check_sea_read, nonfinite_message, refuse_convolution, refuse_impossible, warn_accuracy, warn_stability,
                      warn_verlet_drift)
 from .choices import convolution_or_state_space, judge_radiation, judged_choice, state_space_update
 from .pipeline import prepare_run
@@ -141,6 +141,9 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
                                                        integrator=integ, memory=memory)
         if model.hydro is None:
             radiation = "convolution"          # no water: nothing to choose
+    if radiation == "convolution":
+        refuse_convolution(model, dt=dt, memory=memory, n_offsets=len(stage_offsets(integ)),
+                           why=choice if auto else "")
     q0 = initial_vector(model, q0, "q0")
     qd0 = initial_vector(model, qd0, "qd0")
     free = []
@@ -203,6 +206,10 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
             judged = verdict.attrs()
             radiation, choice = judged_choice(radiation, choice, verdict)
             if not verdict.ok:
+                refuse_convolution(model, dt=dt, memory=memory,
+                                   n_offsets=len(stage_offsets(integ)),
+                                   why=f"'auto': {verdict.summary}, and the convolution that "
+                                       "replaces a fit judged off is too large")
                 phase(bar, "preparing the loads (the convolution)")
                 loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                                     radiation=radiation, memory=memory, added_mass=added_mass,
