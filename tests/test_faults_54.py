@@ -149,8 +149,12 @@ def outcome(call):
     except KeyboardInterrupt:
         return "raised"
 
+def kept():
+    with keeping_interrupts():
+        return work()
+
 print("plain", outcome(work))
-print("kept", outcome(keeping_interrupts(work)))
+print("kept", outcome(kept))
 m = mfm.load(%r)
 armed.append(1)
 print("simulate", outcome(lambda: mfm.simulate(m, hydro.Regular(height=1.0, period=8.0),
@@ -163,8 +167,8 @@ def test_a_ctrl_c_that_python_prints_and_forgets_is_raised_again(tmp_path):
     """Item 15, the full suite's failure of the test above (1 in 12 interrupts of a compiling
     run): Python raised the Ctrl-C inside jax's gc callback, printed it and went on, and the run
     finished. The interrupt here is raised inside a gc callback on purpose: a plain function
-    goes on (the loss is real), a function under keeping_interrupts and mfm.simulate raise it,
-    and the process's SIGINT handler is given back."""
+    goes on (the loss is real), a block under keeping_interrupts and mfm.simulate raise it, and
+    the process's SIGINT handler is given back."""
     env = dict(os.environ, PYTHONPATH=str(ROOT), MFM_FIT_CACHE=str(tmp_path / "fits"))
     out = subprocess.run([sys.executable, "-c", _LOST_INTERRUPT % str(CONFIGS / "sphere.toml")],
                          env=env, cwd=ROOT, capture_output=True, text=True, timeout=300)
@@ -348,3 +352,16 @@ def test_a_cluster_that_does_not_start_blames_the_main_guard_only_where_it_lacks
         assert "put its code under" not in text and "The script is not the cause" in text
     else:
         assert "put its code under `if __name__ == '__main__':`" in text
+
+
+def test_a_front_doors_warnings_point_at_its_caller():
+    """keeping_interrupts is a block inside simulate and simulate_batch, not a wrapper around
+    them: as a decorator it put every warning of theirs on its own line in mfm/runner/threads.py
+    (an extra frame under the warnings' stacklevel) instead of the user's call."""
+    model = mfm.load(CONFIGS / "sphere.toml")
+    sea = hydro.Regular(height=0.5, period=4.0)
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        mfm.simulate(model, sea, duration=3.0, dt=1.0)
+        mfm.simulate_batch(model, [sea], dt=1.0, n_steps=3)
+    assert got and {w.filename for w in got} == {__file__}, [(w.filename, w.lineno) for w in got]

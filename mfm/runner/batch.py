@@ -155,7 +155,6 @@ def _chunk_batch_jit(model, loads, shared, carry, dt, *, model_axis, n_blocks, i
                        model, model_axis, (loads, carry, dt), lanes)
 
 
-@keeping_interrupts
 def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
                    radiation: str = "state_space", state_space_options: dict | None = None,
                    memory: float | None = None, save_every: int = 1, t0: float = 0.0,
@@ -206,190 +205,191 @@ def simulate_batch(model, seas, *, dt, n_steps: int, integrator="rk4", ramp=0.0,
     parameters as coordinates on ``case`` (``sea_hs``, ``sea_tp``, …).
     Raises :class:`SimulationError` naming the first case that goes non-finite.
     """
-    models = [check_model(m_) for m_ in (model if isinstance(model, (list, tuple)) else [model])]
-    from ..radiation import resolve
+    with keeping_interrupts():
+        models = [check_model(m_) for m_ in (model if isinstance(model, (list, tuple)) else [model])]
+        from ..radiation import resolve
 
-    radiation, memory, state_space_options = resolve(radiation, memory, state_space_options)
-    seas = list(seas) if isinstance(seas, (list, tuple)) else [seas]
-    try:
-        dts = np.atleast_1d(np.asarray(dt, dtype=float))
-        ramps = np.atleast_1d(np.asarray(ramp, dtype=float))
-    except (TypeError, ValueError):
-        raise ValueError(f"dt, ramp: {dt!r}, {ramp!r}; give numbers of seconds (one, or one per "
-                         "case)") from None
-    sizes = {"model": len(models), "seas": len(seas), "dt": dts.size, "ramp": ramps.size}
-    B = max(sizes.values())
-    bad = {k: v for k, v in sizes.items() if v not in (1, B)}
-    if bad:
-        raise ValueError(f"simulate_batch: the batched arguments must have one length or 1; got "
-                         f"{sizes}")
-    if not (np.all(dts > 0) and np.all(np.isfinite(dts))):
-        raise ValueError(f"dt: {dts} must be positive numbers of seconds")
-    if not (np.all(ramps >= 0) and np.all(np.isfinite(ramps))):
-        raise ValueError(f"ramp: {ramps} must be numbers of seconds ≥ 0")
-    if not whole_number(n_steps) \
-            or n_steps % save_every:
-        raise ValueError(f"n_steps: {n_steps!r} must be a whole number ≥ 1 and a multiple of "
-                         f"save_every={save_every}")
-    t0 = finite_number(t0, "t0")
-    memory = finite_number(memory, "memory", positive=True, allow_none=True)
-    progress = progress_options(progress)
-    if lanes is None:
-        lanes = default_lanes(B)
-    elif not whole_number(lanes):
-        raise ValueError(f"lanes: {lanes!r}; give a whole number ≥ 1 of cases to advance "
-                         "together in one vmapped loop, or None (1 on a CPU, all on a GPU)")
-    lanes = int(lanes)
-    if threads is None:
-        threads = default_threads()
-    elif not whole_number(threads):
-        raise ValueError(f"threads: {threads!r}; give a whole number ≥ 1 of host threads, or None "
-                         "(one per core on a CPU)")
-    threads = min(int(threads), B)
-    pick = lambda seq, i: seq[i if len(seq) > 1 else 0]  # noqa: E731
-    structure = {m_.coordinates for m_ in models}
-    if len(structure) > 1 or len({id(m_.hydro) for m_ in models}) > 1:
-        raise ValueError("model: the models of a batch must share one topology and one hydro "
-                         "spec (make them from one Model with equinox.tree_at)")
-    integ = _integrators.get(integrator)
-    outputs = output_names(outputs)
-    extra = as_loads(loads)
-    check_sea_read(models[0], extra, seas)
-    refuse_impossible(models[0], extra + tuple(models[0].loads), int(n_steps), int(save_every),
-                      cases=B, every_output=False, names=outputs, what="n_steps")
-    m0 = models[0]
-    if radiation == "convolution":
-        # the shortest dt has the most lags
-        refuse_convolution(m0, dt=float(dts.min()), memory=memory,
-                           n_offsets=len(stage_offsets(integ)))
-    dts_all = np.broadcast_to(dts, (B,))
-    if vary_loads is None and len(models) == 1:
-        # the cases' loads made together (loads.assembly.carried_loads_batch): what they share
-        # once, what differs (the wave tables, what follows dt) with a leading case axis
-        cases = carried_loads_batch(m0, [pick(seas, i) for i in range(B)], dts=dts_all,
-                                    ramps=np.broadcast_to(ramps, (B,)), n_steps=int(n_steps),
-                                    t0=t0, radiation=radiation, memory=memory,
-                                    state_space_options=state_space_options,
-                                    stage_offsets=stage_offsets(integ) if m0.hydro is not None
-                                    else declared_stage_offsets(integ), extra=extra,
-                                    mean_drift=run_mean_drift(m0))
-        model_view, loads_view = compile_view(m0, cases.loads)
-        # the view blanks static fields only: its leaves are the loads' own, in the same order
-        mask = jax.tree_util.tree_unflatten(jax.tree_util.tree_structure(loads_view),
-                                            jax.tree_util.tree_leaves(cases.batched))
-        varying, shared = eqx.partition(loads_view, mask)
-        waves = cases.waves
-        if waves is not None and not outputs:
-            # nothing recorded of the water: the time step reads the moved dofs' excitation alone
-            moving = cases.loads[cases.waves_at].moving
-            waves = waves if moving is None else dataclasses.replace(
-                waves, columns=tuple(int(k) for k in moving))
+        radiation, memory, state_space_options = resolve(radiation, memory, state_space_options)
+        seas = list(seas) if isinstance(seas, (list, tuple)) else [seas]
+        try:
+            dts = np.atleast_1d(np.asarray(dt, dtype=float))
+            ramps = np.atleast_1d(np.asarray(ramp, dtype=float))
+        except (TypeError, ValueError):
+            raise ValueError(f"dt, ramp: {dt!r}, {ramp!r}; give numbers of seconds (one, or one per "
+                             "case)") from None
+        sizes = {"model": len(models), "seas": len(seas), "dt": dts.size, "ramp": ramps.size}
+        B = max(sizes.values())
+        bad = {k: v for k, v in sizes.items() if v not in (1, B)}
+        if bad:
+            raise ValueError(f"simulate_batch: the batched arguments must have one length or 1; got "
+                             f"{sizes}")
+        if not (np.all(dts > 0) and np.all(np.isfinite(dts))):
+            raise ValueError(f"dt: {dts} must be positive numbers of seconds")
+        if not (np.all(ramps >= 0) and np.all(np.isfinite(ramps))):
+            raise ValueError(f"ramp: {ramps} must be numbers of seconds ≥ 0")
+        if not whole_number(n_steps) \
+                or n_steps % save_every:
+            raise ValueError(f"n_steps: {n_steps!r} must be a whole number ≥ 1 and a multiple of "
+                             f"save_every={save_every}")
+        t0 = finite_number(t0, "t0")
+        memory = finite_number(memory, "memory", positive=True, allow_none=True)
+        progress = progress_options(progress)
+        if lanes is None:
+            lanes = default_lanes(B)
+        elif not whole_number(lanes):
+            raise ValueError(f"lanes: {lanes!r}; give a whole number ≥ 1 of cases to advance "
+                             "together in one vmapped loop, or None (1 on a CPU, all on a GPU)")
+        lanes = int(lanes)
+        if threads is None:
+            threads = default_threads()
+        elif not whole_number(threads):
+            raise ValueError(f"threads: {threads!r}; give a whole number ≥ 1 of host threads, or None "
+                             "(one per core on a CPU)")
+        threads = min(int(threads), B)
+        pick = lambda seq, i: seq[i if len(seq) > 1 else 0]  # noqa: E731
+        structure = {m_.coordinates for m_ in models}
+        if len(structure) > 1 or len({id(m_.hydro) for m_ in models}) > 1:
+            raise ValueError("model: the models of a batch must share one topology and one hydro "
+                             "spec (make them from one Model with equinox.tree_at)")
+        integ = _integrators.get(integrator)
+        outputs = output_names(outputs)
+        extra = as_loads(loads)
+        check_sea_read(models[0], extra, seas)
+        refuse_impossible(models[0], extra + tuple(models[0].loads), int(n_steps), int(save_every),
+                          cases=B, every_output=False, names=outputs, what="n_steps")
+        m0 = models[0]
+        if radiation == "convolution":
+            # the shortest dt has the most lags
+            refuse_convolution(m0, dt=float(dts.min()), memory=memory,
+                               n_offsets=len(stage_offsets(integ)))
+        dts_all = np.broadcast_to(dts, (B,))
+        if vary_loads is None and len(models) == 1:
+            # the cases' loads made together (loads.assembly.carried_loads_batch): what they share
+            # once, what differs (the wave tables, what follows dt) with a leading case axis
+            cases = carried_loads_batch(m0, [pick(seas, i) for i in range(B)], dts=dts_all,
+                                        ramps=np.broadcast_to(ramps, (B,)), n_steps=int(n_steps),
+                                        t0=t0, radiation=radiation, memory=memory,
+                                        state_space_options=state_space_options,
+                                        stage_offsets=stage_offsets(integ) if m0.hydro is not None
+                                        else declared_stage_offsets(integ), extra=extra,
+                                        mean_drift=run_mean_drift(m0))
+            model_view, loads_view = compile_view(m0, cases.loads)
+            # the view blanks static fields only: its leaves are the loads' own, in the same order
+            mask = jax.tree_util.tree_unflatten(jax.tree_util.tree_structure(loads_view),
+                                                jax.tree_util.tree_leaves(cases.batched))
+            varying, shared = eqx.partition(loads_view, mask)
+            waves = cases.waves
+            if waves is not None and not outputs:
+                # nothing recorded of the water: the time step reads the moved dofs' excitation alone
+                moving = cases.loads[cases.waves_at].moving
+                waves = waves if moving is None else dataclasses.replace(
+                    waves, columns=tuple(int(k) for k in moving))
 
-        def take(g):
-            part = jax.tree_util.tree_map(lambda a: jnp.asarray(np.asarray(a)[g]), varying)
-            if waves is None:
-                return part, None
-            tables = _tables(waves, cases.polar, g)       # exc, eta (and a drift's)
-            return cases.with_tables(tuple(part), *tables), tables[1]
+            def take(g):
+                part = jax.tree_util.tree_map(lambda a: jnp.asarray(np.asarray(a)[g]), varying)
+                if waves is None:
+                    return part, None
+                tables = _tables(waves, cases.polar, g)       # exc, eta (and a drift's)
+                return cases.with_tables(tuple(part), *tables), tables[1]
 
-        model_of = lambda g: model_view  # noqa: E731
-        model_axis = None
-        loads = cases
-    else:
-        drift_tables: dict = {}            # one per distinct model (the drift of its motions)
+            model_of = lambda g: model_view  # noqa: E731
+            model_axis = None
+            loads = cases
+        else:
+            drift_tables: dict = {}            # one per distinct model (the drift of its motions)
 
-        def run_mean_drift_of(m):
-            if id(m) not in drift_tables:
-                drift_tables[id(m)] = run_mean_drift(m)
-            return drift_tables[id(m)]
+            def run_mean_drift_of(m):
+                if id(m) not in drift_tables:
+                    drift_tables[id(m)] = run_mean_drift(m)
+                return drift_tables[id(m)]
 
-        loads = [model_loads(pick(models, i), pick(seas, i), dt=float(pick(dts, i)),
-                             duration=n_steps * float(pick(dts, i)), t0=t0,
-                             ramp=float(pick(ramps, i)), radiation=radiation, memory=memory,
-                             state_space_options=state_space_options, integrator=integ,
-                             extra=extra, mean_drift=run_mean_drift_of(pick(models, i)))
-                 for i in range(B)]
-        if vary_loads is not None:
-            if not callable(vary_loads):
-                raise ValueError(f"vary_loads: {vary_loads!r}; give a function (case_index, loads) "
-                                 "-> loads")
-            loads = [tuple(vary_loads(i, ld)) for i, ld in enumerate(loads)]
-        # what the compiled call is handed (loads.assembly.compile_view: the host-only fields
-        # blanked)
-        views = [compile_view(pick(models, i), loads[i]) for i in range(B)]
-        defs = {jax.tree_util.tree_structure(v[1]) for v in views}
-        if len(defs) > 1:
-            raise ValueError("simulate_batch: the cases' loads differ in structure (with "
-                             "radiation='convolution' the number of lags follows dt: give every "
-                             "case the same dt and memory, or use radiation='state_space')")
-        stack = _stacked
-        varying, shared = [v[1] for v in views], None
-        take = lambda g: (stack([varying[i] for i in g]), None)  # noqa: E731
-        model_axis = 0 if len(models) > 1 else None
-        model_of = (lambda g: stack([views[i][0] for i in g])) if model_axis == 0 \
-            else (lambda g: views[0][0])
-    q0 = jnp.asarray(initial_vector(m0, q0, "q0"))
-    qd0 = jnp.asarray(initial_vector(m0, qd0, "qd0"))
-    first = loads[0]
-    z0 = initial_states(m0, first)
+            loads = [model_loads(pick(models, i), pick(seas, i), dt=float(pick(dts, i)),
+                                 duration=n_steps * float(pick(dts, i)), t0=t0,
+                                 ramp=float(pick(ramps, i)), radiation=radiation, memory=memory,
+                                 state_space_options=state_space_options, integrator=integ,
+                                 extra=extra, mean_drift=run_mean_drift_of(pick(models, i)))
+                     for i in range(B)]
+            if vary_loads is not None:
+                if not callable(vary_loads):
+                    raise ValueError(f"vary_loads: {vary_loads!r}; give a function (case_index, loads) "
+                                     "-> loads")
+                loads = [tuple(vary_loads(i, ld)) for i, ld in enumerate(loads)]
+            # what the compiled call is handed (loads.assembly.compile_view: the host-only fields
+            # blanked)
+            views = [compile_view(pick(models, i), loads[i]) for i in range(B)]
+            defs = {jax.tree_util.tree_structure(v[1]) for v in views}
+            if len(defs) > 1:
+                raise ValueError("simulate_batch: the cases' loads differ in structure (with "
+                                 "radiation='convolution' the number of lags follows dt: give every "
+                                 "case the same dt and memory, or use radiation='state_space')")
+            stack = _stacked
+            varying, shared = [v[1] for v in views], None
+            take = lambda g: (stack([varying[i] for i in g]), None)  # noqa: E731
+            model_axis = 0 if len(models) > 1 else None
+            model_of = (lambda g: stack([views[i][0] for i in g])) if model_axis == 0 \
+                else (lambda g: views[0][0])
+        q0 = jnp.asarray(initial_vector(m0, q0, "q0"))
+        qd0 = jnp.asarray(initial_vector(m0, qd0, "qd0"))
+        first = loads[0]
+        z0 = initial_states(m0, first)
 
-    recording = Recording(outputs=outputs, states=False)     # the batch form: no z per sample
-    known = set(results.record_specs(m0, first)[0])
-    bad = [n for n in outputs if n not in known]
-    if bad:
-        raise ValueError(f"outputs: {bad} are not outputs of this model and its loads; accepted: "
-                         f"{sorted(known)}")
+        recording = Recording(outputs=outputs, states=False)     # the batch form: no z per sample
+        known = set(results.record_specs(m0, first)[0])
+        bad = [n for n in outputs if n not in known]
+        if bad:
+            raise ValueError(f"outputs: {bad} are not outputs of this model and its loads; accepted: "
+                             f"{sorted(known)}")
 
-    # the cases in `threads` parts of one size (the last padded by repeating its last case): one
-    # compiled program serves every part, each run from its own host thread
-    size = -(-B // threads)
-    lanes = min(lanes, size)
-    groups = [np.minimum(np.arange(k, k + size), B - 1) for k in range(0, B, size)]
-    args, etas = [None] * len(groups), [None] * len(groups)
+        # the cases in `threads` parts of one size (the last padded by repeating its last case): one
+        # compiled program serves every part, each run from its own host thread
+        size = -(-B // threads)
+        lanes = min(lanes, size)
+        groups = [np.minimum(np.arange(k, k + size), B - 1) for k in range(0, B, size)]
+        args, etas = [None] * len(groups), [None] * len(groups)
 
-    def arg(k):
-        """Part k's (model, loads, dt), made once, in the thread that runs it (its tables)."""
-        if args[k] is None:
-            part, etas[k] = take(groups[k])
-            args[k] = (model_of(groups[k]), part, jnp.asarray(dts_all[groups[k]]))
-        return args[k]
+        def arg(k):
+            """Part k's (model, loads, dt), made once, in the thread that runs it (its tables)."""
+            if args[k] is None:
+                part, etas[k] = take(groups[k])
+                args[k] = (model_of(groups[k]), part, jnp.asarray(dts_all[groups[k]]))
+            return args[k]
 
-    t0_ = jnp.asarray(t0, jnp.float64)
-    bar = progress_bar(progress, int(n_steps), f"{m0.name} × {B}")
-    if bar is None:
-        out = _join_parts(_in_threads(len(groups), lambda k: _batch_jit(
-            *arg(k)[:2], shared, q0, qd0, z0, t0_, arg(k)[2], model_axis=model_axis,
-            n_steps=int(n_steps), integrator=integ, save_every=int(save_every), record=recording,
-            lanes=lanes)), B)
-    else:
-        def start():
-            res = _in_threads(len(groups), lambda k: _start_batch_jit(
-                *arg(k)[:2], shared, q0, qd0, z0, t0_, arg(k)[2],
-                model_axis=model_axis, integrator=integ, record=recording, lanes=lanes))
-            return [r[0] for r in res], _join_parts([r[1] for r in res], B)
+        t0_ = jnp.asarray(t0, jnp.float64)
+        bar = progress_bar(progress, int(n_steps), f"{m0.name} × {B}")
+        if bar is None:
+            out = _join_parts(_in_threads(len(groups), lambda k: _batch_jit(
+                *arg(k)[:2], shared, q0, qd0, z0, t0_, arg(k)[2], model_axis=model_axis,
+                n_steps=int(n_steps), integrator=integ, save_every=int(save_every), record=recording,
+                lanes=lanes)), B)
+        else:
+            def start():
+                res = _in_threads(len(groups), lambda k: _start_batch_jit(
+                    *arg(k)[:2], shared, q0, qd0, z0, t0_, arg(k)[2],
+                    model_axis=model_axis, integrator=integ, record=recording, lanes=lanes))
+                return [r[0] for r in res], _join_parts([r[1] for r in res], B)
 
-        def chunk(carries, c):
-            res = _in_threads(len(groups), lambda k: _chunk_batch_jit(
-                *arg(k)[:2], shared, carries[k], arg(k)[2], model_axis=model_axis,
-                n_blocks=c, integrator=integ, save_every=int(save_every), record=recording,
-                lanes=lanes))
-            return [r[0] for r in res], _join_parts([r[1] for r in res], B)
+            def chunk(carries, c):
+                res = _in_threads(len(groups), lambda k: _chunk_batch_jit(
+                    *arg(k)[:2], shared, carries[k], arg(k)[2], model_axis=model_axis,
+                    n_blocks=c, integrator=integ, save_every=int(save_every), record=recording,
+                    lanes=lanes))
+                return [r[0] for r in res], _join_parts([r[1] for r in res], B)
 
-        out = run_chunked(start, chunk, int(n_steps) // int(save_every), int(save_every), bar,
-                           time_axis=1)
-    if isinstance(loads, CaseLoads) and loads.waves is not None:
-        # the elevation for the dataset, from the tables the device made
-        loads = loads.with_eta(np.concatenate([np.asarray(e) for e in etas])[:B])
-    t, q, qd = (np.asarray(a) for a in out[:3])
-    for i in range(B):
-        if not (np.isfinite(q[i]).all() and np.isfinite(qd[i]).all()):
-            k = int(np.argmax(~np.isfinite(q[i]).all(axis=1) | ~np.isfinite(qd[i]).all(axis=1)))
-            raise SimulationError(f"simulate_batch: case {i} went non-finite at t = {t[i, k]:.6g} s "
-                                  f"(dt = {pick(dts, i):.4g} s); run it alone with mfm.simulate "
-                                  "for the diagnosis")
-    settings = dict(radiation=radiation, n_steps=int(n_steps), t0=t0, lanes=lanes,
-                    ramp_s=repr(ramps.tolist()), seas=repr(seas))
-    labels = results.sea_labels(seas) if len(seas) == B else {}
-    recorded = {k: np.asarray(v) for k, v in out[6].items()} if outputs else {}
-    return results.batch(m0, [pick(models, i) for i in range(B)], loads, integ, t, q, qd, dts,
-                         settings, save_every, labels, recorded)
+            out = run_chunked(start, chunk, int(n_steps) // int(save_every), int(save_every), bar,
+                               time_axis=1)
+        if isinstance(loads, CaseLoads) and loads.waves is not None:
+            # the elevation for the dataset, from the tables the device made
+            loads = loads.with_eta(np.concatenate([np.asarray(e) for e in etas])[:B])
+        t, q, qd = (np.asarray(a) for a in out[:3])
+        for i in range(B):
+            if not (np.isfinite(q[i]).all() and np.isfinite(qd[i]).all()):
+                k = int(np.argmax(~np.isfinite(q[i]).all(axis=1) | ~np.isfinite(qd[i]).all(axis=1)))
+                raise SimulationError(f"simulate_batch: case {i} went non-finite at t = {t[i, k]:.6g} s "
+                                      f"(dt = {pick(dts, i):.4g} s); run it alone with mfm.simulate "
+                                      "for the diagnosis")
+        settings = dict(radiation=radiation, n_steps=int(n_steps), t0=t0, lanes=lanes,
+                        ramp_s=repr(ramps.tolist()), seas=repr(seas))
+        labels = results.sea_labels(seas) if len(seas) == B else {}
+        recorded = {k: np.asarray(v) for k, v in out[6].items()} if outputs else {}
+        return results.batch(m0, [pick(models, i) for i in range(B)], loads, integ, t, q, qd, dts,
+                             settings, save_every, labels, recorded)

@@ -30,7 +30,6 @@ from .progress import phase, progress_bar, progress_options
 from .threads import background, keeping_interrupts, result
 
 
-@keeping_interrupts
 def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="rk4",
              q0=None, qd0=None, loads=None, save_every: int = 1, t0: float = 0.0,
              ramp: float = 0.0, radiation: str = "auto", memory: float | None = None,
@@ -101,153 +100,154 @@ def simulate(model: Model, sea=None, *, duration: float, dt: float, integrator="
     Raises :class:`SimulationError` when the state goes non-finite; its ``dataset`` holds the run
     up to the last finite sample.
     """
-    model = check_model(model)
-    check_sea_read(model, as_loads(loads), [sea])
-    # a strategy object or its string alias, with the string API's side options
-    radiation, memory, state_space_options = resolve_radiation(radiation, memory,
-                                                               state_space_options)
-    dt = finite_number(dt, "dt", positive=True)
-    duration = finite_number(duration, "duration", positive=True)
-    t0 = finite_number(t0, "t0")
-    ramp = finite_number(ramp, "ramp", nonnegative=True)
-    memory = finite_number(memory, "memory", positive=True, allow_none=True)
-    progress = progress_options(progress)
-    if compile not in ("default", "fast"):
-        raise ValueError(f"compile={compile!r}; accepted: 'default' (XLA's optimised programs) or "
-                         "'fast' (its lowest optimisation level: a cheaper first compilation, "
-                         "slower steps, other last bits)")
-    fast = compile == "fast"
-    n_steps = int(round(duration / dt))
-    if n_steps < 1:
-        raise ValueError(f"duration = {duration} s is shorter than one step dt = {dt} s")
-    if not whole_number(save_every) or n_steps % save_every:
-        raise ValueError(f"save_every: {save_every!r} must be a positive divisor of the {n_steps} "
-                         "steps")
-    extra = as_loads(loads)
-    refuse_impossible(model, extra + tuple(model.loads), n_steps, save_every)
-    integ = _integrators.get(integrator)
-    if added_mass not in ("lhs", "rhs"):
-        raise ValueError(f"added_mass={added_mass!r}; accepted: 'lhs' (A∞ in M*), 'rhs' (Lande-Sudall et al.)")
-    if added_mass == "rhs" and integ.name != "beeman":
-        raise ValueError(f"added_mass='rhs' (the scheme of Lande-Sudall et al.) iterates the acceleration in "
-                         f"Beeman's corrector; integrator={integ.name!r} has none: use "
-                         "integrator='beeman' or added_mass='lhs'")
-    choice = "given"
-    auto = radiation == "auto"
-    if auto:
-        # the convolution or the state space now; how the state space's states advance once its
-        # fit is made (below, beside the jet's compilation): choose_radiation in two halves
-        radiation, choice = convolution_or_state_space(model, dt=dt, n_steps=n_steps,
-                                                       integrator=integ, memory=memory)
-        if model.hydro is None:
-            radiation = "convolution"          # no water: nothing to choose
-    if radiation == "convolution":
-        refuse_convolution(model, dt=dt, memory=memory, n_offsets=len(stage_offsets(integ)),
-                           why=choice if auto else "")
-    q0 = initial_vector(model, q0, "q0")
-    qd0 = initial_vector(model, qd0, "qd0")
-    free = []
-    judged = {}
-    # The checks' linearisation at q0 (the model's jet at rest, ~6 s to compile for M4 134)
-    # compiles on a second thread while this one builds the run's water (its radiation fit, in
-    # numpy) and compiles the run. An error here returns at once: that compilation finishes on
-    # its own.
-    # the bar from the start, so that a long preparation shows its phase: the radiation fit
-    # (seconds to a minute for 90 dofs) used to run under a bar that said "compiling"
-    bar = progress_bar(progress, n_steps, model.name)
-    fit = model.hydro is not None and radiation.startswith("state_space")
-    phase(bar, "preparing the loads" + (" (the radiation's state-space fit: up to a minute)"
-                                        if fit else ""))
-    try:
-        if check_stability:
-            # still water's loads at rest have the structure of the run's, so the jet compiles
-            # while this thread builds the run's water (its radiation fit) and is then evaluated
-            # with the run's own loads; on a daemon thread, which a Ctrl-C does not wait for
-            # (mfm.runner.threads)
-            ahead = background(rest.compile_jet, model, rest.still_water_loads(
-                model, extra, added_mass=added_mass, stage_offsets=stage_offsets(integ)), q0)
-        # the fit says how far it is (its orders, its passivity iterations) on the bar
-        with phases.reporting(None if bar is None else
-                              (lambda what: phase(bar, f"preparing the loads: {what}"))):
-            if auto and radiation == "state_space_exact":
-                radiation, how = state_space_update(model, dt=dt, integrator=integ,
-                                                    state_space_options=state_space_options)
-                choice = f"{choice}; {how}"
-            # [hydro] drift on a database with the layout's Kochin functions: the drift of the
-            # model's own motions (mfm.frequency.drift), made once for the run
-            drift_table = run_mean_drift(model) if sea is not None else None
-            loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
-                                radiation=radiation, memory=memory,
-                                state_space_options=state_space_options, added_mass=added_mass,
-                                integrator=integ, extra=extra, mean_drift=drift_table)
-        # the recorded run (its programs: the whole run, or its start and chunks), compiled here:
-        # beside the jet's compilation where the water builds faster than that (no fit), and
-        # before the checks' warnings
-        phase(bar, "compiling")
-        run = prepare_run(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
-                          save_every=save_every, t0=t0, recording=OUTPUTS,
-                          chunked=bar is not None, fast=fast)
-        if check_stability:
-            phase(bar, "linearising at q0 for the checks")
-            result(ahead)
-            # one linearisation at q0 gives the shortest period and the coordinates that nothing
-            # pulls back (those of no_restoring(model, q0, loads=<the extra loads>), `mfm info`'s)
-            J, K = rest.linearised_at_rest(model, q0, loads)
-            free = rest.free_coordinates(model, K)
-        if auto and radiation.startswith("state_space"):
-            # the fit judged on the model's own modes and its response to the sea
-            # (mfm.frequency.fitcheck), from the checks' compiled linearisation; past its
-            # tolerances the run is remade with the convolution, which has no fit to be wrong
-            phase(bar, "judging the radiation fit on the model's modes")
-            verdict = judge_radiation(model, loads=extra, sea=sea, duration=duration,
-                                      state_space_options=state_space_options,
-                                      added_mass=added_mass, stage_offsets=stage_offsets(integ),
-                                      q0=q0)
-            judged = verdict.attrs()
-            radiation, choice = judged_choice(radiation, choice, verdict)
-            if not verdict.ok:
-                refuse_convolution(model, dt=dt, memory=memory,
-                                   n_offsets=len(stage_offsets(integ)),
-                                   why=f"'auto': {verdict.summary}, and the convolution that "
-                                       "replaces a fit judged off is too large")
-                phase(bar, "preparing the loads (the convolution)")
+    with keeping_interrupts():
+        model = check_model(model)
+        check_sea_read(model, as_loads(loads), [sea])
+        # a strategy object or its string alias, with the string API's side options
+        radiation, memory, state_space_options = resolve_radiation(radiation, memory,
+                                                                   state_space_options)
+        dt = finite_number(dt, "dt", positive=True)
+        duration = finite_number(duration, "duration", positive=True)
+        t0 = finite_number(t0, "t0")
+        ramp = finite_number(ramp, "ramp", nonnegative=True)
+        memory = finite_number(memory, "memory", positive=True, allow_none=True)
+        progress = progress_options(progress)
+        if compile not in ("default", "fast"):
+            raise ValueError(f"compile={compile!r}; accepted: 'default' (XLA's optimised programs) or "
+                             "'fast' (its lowest optimisation level: a cheaper first compilation, "
+                             "slower steps, other last bits)")
+        fast = compile == "fast"
+        n_steps = int(round(duration / dt))
+        if n_steps < 1:
+            raise ValueError(f"duration = {duration} s is shorter than one step dt = {dt} s")
+        if not whole_number(save_every) or n_steps % save_every:
+            raise ValueError(f"save_every: {save_every!r} must be a positive divisor of the {n_steps} "
+                             "steps")
+        extra = as_loads(loads)
+        refuse_impossible(model, extra + tuple(model.loads), n_steps, save_every)
+        integ = _integrators.get(integrator)
+        if added_mass not in ("lhs", "rhs"):
+            raise ValueError(f"added_mass={added_mass!r}; accepted: 'lhs' (A∞ in M*), 'rhs' (Lande-Sudall et al.)")
+        if added_mass == "rhs" and integ.name != "beeman":
+            raise ValueError(f"added_mass='rhs' (the scheme of Lande-Sudall et al.) iterates the acceleration in "
+                             f"Beeman's corrector; integrator={integ.name!r} has none: use "
+                             "integrator='beeman' or added_mass='lhs'")
+        choice = "given"
+        auto = radiation == "auto"
+        if auto:
+            # the convolution or the state space now; how the state space's states advance once its
+            # fit is made (below, beside the jet's compilation): choose_radiation in two halves
+            radiation, choice = convolution_or_state_space(model, dt=dt, n_steps=n_steps,
+                                                           integrator=integ, memory=memory)
+            if model.hydro is None:
+                radiation = "convolution"          # no water: nothing to choose
+        if radiation == "convolution":
+            refuse_convolution(model, dt=dt, memory=memory, n_offsets=len(stage_offsets(integ)),
+                               why=choice if auto else "")
+        q0 = initial_vector(model, q0, "q0")
+        qd0 = initial_vector(model, qd0, "qd0")
+        free = []
+        judged = {}
+        # The checks' linearisation at q0 (the model's jet at rest, ~6 s to compile for M4 134)
+        # compiles on a second thread while this one builds the run's water (its radiation fit, in
+        # numpy) and compiles the run. An error here returns at once: that compilation finishes on
+        # its own.
+        # the bar from the start, so that a long preparation shows its phase: the radiation fit
+        # (seconds to a minute for 90 dofs) used to run under a bar that said "compiling"
+        bar = progress_bar(progress, n_steps, model.name)
+        fit = model.hydro is not None and radiation.startswith("state_space")
+        phase(bar, "preparing the loads" + (" (the radiation's state-space fit: up to a minute)"
+                                            if fit else ""))
+        try:
+            if check_stability:
+                # still water's loads at rest have the structure of the run's, so the jet compiles
+                # while this thread builds the run's water (its radiation fit) and is then evaluated
+                # with the run's own loads; on a daemon thread, which a Ctrl-C does not wait for
+                # (mfm.runner.threads)
+                ahead = background(rest.compile_jet, model, rest.still_water_loads(
+                    model, extra, added_mass=added_mass, stage_offsets=stage_offsets(integ)), q0)
+            # the fit says how far it is (its orders, its passivity iterations) on the bar
+            with phases.reporting(None if bar is None else
+                                  (lambda what: phase(bar, f"preparing the loads: {what}"))):
+                if auto and radiation == "state_space_exact":
+                    radiation, how = state_space_update(model, dt=dt, integrator=integ,
+                                                        state_space_options=state_space_options)
+                    choice = f"{choice}; {how}"
+                # [hydro] drift on a database with the layout's Kochin functions: the drift of the
+                # model's own motions (mfm.frequency.drift), made once for the run
+                drift_table = run_mean_drift(model) if sea is not None else None
                 loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
-                                    radiation=radiation, memory=memory, added_mass=added_mass,
+                                    radiation=radiation, memory=memory,
+                                    state_space_options=state_space_options, added_mass=added_mass,
                                     integrator=integ, extra=extra, mean_drift=drift_table)
-                phase(bar, "compiling")
-                run = prepare_run(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ,
-                                  loads=loads, save_every=save_every, t0=t0, recording=OUTPUTS,
-                                  chunked=bar is not None, fast=fast)
-    except BaseException:
-        if bar is not None:
-            bar.close()
-        raise
-    if check_stability:
-        warn_stability(integ, dt, rest.period_from_jacobian(J))
-    if sea is not None:
-        warn_accuracy(model, sea, dt, integ)
-    warn_verlet_drift(integ, free)
-    out = run(bar)
-    t, q, qd, qdd, z, iters = (np.asarray(a) for a in out[:6])
-    rec = {k: np.asarray(v) for k, v in out[6].items()}
-    settings = dict(duration=duration, n_steps=n_steps, save_every=int(save_every), t0=t0,
-                    complete="true", ramp_s=ramp, memory_s=memory,
-                    sea="still water" if sea is None else repr(sea),
-                    sea_label="still water" if sea is None else str(sea), radiation_choice=choice,
-                    compile=compile,
-                    no_restoring=", ".join(free) if check_stability else "not checked",
-                    **judged)
-    finite = np.isfinite(q).all(axis=1) & np.isfinite(qd).all(axis=1)
-    if not finite.all():
-        k = int(np.argmax(~finite))
-        message = nonfinite_message(model, integ, t, q, qd, dt, loads, k)
-        partial = None
-        if k > 0:
-            keep = slice(0, k)
-            settings.update(complete="false", stopped=message)
-            partial = results.time_series(model, loads, integ, dt, t[keep], q[keep], qd[keep],
-                                          rec["qdd"][keep], iters[keep],
-                                          {n: v[keep] for n, v in rec.items()}, settings)
-        raise SimulationError(message + (f" The run up to t = {t[k - 1]:.6g} s is in this error's "
-                                         "`dataset`." if partial is not None else ""), partial)
-    return results.time_series(model, loads, integ, dt, t, q, qd, rec["qdd"], iters, rec, settings)
+            # the recorded run (its programs: the whole run, or its start and chunks), compiled here:
+            # beside the jet's compilation where the water builds faster than that (no fit), and
+            # before the checks' warnings
+            phase(bar, "compiling")
+            run = prepare_run(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ, loads=loads,
+                              save_every=save_every, t0=t0, recording=OUTPUTS,
+                              chunked=bar is not None, fast=fast)
+            if check_stability:
+                phase(bar, "linearising at q0 for the checks")
+                result(ahead)
+                # one linearisation at q0 gives the shortest period and the coordinates that nothing
+                # pulls back (those of no_restoring(model, q0, loads=<the extra loads>), `mfm info`'s)
+                J, K = rest.linearised_at_rest(model, q0, loads)
+                free = rest.free_coordinates(model, K)
+            if auto and radiation.startswith("state_space"):
+                # the fit judged on the model's own modes and its response to the sea
+                # (mfm.frequency.fitcheck), from the checks' compiled linearisation; past its
+                # tolerances the run is remade with the convolution, which has no fit to be wrong
+                phase(bar, "judging the radiation fit on the model's modes")
+                verdict = judge_radiation(model, loads=extra, sea=sea, duration=duration,
+                                          state_space_options=state_space_options,
+                                          added_mass=added_mass, stage_offsets=stage_offsets(integ),
+                                          q0=q0)
+                judged = verdict.attrs()
+                radiation, choice = judged_choice(radiation, choice, verdict)
+                if not verdict.ok:
+                    refuse_convolution(model, dt=dt, memory=memory,
+                                       n_offsets=len(stage_offsets(integ)),
+                                       why=f"'auto': {verdict.summary}, and the convolution that "
+                                           "replaces a fit judged off is too large")
+                    phase(bar, "preparing the loads (the convolution)")
+                    loads = model_loads(model, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
+                                        radiation=radiation, memory=memory, added_mass=added_mass,
+                                        integrator=integ, extra=extra, mean_drift=drift_table)
+                    phase(bar, "compiling")
+                    run = prepare_run(model, q0, qd0, dt=dt, n_steps=n_steps, integrator=integ,
+                                      loads=loads, save_every=save_every, t0=t0, recording=OUTPUTS,
+                                      chunked=bar is not None, fast=fast)
+        except BaseException:
+            if bar is not None:
+                bar.close()
+            raise
+        if check_stability:
+            warn_stability(integ, dt, rest.period_from_jacobian(J))
+        if sea is not None:
+            warn_accuracy(model, sea, dt, integ)
+        warn_verlet_drift(integ, free)
+        out = run(bar)
+        t, q, qd, qdd, z, iters = (np.asarray(a) for a in out[:6])
+        rec = {k: np.asarray(v) for k, v in out[6].items()}
+        settings = dict(duration=duration, n_steps=n_steps, save_every=int(save_every), t0=t0,
+                        complete="true", ramp_s=ramp, memory_s=memory,
+                        sea="still water" if sea is None else repr(sea),
+                        sea_label="still water" if sea is None else str(sea), radiation_choice=choice,
+                        compile=compile,
+                        no_restoring=", ".join(free) if check_stability else "not checked",
+                        **judged)
+        finite = np.isfinite(q).all(axis=1) & np.isfinite(qd).all(axis=1)
+        if not finite.all():
+            k = int(np.argmax(~finite))
+            message = nonfinite_message(model, integ, t, q, qd, dt, loads, k)
+            partial = None
+            if k > 0:
+                keep = slice(0, k)
+                settings.update(complete="false", stopped=message)
+                partial = results.time_series(model, loads, integ, dt, t[keep], q[keep], qd[keep],
+                                              rec["qdd"][keep], iters[keep],
+                                              {n: v[keep] for n, v in rec.items()}, settings)
+            raise SimulationError(message + (f" The run up to t = {t[k - 1]:.6g} s is in this error's "
+                                             "`dataset`." if partial is not None else ""), partial)
+        return results.time_series(model, loads, integ, dt, t, q, qd, rec["qdd"], iters, rec, settings)

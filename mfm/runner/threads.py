@@ -29,8 +29,8 @@ from __future__ import annotations
 
 import atexit
 import concurrent.futures
+import contextlib
 import contextvars
-import functools
 import os
 import queue
 import signal
@@ -107,38 +107,39 @@ def interrupted() -> None:
                                 "Python only prints (the traceback above), raised again here")
 
 
-def keeping_interrupts(fn):
-    """``fn`` with the Ctrl-C's that Python loses raised again (module docstring). In the main
-    thread, with a Python SIGINT handler (not ignored, not the OS default), that handler is
-    wrapped for the call: an interrupt it raises is counted, the exception left as it was; a
-    handler that does not raise (a script's own graceful stop) is not changed. On return a
-    counted interrupt is raised. The handler is given back on the way out, whatever happens."""
-    @functools.wraps(fn)
-    def call(*args, **kwargs):
-        if threading.current_thread() is not threading.main_thread():
-            return fn(*args, **kwargs)
-        previous = signal.getsignal(signal.SIGINT)
-        if not callable(previous):
-            return fn(*args, **kwargs)
-        kept = []
+@contextlib.contextmanager
+def keeping_interrupts():
+    """A block (a front door's body) in which the Ctrl-C's that Python loses are raised again
+    (module docstring). In the main thread, with a Python SIGINT handler (not ignored, not the OS
+    default), that handler is wrapped for the block: an interrupt it raises is counted, the
+    exception left as it was; a handler that does not raise (a script's own graceful stop) is
+    not changed. A block that ends normally with an interrupt counted raises it. The handler is
+    given back on the way out, whatever happens. A context manager, not a decorator, so that the
+    warnings of the front door keep pointing at its caller."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.getsignal(signal.SIGINT)
+    if not callable(previous):
+        yield
+        return
+    kept: list = []
 
-        def handler(signum, frame):
-            try:
-                previous(signum, frame)
-            except KeyboardInterrupt:
-                kept.append(signum)
-                raise
-
-        signal.signal(signal.SIGINT, handler)
-        _KEPT.append(kept)
+    def handler(signum, frame):
         try:
-            out = fn(*args, **kwargs)
-            interrupted()
-            return out
-        finally:
-            _KEPT.pop()
-            signal.signal(signal.SIGINT, previous)
-    return call
+            previous(signum, frame)
+        except KeyboardInterrupt:
+            kept.append(signum)
+            raise
+
+    signal.signal(signal.SIGINT, handler)
+    _KEPT.append(kept)
+    try:
+        yield
+        interrupted()
+    finally:
+        _KEPT.pop()
+        signal.signal(signal.SIGINT, previous)
 
 
 def result(future: concurrent.futures.Future):
