@@ -129,7 +129,12 @@ from mfm.runner.threads import keeping_interrupts
 armed = []
 
 def interrupt_inside_gc(phase, info):
+    # armed with a count: the interrupt at that collection (simulate's at its 5th, well inside
+    # its body: not one that its arguments' allocations might start)
     if armed and phase == "start":
+        armed[0] -= 1
+        if armed[0]:
+            return
         armed.pop()
         os.kill(os.getpid(), signal.SIGINT)
         for _ in range(1000):      # bytecode, where Python runs the handler
@@ -156,9 +161,9 @@ def kept():
 print("plain", outcome(work))
 print("kept", outcome(kept))
 m = mfm.load(%r)
-armed.append(1)
-print("simulate", outcome(lambda: mfm.simulate(m, hydro.Regular(height=1.0, period=8.0),
-                                               duration=20.0, dt=0.1)))
+sea = hydro.Regular(height=1.0, period=8.0)
+armed.append(5)
+print("simulate", outcome(lambda: mfm.simulate(m, sea, duration=20.0, dt=0.1)))
 print("handler", signal.getsignal(signal.SIGINT) is signal.default_int_handler)
 """
 
@@ -176,7 +181,9 @@ def test_a_ctrl_c_that_python_prints_and_forgets_is_raised_again(tmp_path):
     said = dict(line.split(" ", 1) for line in out.stdout.splitlines())
     assert said == {"plain": "went on", "kept": "raised", "simulate": "raised",
                     "handler": "True"}, (said, out.stderr[-3000:])
-    assert out.stderr.count("Exception ignored in") == 3, out.stderr[-3000:]
+    # the first two in the main thread (an explicit gc.collect()); simulate's collection may
+    # run on a compile thread, where the interrupt is then raised in the main thread's own code
+    assert out.stderr.count("Exception ignored in") >= 2, out.stderr[-3000:]
 
 
 def _files(folder):
