@@ -465,7 +465,9 @@ def _asymmetry(name, M, labels, om, rtol):
 
 def _negative_damping(B, labels, om, noise):
     """The most negative damping beyond `noise` as (("negative_damping", dof, dof), −its fraction
-    of the peak, message), or None."""
+    of the peak, message), or None; the message also names every other dof negative beyond it,
+    with its worst value (the RM3 hulls revolved by tools/rm3_bem_mesh.py: the float's heave was
+    named, the spar's pitch, as far off, was not)."""
     diag = np.diagonal(B, axis1=1, axis2=2)                  # (omega, dof)
     peak = np.abs(diag).max(axis=0)
     # a dof whose damping is negligible beside the others of its kind (translation / rotation),
@@ -480,9 +482,23 @@ def _negative_damping(B, labels, om, noise):
         return (("negative_damping", labels[i], labels[i]), float(-rel[k, i]),
             f"radiation_damping diagonal is negative beyond the noise tolerance {noise:g} of its "
             f"peak: B[{labels[i]}] = {diag[k, i]:.4g} at omega = {om[k]:.4g} rad/s "
-            f"({rel[k, i]:.3g} of its peak {peak[i]:.4g}). Irregular frequency or unconverged "
-            "mesh? Use a lid / finer mesh, or taper the damping before the impulse response.")
+            f"({rel[k, i]:.3g} of its peak {peak[i]:.4g}).{_also_negative(diag, rel, bad, peak, i, labels, om)} "
+            "Irregular frequency or unconverged mesh? Use a lid / finer mesh, or taper the "
+            "damping before the impulse response.")
     return None
+
+
+def _also_negative(diag, rel, bad, peak, worst, labels, om) -> str:
+    """' Also negative: B[dof] = … at omega = … (… of its peak), …' for every dof but ``worst``
+    with a negative damping beyond the noise (each at its most negative), or ''."""
+    parts = []
+    for i in range(diag.shape[1]):
+        if i == worst or peak[i] <= 0 or not bad[:, i].any():
+            continue
+        k = int(np.argmin(rel[:, i]))
+        parts.append(f"B[{labels[i]}] = {diag[k, i]:.4g} at omega = {om[k]:.4g} rad/s "
+                     f"({rel[k, i]:.3g} of its peak)")
+    return f" Also negative: {'; '.join(parts)}." if parts else ""
 
 
 # ------------------------------------------------------------------------------------ NetCDF I/O

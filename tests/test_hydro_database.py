@@ -196,6 +196,12 @@ def test_validate_reports_each_bad_input(sphere, rm3, monkeypatch):
     neg["radiation_damping"][10, 2, 2] = -0.1 * float(neg.radiation_damping[:, 2, 2].max())
     with pytest.warns(D.HydroDatabaseWarning, match=r"B\[sphere__Heave\].*omega = 1\.1 rad/s"):
         D.validate(neg)
+    # every dof negative beyond the noise is named, not only the worst
+    monkeypatch.setattr(D, "_WARNED", set())
+    neg["radiation_damping"][20, 0, 0] = -0.05 * float(neg.radiation_damping[:, 0, 0].max())
+    with pytest.warns(D.HydroDatabaseWarning, match=r"B\[sphere__Heave\].*Also negative: "
+                      r"B\[sphere__Surge\] = .*\(-0\.05 of its peak\)"):
+        D.validate(neg)
     # the RM3 WAMIT data are asymmetric (float sway–roll A∞ by 15 %): warned, with the dofs
     with warnings.catch_warnings(record=True) as rec:
         warnings.simplefilter("always")
