@@ -101,8 +101,10 @@ _LOOK_S = 0.05
 def interrupted() -> None:
     """Raise KeyboardInterrupt if a Ctrl-C was raised by Python's handler inside the current
     :func:`keeping_interrupts` block and the run still goes on: the interrupt was lost in a
-    callback whose exceptions Python only prints (see the module's docstring)."""
-    if _KEPT and _KEPT[-1]:
+    callback whose exceptions Python only prints (see the module's docstring). Only in the main
+    thread, where the blocks and the signal's handler are: another thread's run (a script's own
+    thread calling simulate) goes on."""
+    if _KEPT and _KEPT[-1] and threading.current_thread() is threading.main_thread():
         raise KeyboardInterrupt("mfm: a Ctrl-C raised inside a callback whose exceptions "
                                 "Python only prints (the traceback above), raised again here")
 
