@@ -404,26 +404,25 @@ def mean_drift(md) -> xr.DataArray:
                         attrs=dict(md.attrs), name="mean_drift")
 
 
-def linear_outputs(model, loads, kin0) -> dict:
-    """Every load's :meth:`~mfm.loads.base.Load.linear_outputs` at ``kin0``, merged: name → (dims,
-    y₀, L, attrs), and "coords"."""
+def linear_outputs(model, loads, kin0) -> tuple[dict, dict]:
+    """Every load's :meth:`~mfm.loads.base.Load.linear_outputs` at ``kin0``, merged: ({name →
+    (dims, y₀, L, attrs)}, their coordinates)."""
     out, coords = {}, {}
     for ld in loads:
         got = dict(ld.linear_outputs(model, kin0))
         coords.update(got.pop("coords", {}))
         out.update(got)
-    return {**out, "coords": coords} if out else {}
+    return out, coords
 
 
-def add_linear_outputs(ds, outs, q0, q=None, lead=("time",), rms=None) -> xr.Dataset:
-    """``ds`` with the linear levels' outputs of the loads (``outs``: :func:`linear_outputs`):
-    ``<name>`` (lead…, dims) = y₀ + L (q − q₀) where ``q`` (lead…, n_q) is given, the value at the
-    equilibrium ``<name>_equilibrium`` (dims), and where ``rms`` {name: (case, k)} is given (the
-    spectral level's Σ ½ a² |L x̂|²) ``<name>_rms`` (case, dims)."""
+def add_linear_outputs(ds, outs, coords, q0, q=None, lead=("time",), rms=None) -> xr.Dataset:
+    """``ds`` with the linear levels' outputs of the loads (``outs``, ``coords``:
+    :func:`linear_outputs`): ``<name>`` (lead…, dims) = y₀ + L (q − q₀) where ``q`` (lead…, n_q)
+    is given, the value at the equilibrium ``<name>_equilibrium`` (dims), and where ``rms``
+    {name: (case, k)} is given (the spectral level's Σ ½ a² |L x̂|²) ``<name>_rms`` (case, dims)."""
     if not outs:
         return ds
-    outs = dict(outs)
-    ds = ds.assign_coords(outs.pop("coords"))
+    ds = ds.assign_coords(coords)
     for name, (dims, y0, L, attrs) in outs.items():
         y0, L = np.asarray(y0, float), np.asarray(L, float)
         units = attrs.get("units", "")

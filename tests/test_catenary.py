@@ -344,6 +344,14 @@ def test_tension_rao_is_the_lines_own_linearisation(lines):
         assert abs(rao[0, k].real / dT - 1) < 1e-4, (k, rao[0, k], dT)
 
 
+def sphere_lines(com):
+    """Three light lines on the floating sphere, 120° apart, their fairleads at its CoM."""
+    return [{"name": f"S{k}", "body": "sphere", "fairlead": list(com),
+             "anchor": [30 * math.cos(a), 30 * math.sin(a), -20.0], "length": 40.0, "weight": 5.0,
+             "EA": 1e7, "table_extent": [3.0, 3.0], "table_step": [0.2, 0.2]}
+            for k, a in enumerate(np.radians([0.0, 120.0, 240.0]))]
+
+
 @pytest.mark.filterwarnings("ignore::hydro.database.HydroDatabaseWarning")
 def test_tension_rao_in_frequency_response():
     # three light lines on the floating sphere (surge, heave, pitch; fairlead at the CoM): the
@@ -353,10 +361,7 @@ def test_tension_rao_in_frequency_response():
 
     m = mfm.load(CONFIGS / "sphere.toml")
     com = np.asarray(m.com[m.body_index("sphere")])
-    angles = np.radians([0.0, 120.0, 240.0])
-    lines = [{"name": f"S{k}", "body": "sphere", "fairlead": list(com),
-              "anchor": [30 * math.cos(a), 30 * math.sin(a), -20.0], "length": 40.0, "weight": 5.0,
-              "EA": 1e7, "table_extent": [3.0, 3.0], "table_step": [0.2, 0.2]} for k, a in enumerate(angles)]
+    lines = sphere_lines(com)
     ld = CatenaryLines.create(m, lines)
     fr = mfm.frequency_response(m, [1.5, 2.0], loads=ld)
     rao = fr.fairlead_tension_rao
@@ -757,11 +762,7 @@ def test_every_level_of_the_ladder_reports_the_line_tensions():
 
     m = mfm.load(CONFIGS / "sphere.toml")
     com = np.asarray(m.com[m.body_index("sphere")])
-    angles = np.radians([0.0, 120.0, 240.0])
-    lines = [{"name": f"S{k}", "body": "sphere", "fairlead": list(com),
-              "anchor": [30 * math.cos(a), 30 * math.sin(a), -20.0], "length": 40.0, "weight": 5.0,
-              "EA": 1e7, "table_extent": [3.0, 3.0], "table_step": [0.2, 0.2]}
-             for k, a in enumerate(angles)]
+    lines = sphere_lines(com)
     moored = dataclasses.replace(m, loads=tuple(m.loads) + (CatenaryLines.create(m, lines),))
     T = 4.0
     import hydro

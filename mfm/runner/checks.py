@@ -149,6 +149,13 @@ def refuse_impossible(model, loads, n_steps, save_every, *, cases=1, every_outpu
 KERNEL_SUBDIVISIONS = 16
 
 
+def _convolution_lags(spec, dt: float, memory) -> tuple[float, int]:
+    """(T_K, N): the convolution's memory (s; ``memory``, or from the decay of K) and its
+    lags N = max(⌈T_K/dt⌉, 2) + 1, as :meth:`hydro.prepare.HydroSpec.kernel` counts them."""
+    T_K = spec.memory() if memory is None else float(memory)
+    return T_K, max(int(math.ceil(T_K / dt)), 2) + 1
+
+
 def convolution_bytes(spec, dt: float, memory, n_offsets: int) -> float:
     """An estimate (bytes) of the peak that building the convolution's weights takes
     (:meth:`mfm.loads.radiation.Convolution.build`, :meth:`hydro.prepare.HydroSpec.kernel`), at
@@ -162,8 +169,7 @@ def convolution_bytes(spec, dt: float, memory, n_offsets: int) -> float:
     integration, and the weights. The constants are measured (numpy's allocations under
     ``tracemalloc``) on the sphere, RM3, M4 134, Stansby & Li and Wu & Yuan model 1: the estimate
     is 1 % to 16 % above each one's peak."""
-    T_K = spec.memory() if memory is None else float(memory)
-    N = max(int(math.ceil(T_K / dt)), 2) + 1
+    _, N = _convolution_lags(spec, dt, memory)
     n, n_all = len(spec.moving), len(spec.A_inf_db)
     n_omega = int(spec.database()["omega"].size)
     n_tau = (N + 1) * KERNEL_SUBDIVISIONS + 1
@@ -184,8 +190,7 @@ def refuse_convolution(model, *, dt: float, memory, n_offsets: int, why: str = "
     have, limit = usable_memory()
     if not have or need <= have:
         return
-    T_K = spec.memory() if memory is None else float(memory)
-    N = max(int(math.ceil(T_K / dt)), 2) + 1
+    T_K, N = _convolution_lags(spec, dt, memory)
     n = len(spec.moving)
     raise ValueError(
         f"radiation: {why + ': ' if why else ''}the convolution's weights (memory T_K "

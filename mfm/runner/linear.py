@@ -317,7 +317,7 @@ def linear_response(model: Model, sea, *, duration: float, dt: float, ramp: floa
     ds = results.linear_time_series(model, sys.loads + (rad,), ts, q, qd, qdd, sys.q0, eta,
                                     settings, source=spec.source,
                                     dampers=load_dampers(sys.loads, sys.kin0))
-    ds = results.add_linear_outputs(ds, results.linear_outputs(model, sys.loads, sys.kin0),
+    ds = results.add_linear_outputs(ds, *results.linear_outputs(model, sys.loads, sys.kin0),
                                     sys.q0, q)
     if groups:
         ds = results.drag_linearisation(ds, groups, drag["C"][0], drag["sigma"][0], case=False)

@@ -256,13 +256,14 @@ def _sweep(model, seas, labels, *, t, q0, loads, radiation, state_space_options,
                           series, start)
     # what the loads record in the time domain, to first order (a catenary's fairlead tension):
     # its standard deviation from the RAOs, its series from the synthesised q
-    outs = results.linear_outputs(model, sys.loads, sys.kin0)
+    outs, coords = results.linear_outputs(model, sys.loads, sys.kin0)
     if outs:
         rms = {name: np.stack([np.sqrt(np.sum(0.5 * cm.amplitude[:, None] ** 2
                                               * np.abs(x @ np.asarray(L).T) ** 2, axis=0))
                                for cm, x in zip(comps, xs)])
-               for name, (_, _, L, _) in ((k, v) for k, v in outs.items() if k != "coords")}
-        ds = results.add_linear_outputs(ds, outs, sys.q0, None if series is None else series[1],
+               for name, (_, _, L, _) in outs.items()}
+        ds = results.add_linear_outputs(ds, outs, coords, sys.q0,
+                                        None if series is None else series[1],
                                         lead=("case", "step"), rms=rms)
     if groups:
         ds = results.drag_linearisation(ds, groups, drag["C"], drag["sigma"])
