@@ -101,6 +101,23 @@ def test_the_nonlinear_level_in_a_batch_is_each_case_s_run():
     assert np.isfinite(again.q.values).all() and np.ptp(again.q.values[0, :, 1]) > 0.05
 
 
+@pytest.mark.parametrize("lanes", [3, 1])
+def test_the_held_nonlinear_level_in_a_batch_is_each_case_s_run(lanes):
+    """[hydro] nonlinear_dt (the hull pressure sampled every 2 steps, HeldHulls): each case's
+    samples carry its own sea's linear Froude–Krylov force (its X_FK at its own components, the
+    tables keeping the whole excitation); q, qd and hydro_force are each case's mfm.simulate to
+    TOL, the cases vmapped together (the step counter shared: one branch taken) and one after
+    another."""
+    model = _sphere(hydrostatics="nonlinear", nonlinear_dt=0.1)
+    seas = _sphere_seas()
+    batch, worst = _against_single_runs(model, seas, [1.0, 0.5, 1.5, 0.0], ("hydro_force",),
+                                        lanes=lanes)
+    assert batch.attrs["hull_pressure"].startswith("sampled every 2 steps")
+    assert worst < 1e-11
+    with pytest.raises(ValueError, match=r"hydro.nonlinear_dt: 0.1 s is \[1, 2\] steps"):
+        mfm.simulate_batch(model, seas[:2], n_steps=4, dt=[0.05, 0.1], radiation="state_space")
+
+
 def test_a_padded_component_changes_nothing():
     """A regular sea padded to 4 components (zero amplitudes, a wavenumber of 1 rad/s) in the
     batch's water against build_water's one component: the hulls' hydrostatic and Froude–Krylov

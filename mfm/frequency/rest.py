@@ -49,7 +49,8 @@ def still_water_loads(model: Model, loads=None, *, added_mass="lhs",
     (:meth:`~mfm.loads.water.Water.static_load` holds no table of the run's length), so one
     compiled linearisation serves them all."""
     return carried_loads(model, None, dt=1.0, duration=1.0, radiation="none",
-                         added_mass=added_mass, stage_offsets=stage_offsets) + as_loads(loads)
+                         added_mass=added_mass, stage_offsets=stage_offsets,
+                         sampled=False) + as_loads(loads)
 
 
 def system_loads(model: Model, loads=None) -> tuple:

@@ -51,7 +51,7 @@ from ..mechanics.tree import (JOINT_KINDS, PLANAR_DOFS, ROOT_DOFS, BodySpec, Joi
 # the tables of loads (moorings, ptos, ...) come from the load registry (mfm.loads.registry)
 TOP_KEYS = {"model", "bodies", "hydro"} | set(LOAD_TABLES)
 HYDRO_KEYS = {"database", "names", "body_coupling", "added_mass_inf", "rho", "g", "bem", "notes",
-              "hydrostatics", "drag_flow", "drift"}
+              "hydrostatics", "nonlinear_dt", "drag_flow", "drift"}
 HYDROSTATICS = ("linear", "nonlinear")
 DRIFTS = ("off", "mean", "newman")
 BODY_HYDRO_KEYS = {"body", "drag_coefficient", "drag_area", "notes"}
@@ -191,6 +191,8 @@ def _parse_hydro(raw, source):
            "hydrostatics": raw.get("hydrostatics", "linear"),
            "drag_flow": raw.get("drag_flow", "body"),
            "drift": raw.get("drift", "off")}
+    if "nonlinear_dt" in raw:
+        out["nonlinear_dt"] = raw["nonlinear_dt"]
     if out["drift"] not in DRIFTS:
         raise ConfigError(f"hydro.drift: {out['drift']!r}; accepted: {list(DRIFTS)} (mean: the "
                           "constant mean wave drift force; newman: its slow drift in irregular "
@@ -203,6 +205,18 @@ def _parse_hydro(raw, source):
         raise ConfigError(f"hydro.hydrostatics: {out['hydrostatics']!r}; accepted: "
                           f"{list(HYDROSTATICS)} (nonlinear: hydrostatics and Froude–Krylov on the "
                           "instantaneous wetted hull of each body's [bodies.hull])")
+    if "nonlinear_dt" in out:
+        v = out["nonlinear_dt"]
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or v <= 0:
+            raise ConfigError(f"hydro.nonlinear_dt: {v!r} is not a positive number of seconds; "
+                              "give the interval at which the hull pressure is sampled (a whole "
+                              "multiple of the run's dt, e.g. 4 × dt), or leave the key out to "
+                              "evaluate it at every stage of every step")
+        if out["hydrostatics"] != "nonlinear":
+            raise ConfigError(f"hydro.nonlinear_dt: {v!r} is given but hydro.hydrostatics is "
+                              f"{out['hydrostatics']!r}: the interval is the nonlinear level's "
+                              "(the hull pressure sampled every nonlinear_dt s); set "
+                              "hydro.hydrostatics = \"nonlinear\" or remove hydro.nonlinear_dt")
     for key, unit, typical in (("rho", "kg/m³", "1025 for sea water, 1000 for fresh water"),
                                ("g", "m/s²", "9.81")):
         v = out[key]

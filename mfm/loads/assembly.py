@@ -29,13 +29,16 @@ RK4_STAGE_OFFSETS = (0.0, 0.5, 1.0)
 
 def carried_loads(model, sea=None, *, dt, duration, t0=0.0, ramp=0.0, radiation="convolution",
                   memory=None, state_space_options=None, added_mass="lhs",
-                  stage_offsets=RK4_STAGE_OFFSETS, extra=(), mean_drift=None) -> tuple[Load, ...]:
+                  stage_offsets=RK4_STAGE_OFFSETS, extra=(), mean_drift=None,
+                  sampled: bool = True) -> tuple[Load, ...]:
     """The loads of a run: with a [hydro] config the model's water for this sea and time grid
     (:func:`mfm.loads.water.build_water`, prepared for an integrator's ``stage_offsets``), then
     the config's loads (``model.loads``: moorings, PTOs, …) and the ``extra`` loads of a front
     door, each laid on the run by its :meth:`~mfm.loads.base.Load.for_run`. The time domain's
     :func:`mfm.timedomain.setup.model_loads` names the integrator instead of its offsets.
-    ``mean_drift``: the water's drift table in place of its database's (:func:`build_water`)."""
+    ``mean_drift``: the water's drift table in place of its database's (:func:`build_water`).
+    ``sampled``: False for loads that serve at rest only (the nonlinear level's pressure at every
+    call whatever ``[hydro] nonlinear_dt``, which is then not checked against ``dt``)."""
     out = []
     run = run_grid(sea, dt=dt, duration=duration, t0=t0, ramp=ramp, stage_offsets=stage_offsets)
     if model.hydro is not None:
@@ -43,7 +46,8 @@ def carried_loads(model, sea=None, *, dt, duration, t0=0.0, ramp=0.0, radiation=
         out.append(build_water(model, model.hydro, sea, dt=dt, duration=duration, t0=t0, ramp=ramp,
                                radiation=radiation, memory=memory,
                                state_space_options=state_space_options, added_mass=added_mass,
-                               stage_offsets=run.stage_offsets, mean_drift=mean_drift))
+                               stage_offsets=run.stage_offsets, mean_drift=mean_drift,
+                               sampled=sampled))
     return tuple(out) + laid_on(model, tuple(model.loads) + tuple(extra), run)
 
 

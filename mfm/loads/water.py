@@ -83,6 +83,8 @@ class Hulls(eqx.Module):
     ramp: jnp.ndarray
     rho: float = eqx.field(static=True, default=1025.0)
     g: float = eqx.field(static=True, default=9.81)
+    # the pressure sampled every few steps (HeldHulls), or None: at every evaluation
+    hold: object = None
 
     def loads(self, geometry, kin, t):
         """(hydrostatic, Froude–Krylov), each (6K,): force and moment about each reference point
@@ -103,8 +105,111 @@ class Hulls(eqx.Module):
         return jnp.concatenate(hs), jnp.concatenate(fk)
 
     def still(self) -> "Hulls":
-        """These hulls in still water (the linearisation's static load)."""
-        return dataclasses.replace(self, wave=_still(self.wave))
+        """These hulls in still water, their pressure evaluated at every call (the
+        linearisation's static load)."""
+        return dataclasses.replace(self, wave=_still(self.wave), hold=None)
+
+    # -- the pressure sampled every few steps ([hydro] nonlinear_dt): module docstring of HeldHulls
+    def correction(self, geometry, kin, t):
+        """Δ (2, 6K): the pressure loads (hydrostatic, Froude–Krylov) less what the linear level
+        gives at the same pose and time (:meth:`HeldHulls.linear`)."""
+        hs, fk = self.loads(geometry, kin, t)
+        hs_lin, fk_lin = self.hold.linear(geometry, kin, _ramped(self.wave, self.ramp, t), t)
+        return jnp.stack([hs - hs_lin, fk - fk_lin])
+
+    def init_held(self, geometry, kin, t0):
+        """The held samples at the run's start: (count, t_a, t_b, t_c, Δ_a, Δ_b, Δ_c), newest
+        first, the three the same (no slope before a second sample, no curvature before a
+        third)."""
+        d = self.correction(geometry, kin, t0)
+        t0 = jnp.asarray(t0, jnp.float64)
+        return (jnp.asarray(0, jnp.int32), t0, t0, t0, d, d, d)
+
+    def update_held(self, geometry, kin, t, held):
+        """The held samples after a step ending at (t, kin): every ``every`` steps a new sample,
+        the two before it kept (the extrapolation's), the oldest dropped; else unchanged."""
+        count, t_a, t_b, t_c, d_a, d_b, d_c = held
+        count = count + 1
+
+        def sample(_):
+            return (jnp.asarray(0, jnp.int32), jnp.asarray(t, jnp.float64), t_a, t_b,
+                    self.correction(geometry, kin, t), d_a, d_b)
+
+        if self.hold.every == 1:
+            return sample(None)
+        # a step counter the cases of a batch share: a branch taken, not both evaluated
+        return jax.lax.cond(count >= self.hold.every, sample,
+                            lambda _: (count, t_a, t_b, t_c, d_a, d_b, d_c), None)
+
+    def held_loads(self, geometry, kin, t, held):
+        """(hydrostatic, Froude–Krylov) at a stage (t, kin) of the held level: the linear
+        level's hydrostatics (the Froude–Krylov's is in the water's tables) and Δ extrapolated
+        from the last three samples by Newton's divided differences,
+
+            Δ(t) = Δ_a + (t − t_a) (Δ[a, b] + (t − t_b) Δ[a, b, c]),
+
+        Δ[a, b] = (Δ_a − Δ_b)/(t_a − t_b), Δ[a, b, c] = (Δ[a, b] − Δ[b, c])/(t_a − t_c); a
+        divided difference over samples not yet taken (equal times, the run's start) is 0."""
+        _, t_a, t_b, t_c, d_a, d_b, d_c = held
+
+        def divided(x, y, gap):
+            return jnp.where(gap > 0, (x - y) / jnp.where(gap > 0, gap, 1.0), 0.0)
+
+        s_ab = divided(d_a, d_b, t_a - t_b)
+        s_bc = divided(d_b, d_c, t_b - t_c)
+        curv = jnp.where(t_b > t_c, divided(s_ab, s_bc, t_a - t_c), 0.0)
+        d = d_a + (t - t_a) * (s_ab + (t - t_b) * curv)
+        hs_lin = self.hold.hydrostatic(geometry, kin)
+        return hs_lin + d[0], d[1]
+
+
+class HeldHulls(eqx.Module):
+    """The nonlinear level with its hull pressure sampled every ``every`` steps
+    (``[hydro] nonlinear_dt`` = every × dt, as WEC-Sim's ``dtNL``): each stage of each step takes
+    the linear level's loads (the database's buoyancy, water-plane stiffness and excitation, at
+    the stage's own pose and time) plus the nonlinear level's excess over them,
+
+        Δ = F_pressure(q, t) − [ρgV ẑ at the CoB − C_wp ξ + F_FK,lin(t)],
+
+    evaluated on the wetted hull at the samples only and extrapolated quadratically from the last
+    three between them. At rest and in small waves Δ is second order in the motions and the
+    wave, so the error of sampling it is a fraction |Δ|/|F| of the extrapolation's own,
+    O((ω h)³) per interval h = nonlinear_dt (tests/test_nonlinear_held.py: ×8 per doubling); what
+    stiffens the equations (C_wp, the wave force) is still evaluated at every stage. One pressure
+    integral per ``every`` steps instead of RK4's four per step.
+
+    ``C_wp`` (6K, 6K), ``buoyancy`` (K,) ρgV, ``d_cob`` (K, 3): the linear level's hydrostatics;
+    ``fk_re``, ``fk_im`` (J, 6K): the hulls' linear Froude–Krylov coefficients X_FK at the wave
+    field's components (:func:`hydro.wetted.froude_krylov_linear`; per metre of amplitude),
+    F_FK,lin(t) = Σ_j a_j r(t) Re[X_FK,j e^{i(φ_j − ω_j t)}], what the tables' excitation holds."""
+    C_wp: jnp.ndarray
+    buoyancy: jnp.ndarray
+    d_cob: jnp.ndarray
+    fk_re: jnp.ndarray
+    fk_im: jnp.ndarray
+    every: int = eqx.field(static=True, default=1)
+
+    def hydrostatic(self, geometry, kin):
+        """The linear level's hydrostatic load (6K,): ρgV ẑ at each centre of buoyancy (as loads
+        at r_k) − C_wp ξ."""
+        f, lever = buoyancy_at(geometry, kin, self.buoyancy, self.d_cob)
+        moment = jnp.cross(lever - geometry._frames(kin)[2], f)
+        return jnp.concatenate([f, moment], axis=1).reshape(-1) - self.C_wp @ geometry.xi(kin)
+
+    def linear(self, geometry, kin, wave, t):
+        """(hydrostatic, Froude–Krylov) of the linear level at (t, kin), ``wave`` ramped."""
+        ph = wave.phase - wave.omega * t
+        c, s = wave.amplitude * jnp.cos(ph), wave.amplitude * jnp.sin(ph)
+        return self.hydrostatic(geometry, kin), c @ self.fk_re - s @ self.fk_im
+
+
+def buoyancy_at(geometry, kin, buoyancy, d_cob):
+    """ρgV ẑ at each centre of buoyancy: the forces (K, 3) and the levers CoB − CoM (K, 3),
+    inertial axes; ``buoyancy`` (K,) ρgV, ``d_cob`` (K, 3) CoB − CoM in body axes."""
+    R = kin.E[np.asarray(geometry.body_index), :3, :3]
+    lever = se3.rotate(R, d_cob)
+    f = jnp.zeros_like(lever).at[:, 2].set(buoyancy)
+    return f, lever
 
 
 class Flow(eqx.Module):
@@ -181,15 +286,31 @@ class Water(Load):
     def n_states(self) -> int:
         return self.rad.n_states
 
+    @property
+    def _held(self) -> bool:
+        """Whether the hull pressure is sampled every few steps (:class:`HeldHulls`): the memory
+        is then (the radiation's, the held samples)."""
+        return self.hulls is not None and self.hulls.hold is not None
+
+    def _rad_memory(self, memory):
+        return memory[0] if self._held else memory
+
     def init_memory(self, model, t0, q0, qd0, dt):
         from ..mechanics.kinematics import kinematics
 
-        v, _ = self.geometry.velocity_and_bias(kinematics(model, q0, qd0))
-        return self.rad.init_memory(v, t0)
+        kin = kinematics(model, q0, qd0)
+        v, _ = self.geometry.velocity_and_bias(kin)
+        rad = self.rad.init_memory(v, t0)
+        if not self._held:
+            return rad
+        return rad, self.hulls.init_held(self.geometry, kin, t0)
 
     def update_memory(self, model, t, q, qd, kin, memory):
         v, _ = self.geometry.velocity_and_bias(kin)
-        return self.rad.update_memory(v, t, memory)
+        rad = self.rad.update_memory(v, t, self._rad_memory(memory))
+        if not self._held:
+            return rad
+        return rad, self.hulls.update_held(self.geometry, kin, t, memory[1])
 
     def _series(self, values, t):
         s = (t - self.exc_t0) / self.exc_step
@@ -211,7 +332,7 @@ class Water(Load):
         g, mv = self.geometry, self._moved
         xi = g.xi(kin)
         v, hbias = g.velocity_and_bias(kin)
-        r_rad, F_rad, zd = self.rad.force_rows(t, v, z, memory)
+        r_rad, F_rad, zd = self.rad.force_rows(t, v, z, self._rad_memory(memory))
         if r_rad is None:
             rad = jnp.zeros(len(rows))
         elif tuple(r_rad) == tuple(rows):
@@ -247,11 +368,8 @@ class Water(Load):
         return out, zd, v, hbias
 
     def _buoyancy(self, kin):
-        """ρgV ẑ at each centre of buoyancy: as loads at r_k (6K,) and the CoB lever (K, 3)."""
-        R = kin.E[np.asarray(self.geometry.body_index), :3, :3]
-        lever = se3.rotate(R, self.d_cob)
-        f = jnp.zeros_like(lever).at[:, 2].set(self.buoyancy)
-        return f, lever
+        """ρgV ẑ at each centre of buoyancy: the forces (K, 3) and the CoB lever (K, 3)."""
+        return buoyancy_at(self.geometry, kin, self.buoyancy, self.d_cob)
 
     @property
     def _moved(self) -> np.ndarray:
@@ -282,13 +400,23 @@ class Water(Load):
         # (they are made for the joint reactions only, :meth:`reaction_loads`)
         mv = self._moved
         H = self.geometry.h_matrix(ctx.kin)[0][mv]
-        hull = None if self.hulls is None else self.hulls.loads(self.geometry, ctx.kin, ctx.t)
+        hull = self._hull_loads(ctx)
         F, zd = self._moved_load(ctx, H, hull)
         tau = jnp.sum(H * F[:, None], axis=0)
         rhs = self.added_mass == "rhs" and ctx.qdd_guess is not None
         mass = None if rhs else se3.matmul_small(H, se3.matmul_small(self.A_inf[mv][:, mv], H),
                                                  transpose_x=True)
         return LoadOutput(tau=tau, zd=zd, mass=mass, extra=hull)
+
+    def _hull_loads(self, ctx):
+        """The nonlinear level's (hydrostatic, Froude–Krylov) at the context's state: the
+        pressure on the wetted hull, or with ``[hydro] nonlinear_dt`` the held level's
+        (:meth:`Hulls.held_loads`); None for the linear level."""
+        if self.hulls is None:
+            return None
+        if self._held:
+            return self.hulls.held_loads(self.geometry, ctx.kin, ctx.t, ctx.memory[1])
+        return self.hulls.loads(self.geometry, ctx.kin, ctx.t)
 
     def reaction_loads(self, ctx, out):
         # the whole −A∞ ξ̈ on the bodies: −A∞ Ḣq̇ and −A∞ H q̈ (with added_mass="rhs" the load
@@ -351,6 +479,9 @@ class Water(Load):
                "drag_flow": "body" if self.flow is None else "relative"}
         if self.hulls is not None:
             out["hull_panels"] = ", ".join(str(int(t.shape[-1])) for t in self.hulls.tri)
+            if self._held:
+                out["hull_pressure"] = (f"sampled every {int(self.hulls.hold.every)} steps "
+                                        "(hydro.nonlinear_dt), extrapolated between")
         if self.spec is not None:
             out.update(self.spec.provenance())
         return out
@@ -519,7 +650,7 @@ class Water(Load):
 def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0,
                 ramp: float = 0.0, radiation: str = "convolution", memory: float | None = None,
                 state_space_options: dict | None = None, added_mass: str = "lhs",
-                stage_offsets=(0.0, 0.5, 1.0), mean_drift=None) -> Water:
+                stage_offsets=(0.0, 0.5, 1.0), mean_drift=None, sampled: bool = True) -> Water:
     """The :class:`Water` load of ``model`` for one sea state and time grid.
 
     sea: a ``hydro.waves`` sea state (Regular, Jonswap, …) or None for still water.
@@ -530,6 +661,8 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
     mean_drift: with ``[hydro] drift``, a :class:`mfm.frequency.drift.MeanDrift` in place of the
     database's ``mean_drift`` (the drift of the model's own motions,
     :func:`mfm.frequency.drift.run_mean_drift`).
+    sampled: with ``[hydro] nonlinear_dt``, the hull pressure sampled every nonlinear_dt / dt
+    steps (:class:`HeldHulls`); False: at every evaluation (a water that serves at rest only).
     """
     from hydro.excitation import excitation_time_series
     from hydro.waves import elevation
@@ -554,9 +687,16 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
     C_wp, buoyancy, hulls, flow = spec.C_wp, spec.rho * spec.g * spec.volume, None, None
     comps = None if sea is None else sea.components(water_depth=spec.water_depth, g=spec.g)
     if nonlinear(spec):
-        exc = exc - froude_krylov_series(spec, comps, t_grid, ramp)
-        C_wp, buoyancy = np.zeros_like(C_wp), np.zeros_like(buoyancy)
+        every = nonlinear_every(spec, dt) if sampled else None
         hulls = make_hulls(spec, comps, ramp)
+        if every is None:
+            exc = exc - froude_krylov_series(spec, comps, t_grid, ramp)
+        else:
+            # the tables keep the database's whole excitation: each stage takes the linear level
+            # and the held excess over it (HeldHulls)
+            hulls = dataclasses.replace(hulls, hold=held_hulls(
+                spec, froude_krylov_coefficients(spec, comps), every))
+        C_wp, buoyancy = np.zeros_like(C_wp), np.zeros_like(buoyancy)
     if relative_drag(spec):
         from hydro.wetted import WaveField, still_water
 
@@ -580,7 +720,7 @@ def build_water(model, spec, sea, *, dt: float, duration: float, t0: float = 0.0
 
 # the attributes that put a spec above linear potential flow (set by load_hydro_spec only when
 # asked, so that every other spec keeps its content key)
-ABOVE_LINEAR = ("hulls", "hydrostatics", "drag_flow", "drift")
+ABOVE_LINEAR = ("hulls", "hydrostatics", "nonlinear_dt", "drag_flow", "drift")
 
 
 def linear_spec(spec):
@@ -592,6 +732,21 @@ def linear_spec(spec):
     out = copy.copy(spec)
     for name in ABOVE_LINEAR:
         out.__dict__.pop(name, None)
+    out._cache = {k: v for k, v in spec._cache.items()
+                  if not (isinstance(k, tuple) and k and k[0] == "replace")}
+    return out
+
+
+def sampled_spec(spec, nonlinear_dt: float | None):
+    """A copy of ``spec`` (at the nonlinear level) whose hull pressure is sampled every
+    ``nonlinear_dt`` s (:class:`HeldHulls`), or at every evaluation (None); its caches shared as
+    :func:`linear_spec`'s."""
+    import copy
+
+    out = copy.copy(spec)
+    out.__dict__.pop("nonlinear_dt", None)
+    if nonlinear_dt is not None:
+        out.nonlinear_dt = float(nonlinear_dt)
     out._cache = {k: v for k, v in spec._cache.items()
                   if not (isinstance(k, tuple) and k and k[0] == "replace")}
     return out
@@ -646,20 +801,58 @@ def make_hulls(spec, comps, ramp: float) -> Hulls:
                  g=float(spec.g))
 
 
+def nonlinear_every(spec, dt: float) -> int | None:
+    """The steps between two samples of the hull pressure, ``[hydro] nonlinear_dt`` / dt (None:
+    at every evaluation). Refused unless nonlinear_dt is a whole multiple of the run's dt."""
+    ndt = getattr(spec, "nonlinear_dt", None)
+    if ndt is None:
+        return None
+    dt = float(dt)
+    k = int(round(ndt / dt))
+    if k < 1 or abs(k * dt - ndt) > 1e-9 * ndt:
+        lo, hi = max(1, int(ndt // dt)), max(1, int(ndt // dt)) + 1
+        raise ValueError(
+            f"hydro.nonlinear_dt: {ndt!r} s is not a whole multiple of the run's dt {dt!r} s: "
+            f"the hull pressure is sampled at the end of a step; give nonlinear_dt = "
+            f"{lo * dt:.6g} or {hi * dt:.6g} s ({lo} or {hi} steps), or a dt that divides it")
+    return k
+
+
+def held_hulls(spec, X_fk, every: int) -> "HeldHulls":
+    """The :class:`HeldHulls` of ``spec`` sampled every ``every`` steps, ``X_fk`` (J, 6K) complex
+    (or (B, J, 6K) for a batch) the hulls' linear Froude–Krylov coefficients at the run's
+    components (:func:`froude_krylov_coefficients`)."""
+    X_fk = np.asarray(X_fk, complex)
+    return HeldHulls(C_wp=_f64(spec.C_wp), buoyancy=_f64(spec.rho * spec.g * spec.volume),
+                     d_cob=_f64(spec.d_cob), fk_re=_f64(X_fk.real.copy()),
+                     fk_im=_f64(X_fk.imag.copy()), every=int(every))
+
+
+def froude_krylov_coefficients(spec, comps) -> np.ndarray:
+    """The hulls' linear Froude–Krylov force per metre of amplitude at each component, (J, 6K)
+    complex, about each body's reference point at rest (:func:`hydro.wetted.froude_krylov_linear`
+    at the component's k and heading); (0, 6K) in still water."""
+    from hydro.wetted import froude_krylov_linear
+
+    if comps is None or len(comps.omega) == 0:
+        return np.zeros((0, 6 * len(spec.hulls)), complex)
+    return np.concatenate([froude_krylov_linear(T, spec.ref0[k], comps.wavenumber, comps.heading,
+                                                water_depth=spec.water_depth, rho=spec.rho,
+                                                g=spec.g)
+                           for k, T in enumerate(spec.hulls)], axis=1)
+
+
 def froude_krylov_series(spec, comps, t, ramp: float) -> np.ndarray:
     """The linear Froude–Krylov force of the hulls at rest, (len(t), 6K): what the nonlinear
     level takes out of the database's excitation (its tables keep the diffraction), so that in
     small waves the two add up to the database's (:func:`hydro.wetted.froude_krylov_linear` at
     each component's k and heading: no interpolation)."""
     from hydro.waves import _harmonic_sum, ramp as ramp_of
-    from hydro.wetted import froude_krylov_linear
 
     t = np.asarray(t, float)
     if comps is None or len(comps.omega) == 0:
         return np.zeros((len(t), 6 * len(spec.hulls)))
-    X = np.concatenate([froude_krylov_linear(T, spec.ref0[k], comps.wavenumber, comps.heading,
-                                             water_depth=spec.water_depth, rho=spec.rho, g=spec.g)
-                        for k, T in enumerate(spec.hulls)], axis=1)          # (J, 6K)
+    X = froude_krylov_coefficients(spec, comps)                             # (J, 6K)
     out = _harmonic_sum(np.asarray(comps.omega, float), comps.complex_amplitude[:, None] * X, t)
     return out * ramp_of(t, ramp)[:, None] if ramp else out
 
@@ -897,7 +1090,17 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
         arrays["active"][i, :n] = ~outside[j]
         for name, values in zip(("i0", "k0", "k1", "sw", "sb"), br):
             arrays[name][i, :n] = values[j]
-    above = _above_linear_batch(spec, comps, live, B, n_c, omega, mean_drift)
+    every = None
+    if nonlinear(spec):
+        steps_between = {nonlinear_every(spec, float(d)) for d in uniq}
+        if len(steps_between) != 1:
+            raise ValueError(f"hydro.nonlinear_dt: {spec.nonlinear_dt!r} s is {sorted(steps_between)} "
+                             f"steps of the cases' time steps {uniq}: the steps between two "
+                             "samples of the hull pressure are one structure for the batch; give "
+                             "every case the same dt")
+        every = steps_between.pop()
+    above = _above_linear_batch(spec, comps, live, B, n_c, omega, mean_drift,
+                                fk_in_tables=every is None)
     waves = WaveSum(omega=omega, **arrays, t0=np.full(B, float(t0)), step=steps.copy(),
                     ramp=ramps.copy(), n_grid=n_grid, one_heading=table.beta.shape[0] == 1,
                     **above["waves"])
@@ -910,6 +1113,8 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
         # build_water), each case's sea in its wave field
         C_wp, buoyancy = np.zeros_like(C_wp), np.zeros_like(buoyancy)
         hulls = dataclasses.replace(make_hulls(spec, None, 0.0), wave=field, ramp=ramps.copy())
+        if every is not None:
+            hulls = dataclasses.replace(hulls, hold=held_hulls(spec, above["fk"], every))
     if relative_drag(spec):
         flow = Flow(wave=field, ramp=ramps.copy())
     water = Water(geometry=geometry, A_inf=_f64(rad.added_mass_inf(spec)),
@@ -924,11 +1129,14 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
     batched = eqx.tree_at(lambda w: (w.exc_step, w.rad), batched, (True, rad_batched))
     # so has each case's sea, where the water reads it at the time step (the hulls' wave
     # pressure, the relative flow): a wave field (B, n_c) and the ramp (B,)
-    every = jax.tree_util.tree_map(lambda _: True, field)
+    each = jax.tree_util.tree_map(lambda _: True, field)
     if hulls is not None:
-        batched = eqx.tree_at(lambda w: (w.hulls.wave, w.hulls.ramp), batched, (every, True))
+        batched = eqx.tree_at(lambda w: (w.hulls.wave, w.hulls.ramp), batched, (each, True))
+        if hulls.hold is not None:
+            batched = eqx.tree_at(lambda w: (w.hulls.hold.fk_re, w.hulls.hold.fk_im), batched,
+                                  (True, True))
     if flow is not None:
-        batched = eqx.tree_at(lambda w: (w.flow.wave, w.flow.ramp), batched, (every, True))
+        batched = eqx.tree_at(lambda w: (w.flow.wave, w.flow.ramp), batched, (each, True))
     return water, batched, waves, tuple(jnp.asarray(a) for a in table.polar)
 
 
@@ -937,11 +1145,15 @@ def build_water_batch(model, spec, seas, *, dts, ramps, n_steps: int, t0: float 
 FK_CHUNK = 64
 
 
-def _above_linear_batch(spec, comps, live, B: int, n_c: int, omega, mean_drift=None) -> dict:
+def _above_linear_batch(spec, comps, live, B: int, n_c: int, omega, mean_drift=None,
+                        fk_in_tables: bool = True) -> dict:
     """What the above-linear options add to a batch (``comps``: the components of the cases
     ``live``, each padded to ``n_c`` with zero amplitudes, as :class:`WaveSum`'s; ``omega``
     (B, n_c) its frequencies, 1 rad/s on the padding): ``"waves"``, the :class:`WaveSum` fields
-    (the hulls' X_FK of the nonlinear level; the drift's coefficients); ``"field"``, a
+    (the hulls' X_FK of the nonlinear level, taken out of the tables unless ``fk_in_tables`` is
+    False: the held level's tables keep the whole excitation; the drift's coefficients);
+    ``"fk"`` (B, n_c, 6K) complex, the X_FK of each case's components (nonlinear level);
+    ``"field"``, a
     :class:`hydro.wetted.WaveField` (B, n_c) of each case's components for the hulls and the
     relative flow (None when neither). A padded component has amplitude 0 and a wavenumber of
     its 1 rad/s (finite, positive: the depth decays stay finite), so every term it adds to a sum
@@ -964,7 +1176,9 @@ def _above_linear_batch(spec, comps, live, B: int, n_c: int, omega, mean_drift=N
         fk = np.zeros((B, n_c, nd), complex)
         for c, i, X in zip(comps, live, _froude_krylov_many(spec, comps)):
             fk[i, :len(c.omega)] = X
-        out["waves"].update(fk_re=fk.real.copy(), fk_im=fk.imag.copy())
+        out["fk"] = fk
+        if fk_in_tables:
+            out["waves"].update(fk_re=fk.real.copy(), fk_im=fk.imag.copy())
     if wave_drift(spec):
         out["waves"].update(_drift_coefficients(spec, comps, live, B, n_c, mean_drift))
     return out
@@ -1141,6 +1355,10 @@ def load_hydro_spec(model, bodies, options: dict, config_dir: Path, body_couplin
                      source=str(path), moving=moving)
     if options.get("hydrostatics", "linear") == "nonlinear":
         attach_hulls(spec, [by_name[name] for name, _, _ in wet], config_dir)
+        if options.get("nonlinear_dt") is not None:
+            # set only when asked (the spec's content key); checked against each run's dt
+            # where the water is built (nonlinear_every)
+            spec.nonlinear_dt = float(options["nonlinear_dt"])
     if options.get("drag_flow", "body") == "relative":
         # set only when asked: every other spec keeps its content key (fingerprint) as before
         spec.drag_flow = "relative"
