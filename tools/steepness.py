@@ -2,6 +2,7 @@
 against wave steepness H/λ, on the floating sphere, RM3, M4 134 and the Stansby & Li hybrid.
 
     python tools/steepness.py [--system sphere|rm3|m4_134|stansby_li] [--period T] [--heights H ...]
+                              [--sampled K]
 
 Each height: a regular wave of the period, with the system's run settings below, radiation
 "state_space", the checks off; the amplitudes at the wave frequency over the last periods (least
@@ -10,6 +11,11 @@ against nonlinear (``[hydro] hydrostatics = "nonlinear"``: the hydrostatic and t
 wave's pressure on the instantaneous wetted hull), and their relative difference. Prints a table
 (those in docs/nonlinear.md) and writes notebooks/figures/steepness_<system>.png where matplotlib
 is installed.
+
+``--sampled K``: also the nonlinear level with its hull pressure sampled every K steps
+(``[hydro] nonlinear_dt`` = K dt, :class:`mfm.loads.water.HeldHulls`), printed as its relative
+difference from the every-stage nonlinear level at each height (where the sampled rung stops
+being within a tolerance); the figure is unchanged.
 
 The sphere, RM3 and M4 134 are held in surge (their other coordinates free): unmoored, the nonlinear level's mean
 wave force (the waterline moving against the wave) carries a body downstream, and the encounter
@@ -132,6 +138,8 @@ def main():
     ap.add_argument("--period", type=float, default=None, help="s (default: the system's)")
     ap.add_argument("--heights", type=float, nargs="+", default=None,
                     help="m (default: the system's)")
+    ap.add_argument("--sampled", type=int, default=None,
+                    help="also the nonlinear level sampled every K steps (nonlinear_dt = K dt)")
     args = ap.parse_args()
 
     import hydro
@@ -142,6 +150,11 @@ def main():
     case = SYSTEMS[args.system]()
     lin = mfm.load(case["cfg"], base=ROOT / "configs")
     nl = mfm.load(case["nl"], base=ROOT / "configs")
+    models = [lin, nl]
+    if args.sampled:
+        held = copy.deepcopy(case["nl"])
+        held["hydro"]["nonlinear_dt"] = args.sampled * case["run"]["dt"]
+        models.append(mfm.load(held, base=ROOT / "configs"))
     T = args.period or case["period"]
     heights = args.heights or case["heights"]
     w = 2 * math.pi / T
@@ -152,7 +165,7 @@ def main():
     for H in heights:
         sea = hydro.Regular(height=H, period=T)
         out = []
-        for m in (lin, nl):
+        for m in models:
             ds = mfm.simulate(m, sea, **run)
             t = ds.time.values
             late = t >= t[-1] - case["window"]
@@ -166,7 +179,8 @@ def main():
         if case["rao"]:
             k = list(case["coords"].values()).index(case["rao"])
             rao = (lin_v[k] / (H / 2), nl_v[k] / (H / 2))
-        rows.append((H, H / lam, lin_v, nl_v, lin_v / nl_v - 1, rao))
+        rows.append((H, H / lam, lin_v, nl_v, lin_v / nl_v - 1, rao,
+                     np.asarray(out[2]) / nl_v - 1 if args.sampled else None))
 
     print(f"{args.system}: regular waves of T {T:g} s (λ {lam:.2f} m), held in surge; "
           f"amplitudes at the wave frequency (m, rad) and mean power (W), linear against nonlinear")
@@ -176,15 +190,21 @@ def main():
     for n in names:
         head += f" {n + ' lin/nl−1':>18s}"
     print(head)
-    for H, s, lv, nv, d, rao in rows:
+    for H, s, lv, nv, d, rao, _ in rows:
         line = f"{H:7.3f} {s:7.4f}"
         if rao:
             line += f" {rao[0]:14.4f} {rao[1]:13.4f}"
         line += "".join(f" {x:+18.2%}" for x in d)
         print(line)
     print("values (linear | nonlinear):")
-    for H, s, lv, nv, d, rao in rows:
+    for H, s, lv, nv, d, rao, _ in rows:
         print(f"{H:7.3f} " + "  ".join(f"{n} {a:.5g} | {b:.5g}" for n, a, b in zip(names, lv, nv)))
+    if args.sampled:
+        print(f"sampled every {args.sampled} steps (ω h = {w * args.sampled * run['dt']:.3f}) "
+              "against the nonlinear level at every stage:")
+        print(f"{'H m':>7s} {'H/λ':>7s}" + "".join(f" {n + ' sampled/nl−1':>22s}" for n in names))
+        for H, s, lv, nv, d, rao, ds in rows:
+            print(f"{H:7.3f} {s:7.4f}" + "".join(f" {x:+22.3%}" for x in ds))
     try:
         import matplotlib
         matplotlib.use("Agg")
