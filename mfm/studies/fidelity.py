@@ -72,6 +72,8 @@ SAMPLED_OMEGA_H = 0.125
 def sampled_steps(steps_per_period: int) -> int:
     """The "sampled" level's steps between two samples: ω h ≈ :data:`SAMPLED_OMEGA_H`."""
     return max(1, int(round(SAMPLED_OMEGA_H * steps_per_period / (2 * np.pi))))
+
+
 # the levels of linear potential flow: run on the model's linear water (linear_water)
 LINEAR_LEVELS = ("spectral", "linear", "fast", "full")
 
