@@ -53,17 +53,18 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 SYSTEMS = {
-    # config, regular wave (H, T), dt, duration, ramp, hull table, reported coordinates
+    # config, regular wave (H, T), dt, duration, ramp, hull table (of the panel size and the
+    # body's name), reported coordinates, panel sizes
     "sphere": ("sphere.toml", (0.5, 4.0), 0.02, 40.0, 8.0,
-               lambda s: {"shape": "sphere", "radius": 1.0, "panel_size": s},
+               lambda s, name: {"shape": "sphere", "radius": 1.0, "panel_size": s},
                ("sphere.heave", "sphere.pitch"), [0.25, 0.125, 0.0625]),
     "m4_134": ("m4_134.toml", (0.04, 1.2), 0.006, 12.0, 2.4,
-               lambda s: {"shape": "geometry", "top": 0.1, "panel_size": s},
+               lambda s, name: {"shape": "geometry", "top": 0.1, "panel_size": s},
                ("float1.heave", "float1.pitch", "float3.angle"), [0.04, 0.02, 0.01]),
     # the seed's regular wave; the columns' hulls up to 15 m (the fairleads' height), the WECs'
     # to their stated 2 m freeboard
     "wu_yuan_m1": ("wu_yuan_m1_td.toml", (3.8, 8.3), 0.083, 49.8, 16.6,
-                   lambda s, name="": {"shape": "geometry", "panel_size": s,
+                   lambda s, name: {"shape": "geometry", "panel_size": s,
                                        "top": 15.0 if name.startswith("column") else 2.0},
                    ("platform.heave", "platform.pitch", "wec1.angle"), [2.0, 1.0]),
 }
@@ -120,7 +121,7 @@ def main():
         cfg["hydro"]["hydrostatics"] = "nonlinear"
         for b in cfg["bodies"]:
             if b["name"] == "sphere" or "geometry" in b:
-                b["hull"] = hull(s, b["name"]) if args.system == "wu_yuan_m1" else hull(s)
+                b["hull"] = hull(s, b["name"])
         model = mfm.load(cfg, base=ROOT / "configs")
         tri = sum(int(h.shape[0]) for h in model.hydro.hulls)
         every_stage = timed(model)
@@ -134,11 +135,10 @@ def main():
             rows.append((f"  sampled every {k} steps", tri, wall, cpu, amps, series,
                          " ".join(f"{x:.1e}" for x in worst)))
     fine = [r for r in rows if r[0].startswith("nonlinear")][-1][4]
-    lin_wall, lin_cpu = rows[0][2], rows[0][3]
+    lin_wall = rows[0][2]
     print(f"{args.system}, regular H {H:g} m T {T:g} s, {n} RK4 steps of {dt} s; median of "
           f"{args.repeats} warm calls")
     names = [c.split(".", 1)[1] if args.system == "sphere" else c for c in coords]
-    # (wu_yuan_m1: the coordinates' full names)
     print(f"{'row':28s} {'triangles':>9s} {'wall µs/step':>13s} {'CPU µs/step':>12s} "
           f"{'× linear':>9s} " + " ".join(f"{c:>13s}" for c in names) + " "
           + " ".join(f"{'Δ ' + c:>15s}" for c in names)

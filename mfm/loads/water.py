@@ -192,9 +192,8 @@ class HeldHulls(eqx.Module):
     def hydrostatic(self, geometry, kin):
         """The linear level's hydrostatic load (6K,): ρgV ẑ at each centre of buoyancy (as loads
         at r_k) − C_wp ξ."""
-        f, lever = buoyancy_at(geometry, kin, self.buoyancy, self.d_cob)
-        moment = jnp.cross(lever - geometry._frames(kin)[2], f)
-        return jnp.concatenate([f, moment], axis=1).reshape(-1) - self.C_wp @ geometry.xi(kin)
+        return (buoyancy_load(geometry, kin, self.buoyancy, self.d_cob)
+                - self.C_wp @ geometry.xi(kin))
 
     def linear(self, geometry, kin, wave, t):
         """(hydrostatic, Froude–Krylov) of the linear level at (t, kin), ``wave`` ramped."""
@@ -203,13 +202,15 @@ class HeldHulls(eqx.Module):
         return self.hydrostatic(geometry, kin), c @ self.fk_re - s @ self.fk_im
 
 
-def buoyancy_at(geometry, kin, buoyancy, d_cob):
-    """ρgV ẑ at each centre of buoyancy: the forces (K, 3) and the levers CoB − CoM (K, 3),
-    inertial axes; ``buoyancy`` (K,) ρgV, ``d_cob`` (K, 3) CoB − CoM in body axes."""
+def buoyancy_load(geometry, kin, buoyancy, d_cob):
+    """ρgV ẑ at each centre of buoyancy as loads at the reference points r_k (6K,): force and
+    moment (CoB − r_k) × f, inertial axes; ``buoyancy`` (K,) ρgV, ``d_cob`` (K, 3) CoB − CoM in
+    body axes. The linear level's buoyancy (:meth:`Water._forces`, :meth:`HeldHulls.hydrostatic`)."""
     R = kin.E[np.asarray(geometry.body_index), :3, :3]
     lever = se3.rotate(R, d_cob)
     f = jnp.zeros_like(lever).at[:, 2].set(buoyancy)
-    return f, lever
+    return jnp.concatenate([f, jnp.cross(lever - geometry._frames(kin)[2], f)],
+                           axis=1).reshape(-1)
 
 
 class Flow(eqx.Module):
@@ -350,8 +351,7 @@ class Water(Load):
             vr = vr - jnp.concatenate([u, jnp.zeros_like(u)], axis=1).reshape(-1)[rows]
         exc = self._series(self.exc_values, t)
         if self.hulls is None:
-            f, lever = self._buoyancy(kin)
-            buoy = jnp.concatenate([f, jnp.cross(lever - g._frames(kin)[2], f)], axis=1).reshape(-1)
+            buoy = buoyancy_load(g, kin, self.buoyancy, self.d_cob)
         else:
             # the pressure on the wetted hull: its hydrostatic part is the buoyancy and the
             # restoring (C_wp is 0 here), its wave part adds to the tables' diffraction (made
@@ -366,10 +366,6 @@ class Water(Load):
         if self.drift_values is not None:
             out["drift"] = self._series(self.drift_values, t)[rows]
         return out, zd, v, hbias
-
-    def _buoyancy(self, kin):
-        """ρgV ẑ at each centre of buoyancy: the forces (K, 3) and the CoB lever (K, 3)."""
-        return buoyancy_at(self.geometry, kin, self.buoyancy, self.d_cob)
 
     @property
     def _moved(self) -> np.ndarray:
@@ -727,26 +723,27 @@ def linear_spec(spec):
     """A copy of ``spec`` with the linear water (no hulls, drag on the body's velocity): the same
     database, bodies and options, its own cache holding what ``spec`` has made (the radiation's
     fits and kernels, the same for both) but not its replaced copies (those carry the hulls)."""
-    import copy
-
-    out = copy.copy(spec)
-    for name in ABOVE_LINEAR:
-        out.__dict__.pop(name, None)
-    out._cache = {k: v for k, v in spec._cache.items()
-                  if not (isinstance(k, tuple) and k and k[0] == "replace")}
-    return out
+    return _spec_copy(spec, drop=ABOVE_LINEAR)
 
 
 def sampled_spec(spec, nonlinear_dt: float | None):
     """A copy of ``spec`` (at the nonlinear level) whose hull pressure is sampled every
     ``nonlinear_dt`` s (:class:`HeldHulls`), or at every evaluation (None); its caches shared as
     :func:`linear_spec`'s."""
+    out = _spec_copy(spec, drop=("nonlinear_dt",))
+    if nonlinear_dt is not None:
+        out.nonlinear_dt = float(nonlinear_dt)
+    return out
+
+
+def _spec_copy(spec, drop):
+    """A copy of ``spec`` without the attributes ``drop``, its own cache holding what ``spec`` has
+    made but not its replaced copies (keyed ``("replace", …)``: those carry the attributes)."""
     import copy
 
     out = copy.copy(spec)
-    out.__dict__.pop("nonlinear_dt", None)
-    if nonlinear_dt is not None:
-        out.nonlinear_dt = float(nonlinear_dt)
+    for name in drop:
+        out.__dict__.pop(name, None)
     out._cache = {k: v for k, v in spec._cache.items()
                   if not (isinstance(k, tuple) and k and k[0] == "replace")}
     return out
@@ -832,11 +829,16 @@ def froude_krylov_coefficients(spec, comps) -> np.ndarray:
     """The hulls' linear Froude–Krylov force per metre of amplitude at each component, (J, 6K)
     complex, about each body's reference point at rest (:func:`hydro.wetted.froude_krylov_linear`
     at the component's k and heading); (0, 6K) in still water."""
-    from hydro.wetted import froude_krylov_linear
-
     if comps is None or len(comps.omega) == 0:
         return np.zeros((0, 6 * len(spec.hulls)), complex)
-    return np.concatenate([froude_krylov_linear(T, spec.ref0[k], comps.wavenumber, comps.heading,
+    return _froude_krylov_at(spec, comps.wavenumber, comps.heading)
+
+
+def _froude_krylov_at(spec, wavenumber, heading) -> np.ndarray:
+    """X_FK (J, 6K) complex of every hull at the wavenumbers and headings (J,)."""
+    from hydro.wetted import froude_krylov_linear
+
+    return np.concatenate([froude_krylov_linear(T, spec.ref0[k], wavenumber, heading,
                                                 water_depth=spec.water_depth, rho=spec.rho,
                                                 g=spec.g)
                            for k, T in enumerate(spec.hulls)], axis=1)
@@ -1188,21 +1190,15 @@ def _froude_krylov_many(spec, comps) -> list:
     """Each case's X_FK (J_i, 6K) of :func:`froude_krylov_series` (the hulls at rest,
     :func:`hydro.wetted.froude_krylov_linear` at each component's k and heading), the distinct
     (k, β) of every case made once, :data:`FK_CHUNK` at a time."""
-    from hydro.wetted import froude_krylov_linear
-
     counts = [len(c.omega) for c in comps]
     if not sum(counts):
         return [np.zeros((0, len(spec.dofs)), complex) for _ in comps]
     kb = np.stack([np.concatenate([np.asarray(c.wavenumber, float) for c in comps]),
                    np.concatenate([np.asarray(c.heading, float) for c in comps])], axis=1)
     pairs, inverse = np.unique(kb, axis=0, return_inverse=True)
-    X = np.concatenate([
-        np.concatenate([froude_krylov_linear(T, spec.ref0[k], pairs[j:j + FK_CHUNK, 0],
-                                             pairs[j:j + FK_CHUNK, 1],
-                                             water_depth=spec.water_depth, rho=spec.rho,
-                                             g=spec.g)
-                        for k, T in enumerate(spec.hulls)], axis=1)
-        for j in range(0, len(pairs), FK_CHUNK)])
+    X = np.concatenate([_froude_krylov_at(spec, pairs[j:j + FK_CHUNK, 0],
+                                          pairs[j:j + FK_CHUNK, 1])
+                        for j in range(0, len(pairs), FK_CHUNK)])
     return np.split(X[np.asarray(inverse).reshape(-1)], np.cumsum(counts)[:-1])
 
 
