@@ -16,6 +16,8 @@ failure is recorded as its error string and the others go on):
   dt=T/40, ramp=5 dt, radiation="convolution", memory=T/2)`` (20 RK4 steps);
   ``frequency_response``: ``mfm.frequency_response(m, ω)``, ω 3 frequencies geometrically spaced
   over [0.7 ω_c, 1.4 ω_c] ∩ the database's range;
+  ``simulate_chunked``: the ``simulate`` call (the convolution) with a progress bar (drawn nowhere),
+  the command line's path: the run in chunks, their own start and programs;
   for rm3 and m4_111 also ``simulate_state_space`` (the same run with ``radiation="state_space"``
   and no ``memory``)
   and ``frequency_response_state_space`` (``radiation="state_space"``);
@@ -56,8 +58,10 @@ both with the same (masked) error string is shown as "same error" and is not.
 Runtime (this 2-core machine, measured at 7ace823): the probe takes 8–11 minutes per tree (494 s
 on a quiet machine, 626 and 667 s with the test suite and another probe running beside it; 18
 configs, 57 calls; the six Wu & Yuan configs with 18 coordinates 34–53 s each (to 72 s loaded),
-the others 2–35 s; ``--only`` runs a few), the comparison a few seconds. So a check against a
-commit takes ~17–22 minutes, one against a saved reference (``--reference``) half that; the
+the others 2–35 s; ``--only`` runs a few), the comparison a few seconds. With the chunked
+calls (2026-11-29: 21 configs, 87 calls) a whole check against HEAD took ~14 minutes on the
+quiet machine. So a check against a
+commit takes ~15–22 minutes, one against a saved reference (``--reference``) half that; the
 datasets take 3 MB. A saved reference compares only under the same environment and machine (the
 jax/XLA versions, the flags and the CPU decide the bits).
 
@@ -117,6 +121,8 @@ out.mkdir(parents=True, exist_ok=True)
 state_space_configs = set(sys.argv[2].split(","))
 configs = sys.argv[3:]
 summary = {"tree": os.getcwd(), "xla_flags": os.environ.get("XLA_FLAGS", ""), "calls": {}}
+# a bar drawn nowhere: the run in chunks, as the command line makes it
+BAR = {"file": open(os.devnull, "w")}
 
 
 def record(key, fn):
@@ -159,6 +165,8 @@ for path in configs:
     if m.hydro is None:
         record(f"{name}.simulate", lambda: mfm.simulate(
             m, None, duration=0.5, dt=0.01, q0=np.full(m.n_coordinates, 0.5)))
+        record(f"{name}.simulate_chunked", lambda: mfm.simulate(
+            m, None, duration=0.5, dt=0.01, q0=np.full(m.n_coordinates, 0.5), progress=BAR))
         continue
     om = np.asarray(m.hydro.db["omega"].values, dtype=float)
     wc = math.sqrt(m.hydro.g / float(np.max(m.hydro.volume)) ** (1.0 / 3.0))
@@ -175,6 +183,10 @@ for path in configs:
         record(f"{name}.simulate{suffix}", lambda: mfm.simulate(
             m, sea, duration=20 * dt, dt=dt, ramp=5 * dt, radiation=rad,
             memory=T / 2 if rad == "convolution" else None))
+    # the command line's path: a progress bar, the run in chunks (their own start and programs)
+    record(f"{name}.simulate_chunked", lambda: mfm.simulate(
+        m, sea, duration=20 * dt, dt=dt, ramp=5 * dt, radiation="convolution", memory=T / 2,
+        progress=BAR))
     record(f"{name}.frequency_response", lambda: mfm.frequency_response(m, omega))
     if name in state_space_configs:
         record(f"{name}.frequency_response_state_space",
