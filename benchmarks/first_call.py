@@ -2,7 +2,7 @@
 
     python benchmarks/first_call.py [--only rm3 rm3_cached m4 m4_cached wu_yuan wu_yuan_fd
                                      wu_yuan_fd_cached optimize optimize_cached yardstick
-                                     rm3_fast]
+                                     rm3_fast warm] [--warm-repeats 5]
 
 - ``rm3``: the README's first command (``mfm simulate configs/rm3.toml ...``, the run without the
   install), compilation and fit caches empty (fresh folders). Goal (issue 55) ≤ 5 CPU s.
@@ -23,6 +23,12 @@
   ``optimize_cached``: the same in a second fresh process. Goals (issue 55) ≤ 12 and ≤ 2 CPU s.
 - ``rm3_fast``: the README's first command with ``--fast-compile`` (``compile="fast"``: every
   program of the run at XLA's lowest optimisation level), empty caches. Not run unless named.
+- ``warm``: the issue's row "warm calls, every row" (no slower than 2 %): in one process per
+  system, the call of the rows ``rm3`` (``mfm.simulate`` with the README command's arguments and
+  its progress bar, drawn nowhere), ``m4``, ``optimize`` and, with ``wu_yuan`` in ``--only``, the
+  Wu & Yuan run (its bar too), made once (compiled) and then ``--warm-repeats`` times: the median
+  and the least of their wall and CPU seconds (the process's, every thread, over each call).
+  Compare trees by running the script under each (``PYTHONPATH=<tree>``), in turn.
 - ``yardstick``: a fixed piece of jax work in a fresh process (import jax, trace and compile a
   fixed program: 8 RK4 steps of a 12-state nonlinear oscillator chain, unrolled, XLA's default
   options, no cache): machines differ more than their cores say, so every row is also printed as
@@ -93,6 +99,47 @@ with warnings.catch_warnings():
     r = mfm.optimize(m, sea, {"floatB.angle.damping": (0.0, 4e9),
                               "floatC.angle.damping": (0.0, 4e9)})
 print("PHASES", round(time.perf_counter() - t0, 2), float(r["objective"]))
+"""
+
+# the warm calls: one system's call made once, then timed ``repeats`` times in the same process
+WARM = """
+import os, resource, statistics, sys, time, warnings
+import numpy as np
+import hydro, mfm
+
+def cpu():
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
+
+name, repeats = sys.argv[1], int(sys.argv[2])
+bar = {"file": open(os.devnull, "w")}
+if name == "rm3":
+    m = mfm.load("configs/rm3.toml")
+    call = lambda: mfm.simulate(m, hydro.Regular(height=2.5, period=8.0), duration=200.0,
+                                dt=0.1, ramp=40.0, progress=bar)
+elif name == "m4":
+    m = mfm.load("configs/m4_134.toml")
+    sea = hydro.Jonswap(hs=0.04, tp=1.2, gamma=3.3, seed=1, omega_range=(1.0, 25.0))
+    call = lambda: mfm.simulate(m, sea, duration=120.0, dt=0.006)
+elif name == "optimize":
+    m = mfm.load("configs/stansby_li.toml")
+    sea = hydro.Jonswap(hs=2.0, tp=9.0, gamma=3.3, seed=1, omega_range=(0.3, 2.0))
+    call = lambda: mfm.optimize(m, sea, {"floatB.angle.damping": (0.0, 4e9),
+                                         "floatC.angle.damping": (0.0, 4e9)})
+else:
+    m = mfm.load("configs/wu_yuan_m1_td.toml")
+    call = lambda: mfm.simulate(m, hydro.Regular(height=2.0, period=8.0), duration=600.0,
+                                dt=0.05, progress=bar)
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    call()
+    walls, cpus = [], []
+    for _ in range(repeats):
+        t, c = time.perf_counter(), cpu()
+        call()
+        walls.append(time.perf_counter() - t)
+        cpus.append(cpu() - c)
+print("WARM", statistics.median(walls), min(walls), statistics.median(cpus), min(cpus))
 """
 
 YARDSTICK = """
@@ -200,7 +247,9 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", nargs="*",
                     default=["yardstick", "rm3", "rm3_cached", "m4", "m4_cached", "wu_yuan",
-                             "optimize", "optimize_cached"])
+                             "optimize", "optimize_cached", "warm"])
+    ap.add_argument("--warm-repeats", type=int, default=5,
+                    help="the warm calls timed per system (row 'warm'), after one that compiles")
     a = ap.parse_args(argv)
     print(f"{_cores()} cores, load average {os.getloadavg()[0]:.1f} at the start"
           + ("; PYTHONDONTWRITEBYTECODE set: each process compiles mfm's Python sources"
@@ -279,6 +328,20 @@ def main(argv=None):
                            "--progress", "on", "--no-plot", "--out", str(out)], "wy",
                           "15 CPU s")
             print(f"    phases shown: {_phases(r.stderr) or 'none'}")
+        if "warm" in a.only:
+            (tmp / "warm.py").write_text(WARM)
+            systems = {"rm3": "RM3, the README command's simulate", "m4": "M4 134 simulate defaults",
+                       "optimize": "optimize Stansby & Li",
+                       "wu_yuan": "Wu & Yuan m1 time domain, 600 s"}
+            for system, label in systems.items():
+                if system == "wu_yuan" and "wu_yuan" not in a.only:
+                    continue
+                _, r, _ = _run([sys.executable, "warm.py", system, str(a.warm_repeats)],
+                               env(f"warm-{system}"), tmp)
+                w_med, w_min, c_med, c_min = (float(v) for v in r.stdout.split("WARM")[-1].split())
+                print(f"{label}, warm (the same call again in its process, {a.warm_repeats} "
+                      f"times): median {w_med:.3f} s (least {w_min:.3f}) [CPU median {c_med:.3f} s, "
+                      f"least {c_min:.3f}]")
     print(f"load average {os.getloadavg()[0]:.1f} at the end")
 
 
