@@ -30,7 +30,8 @@ as attributes) and ``<dir>/summary.json`` holds per call its file, seconds, erro
 not counted as a difference: hydro says some only once a process). The probe's environment:
 ``XLA_FLAGS="--xla_backend_optimization_level=0 --xla_llvm_disable_expensive_passes=true"`` (fast
 compiles; both trees get the same flags, so the bits are comparable, but they are not the bits of
-a default run), jax's and mfm's caches off (``MFM_COMPILATION_CACHE=off``, ``MFM_FIT_CACHE=off``,
+a default run; ``--xla-flags ''`` runs at XLA's defaults, where a change to compile options
+shows), jax's and mfm's caches off (``MFM_COMPILATION_CACHE=off``, ``MFM_FIT_CACHE=off``,
 ``XDG_CACHE_HOME`` a fresh temporary folder, ``JAX_COMPILATION_CACHE_DIR`` removed),
 ``JAX_PLATFORMS=cpu``, ``PYTHONHASHSEED=0``.
 
@@ -208,13 +209,14 @@ def configs(only=None) -> list[str]:
     return found
 
 
-def probe(tree: Path, out: Path, paths: list[str]) -> dict:
-    """Run the probe in ``tree`` (its own mfm), datasets and summary.json into ``out``."""
+def probe(tree: Path, out: Path, paths: list[str], flags: str = XLA_FLAGS) -> dict:
+    """Run the probe in ``tree`` (its own mfm), datasets and summary.json into ``out``, with
+    ``XLA_FLAGS`` = ``flags``."""
     out.mkdir(parents=True, exist_ok=True)
     print(f"running {len(paths)} configs in {tree} → {out}", flush=True)
     t = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="regression-cache-") as cache:
-        env = dict(os.environ, PYTHONPATH=str(tree), XLA_FLAGS=XLA_FLAGS, JAX_PLATFORMS="cpu",
+        env = dict(os.environ, PYTHONPATH=str(tree), XLA_FLAGS=flags, JAX_PLATFORMS="cpu",
                    MFM_COMPILATION_CACHE="off", MFM_FIT_CACHE="off", XDG_CACHE_HOME=cache,
                    MFM_BEM_CACHE=str(Path(cache) / "bem"), PYTHONHASHSEED="0")
         env.pop("JAX_COMPILATION_CACHE_DIR", None)
@@ -232,14 +234,14 @@ def read_summary(folder: Path) -> dict:
     return json.loads(f.read_text())
 
 
-def probe_commit(rev: str, out: Path, paths: list[str]) -> dict:
+def probe_commit(rev: str, out: Path, paths: list[str], flags: str = XLA_FLAGS) -> dict:
     """The probe in a temporary detached worktree of ``rev`` (removed afterwards)."""
     with tempfile.TemporaryDirectory(prefix="regression-tree-") as tmp:
         tree = Path(tmp) / "tree"
         subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), rev],
                        check=True, capture_output=True)
         try:
-            return probe(tree, out, paths)
+            return probe(tree, out, paths, flags)
         finally:
             subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)],
                            capture_output=True, check=False)
@@ -441,6 +443,10 @@ def main(argv=None) -> int:
                          "(default 0: the same bits)")
     ap.add_argument("--only", nargs="+", default=None, metavar="NAME",
                     help="only these configs (stems, e.g. rm3 m4_134)")
+    ap.add_argument("--xla-flags", default=XLA_FLAGS, metavar="FLAGS",
+                    help="the probe's XLA_FLAGS (default: level 0, fast compiles); '' for XLA's "
+                         "defaults, the bits a user's run has (a change to compile options "
+                         "shows only there; the probe takes about twice as long)")
     args = ap.parse_args(argv)
     if args.reference is not None and args.commit is not None:
         ap.error("--reference and --commit are alternatives")
@@ -451,7 +457,7 @@ def main(argv=None) -> int:
     if args.write is not None:
         if args.write.exists() and any(args.write.iterdir()):
             ap.error(f"--write {args.write}: the folder is not empty")
-        calls = probe(ROOT, args.write, paths)["calls"]
+        calls = probe(ROOT, args.write, paths, args.xla_flags)["calls"]
         failed = [k for k, e in calls.items() if e["error"]]
         for k in failed:
             print(f"  failed: {k}: {calls[k]['error']}")
@@ -475,9 +481,9 @@ def main(argv=None) -> int:
             full = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", rev],
                                   capture_output=True, text=True, check=True).stdout.strip()
             print(f"reference: commit {rev} ({full})")
-            probe_commit(full, ref_dir, paths)
+            probe_commit(full, ref_dir, paths, args.xla_flags)
         new_dir = base / "current"
-        probe(ROOT, new_dir, paths)
+        probe(ROOT, new_dir, paths, args.xla_flags)
         label = new_dir if args.keep is not None else f"this tree, {ROOT}"
         return compare(ref_dir, new_dir, args.rtol, args.only, label)
 
