@@ -104,7 +104,6 @@ print("PHASES", round(time.perf_counter() - t0, 2), float(r["objective"]))
 # the warm calls: one system's call made once, then timed ``repeats`` times in the same process
 WARM = """
 import os, resource, statistics, sys, time, warnings
-import numpy as np
 import hydro, mfm
 
 def cpu():
@@ -251,6 +250,8 @@ def main(argv=None):
     ap.add_argument("--warm-repeats", type=int, default=5,
                     help="the warm calls timed per system (row 'warm'), after one that compiles")
     a = ap.parse_args(argv)
+    if a.warm_repeats < 1:
+        ap.error(f"--warm-repeats {a.warm_repeats}: give 1 or more")
     print(f"{_cores()} cores, load average {os.getloadavg()[0]:.1f} at the start"
           + ("; PYTHONDONTWRITEBYTECODE set: each process compiles mfm's Python sources"
              if os.environ.get("PYTHONDONTWRITEBYTECODE") else ""))

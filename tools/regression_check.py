@@ -446,7 +446,8 @@ def main(argv=None) -> int:
     ap.add_argument("--xla-flags", default=XLA_FLAGS, metavar="FLAGS",
                     help="the probe's XLA_FLAGS (default: level 0, fast compiles); '' for XLA's "
                          "defaults, the bits a user's run has (a change to compile options "
-                         "shows only there; the probe takes about twice as long)")
+                         "shows only there; slower: both trees ~20 minutes with the test suite "
+                         "beside them, 2026-11-29)")
     args = ap.parse_args(argv)
     if args.reference is not None and args.commit is not None:
         ap.error("--reference and --commit are alternatives")
