@@ -44,6 +44,7 @@ model, paid once for a scene that is then run long or swept.
 """
 from __future__ import annotations
 
+import dataclasses
 import numbers
 import time as _time
 from dataclasses import dataclass, field
@@ -91,8 +92,6 @@ def linear_water(model: Model) -> Model:
     """``model`` with the linear water: its spec without the nonlinear level's hulls and the wave
     drift, with drag on the body's velocity (the same database, bodies and options; the radiation's fits and
     kernels shared, as they do not depend on either)."""
-    import dataclasses
-
     from ..loads.water import linear_spec
 
     if not above_linear(model):
@@ -114,16 +113,12 @@ def variant_model(model: Model, variant: dict) -> Model:
     if variant.pop("linear_water", False):
         model = linear_water(model)
     if "nonlinear_dt" in variant:
-        import dataclasses
-
         from ..loads.water import sampled_spec
 
         model = dataclasses.replace(model, hydro=sampled_spec(model.hydro,
                                                               variant.pop("nonlinear_dt")))
     if not variant:
         return model
-    import dataclasses
-
     return dataclasses.replace(model, hydro=model.hydro.replace(**variant))
 
 
