@@ -64,17 +64,42 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 
-M4 = """
-import time, warnings
-t0 = time.perf_counter()
-import hydro, mfm
+# each row's call, ``call()`` (made by the row's script and, again and again, by the row warm)
+M4_CALL = """
 m = mfm.load("configs/m4_134.toml")
 sea = hydro.Jonswap(hs=0.04, tp=1.2, gamma=3.3, seed=1, omega_range=(1.0, 25.0))
-with warnings.catch_warnings():
-    warnings.simplefilter("ignore")
-    ds = mfm.simulate(m, sea, duration=120.0, dt=0.006)
-print("PHASES", round(time.perf_counter() - t0, 2), float(ds.pto_power.mean()))
+call = lambda: mfm.simulate(m, sea, duration=120.0, dt=0.006)
 """
+OPTIMIZE_CALL = """
+m = mfm.load("configs/stansby_li.toml")
+sea = hydro.Jonswap(hs=2.0, tp=9.0, gamma=3.3, seed=1, omega_range=(0.3, 2.0))
+call = lambda: mfm.optimize(m, sea, {"floatB.angle.damping": (0.0, 4e9),
+                                     "floatC.angle.damping": (0.0, 4e9)})
+"""
+# the warm rows of the README's RM3 command (mfm.simulate with its arguments and its bar, drawn
+# nowhere) and of Wu & Yuan's run
+RM3_CALL = """
+m = mfm.load("configs/rm3.toml")
+call = lambda: mfm.simulate(m, hydro.Regular(height=2.5, period=8.0), duration=200.0, dt=0.1,
+                            ramp=40.0, progress={"file": open(os.devnull, "w")})
+"""
+WU_YUAN_CALL = """
+m = mfm.load("configs/wu_yuan_m1_td.toml")
+call = lambda: mfm.simulate(m, hydro.Regular(height=2.0, period=8.0), duration=600.0, dt=0.05,
+                            progress={"file": open(os.devnull, "w")})
+"""
+
+# a row's script: its call once, timed from the process's start
+ROW = """
+import os, time, warnings
+t0 = time.perf_counter()
+import hydro, mfm
+warnings.simplefilter("ignore")
+{call}
+out = call()
+print("PHASES", round(time.perf_counter() - t0, 2))
+"""
+M4 = ROW.format(call=M4_CALL)
 
 FD = """
 import time, warnings
@@ -88,56 +113,27 @@ print("PHASES", round(time.perf_counter() - t0, 2), float(np.abs(r.rao).max()))
 """
 
 
-OPTIMIZE = """
-import time, warnings
-t0 = time.perf_counter()
-import hydro, mfm
-with warnings.catch_warnings():
-    warnings.simplefilter("ignore")
-    m = mfm.load("configs/stansby_li.toml")
-    sea = hydro.Jonswap(hs=2.0, tp=9.0, gamma=3.3, seed=1, omega_range=(0.3, 2.0))
-    r = mfm.optimize(m, sea, {"floatB.angle.damping": (0.0, 4e9),
-                              "floatC.angle.damping": (0.0, 4e9)})
-print("PHASES", round(time.perf_counter() - t0, 2), float(r["objective"]))
-"""
+OPTIMIZE = ROW.format(call=OPTIMIZE_CALL)
 
-# the warm calls: one system's call made once, then timed ``repeats`` times in the same process
+# a warm row's script: its call made once, then timed ``repeats`` (argv[1]) times in the same
+# process
 WARM = """
 import os, resource, statistics, sys, time, warnings
 import hydro, mfm
+warnings.simplefilter("ignore")
 
 def cpu():
     r = resource.getrusage(resource.RUSAGE_SELF)
     return r.ru_utime + r.ru_stime
 
-name, repeats = sys.argv[1], int(sys.argv[2])
-bar = {"file": open(os.devnull, "w")}
-if name == "rm3":
-    m = mfm.load("configs/rm3.toml")
-    call = lambda: mfm.simulate(m, hydro.Regular(height=2.5, period=8.0), duration=200.0,
-                                dt=0.1, ramp=40.0, progress=bar)
-elif name == "m4":
-    m = mfm.load("configs/m4_134.toml")
-    sea = hydro.Jonswap(hs=0.04, tp=1.2, gamma=3.3, seed=1, omega_range=(1.0, 25.0))
-    call = lambda: mfm.simulate(m, sea, duration=120.0, dt=0.006)
-elif name == "optimize":
-    m = mfm.load("configs/stansby_li.toml")
-    sea = hydro.Jonswap(hs=2.0, tp=9.0, gamma=3.3, seed=1, omega_range=(0.3, 2.0))
-    call = lambda: mfm.optimize(m, sea, {"floatB.angle.damping": (0.0, 4e9),
-                                         "floatC.angle.damping": (0.0, 4e9)})
-else:
-    m = mfm.load("configs/wu_yuan_m1_td.toml")
-    call = lambda: mfm.simulate(m, hydro.Regular(height=2.0, period=8.0), duration=600.0,
-                                dt=0.05, progress=bar)
-with warnings.catch_warnings():
-    warnings.simplefilter("ignore")
+{call}
+call()
+walls, cpus = [], []
+for _ in range(int(sys.argv[1])):
+    t, c = time.perf_counter(), cpu()
     call()
-    walls, cpus = [], []
-    for _ in range(repeats):
-        t, c = time.perf_counter(), cpu()
-        call()
-        walls.append(time.perf_counter() - t)
-        cpus.append(cpu() - c)
+    walls.append(time.perf_counter() - t)
+    cpus.append(cpu() - c)
 print("WARM", statistics.median(walls), min(walls), statistics.median(cpus), min(cpus))
 """
 
@@ -330,14 +326,15 @@ def main(argv=None):
                           "15 CPU s")
             print(f"    phases shown: {_phases(r.stderr) or 'none'}")
         if "warm" in a.only:
-            (tmp / "warm.py").write_text(WARM)
-            systems = {"rm3": "RM3, the README command's simulate", "m4": "M4 134 simulate defaults",
-                       "optimize": "optimize Stansby & Li",
-                       "wu_yuan": "Wu & Yuan m1 time domain, 600 s"}
-            for system, label in systems.items():
+            systems = {"rm3": ("RM3, the README command's simulate", RM3_CALL),
+                       "m4": ("M4 134 simulate defaults", M4_CALL),
+                       "optimize": ("optimize Stansby & Li", OPTIMIZE_CALL),
+                       "wu_yuan": ("Wu & Yuan m1 time domain, 600 s", WU_YUAN_CALL)}
+            for system, (label, call) in systems.items():
                 if system == "wu_yuan" and "wu_yuan" not in a.only:
                     continue
-                _, r, _ = _run([sys.executable, "warm.py", system, str(a.warm_repeats)],
+                (tmp / f"warm_{system}.py").write_text(WARM.format(call=call))
+                _, r, _ = _run([sys.executable, f"warm_{system}.py", str(a.warm_repeats)],
                                env(f"warm-{system}"), tmp)
                 w_med, w_min, c_med, c_min = (float(v) for v in r.stdout.split("WARM")[-1].split())
                 print(f"{label}, warm (the same call again in its process, {a.warm_repeats} "
